@@ -1,0 +1,139 @@
+/* h5format: the element-state file (one HDF5 file per simulation), written by cdem-run and
+ * read by cdem-strain, h5py and ParaView (through the .xmf sidecar). docs/format.md is the
+ * authority on the layout; this header is its C interface.
+ *
+ * Layout (format version CDEM_FORMAT_VERSION):
+ *   /                      attrs: format ("cdem-c"), format_version, program_version, seed,
+ *                                 created, summary, params_text, stop_reason, stop_detail
+ *   /parameters            one attribute per parameter "section.key" (value as text) plus
+ *                          a table dataset (name, value, unit)
+ *   /increments/NNNNNN     one group per display increment (6-digit number), attrs: number,
+ *                          step, time, phase, net_displacement, axial_strain, sea_level, n;
+ *                          datasets: id, x, y, radius, layer, flags, born [, sxx, syy, sxy]
+ *   /series/<column>       extendible 1-D datasets sampled during the run
+ * Every dataset is chunked and compressed (shuffle + deflate). The writer flushes after
+ * every increment, so a file whose writer died keeps every increment completed before.
+ * Ownership: writer and reader are opaque handles; _close/_free release them.
+ * Thread safety: one handle per thread; HDF5 itself is not called concurrently. */
+#ifndef CDEM_H5FORMAT_H
+#define CDEM_H5FORMAT_H
+
+#include "cdem_error.h"
+#include "params.h"
+#include "state.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define CDEM_FORMAT_NAME "cdem-c"
+#define CDEM_FORMAT_VERSION 1
+
+typedef enum {
+    CDEM_PHASE_EQUILIBRATION = 0, /* walls still, assembly settling */
+    CDEM_PHASE_DEFORMATION = 1,   /* boundaries moving */
+    CDEM_PHASE_SETTLING = 2,      /* boundaries still while new sediment settles */
+} cdem_phase;
+
+/* What is known about one display increment. */
+typedef struct {
+    int32_t number;          /* increment number, 0 = start of equilibration */
+    int64_t step;            /* time step at which it was written */
+    double time;             /* model time, s */
+    int32_t phase;           /* cdem_phase */
+    double net_displacement; /* m, displacement of the moving boundary (net under inversion) */
+    double axial_strain;     /* biaxial test: platen shortening / initial height; else 0 */
+    double differential_stress; /* biaxial test: sigma1 - sigma3 in N/m; else 0 */
+    double sea_level;        /* m; NaN when there is no sedimentation */
+    int64_t n_elements;      /* element count of the increment (filled by the reader) */
+    int32_t has_stress;      /* 1 when sxx, syy, sxy are stored (filled by the reader) */
+} cdem_increment_info;
+
+/* One time-series sample. Columns with no meaning for the mode are 0. */
+typedef struct {
+    int64_t step;               /* time step */
+    double time;                /* s */
+    double kinetic_energy;      /* J per metre, sum of 1/2 m v^2 over free elements */
+    int64_t contacts;           /* touching pairs */
+    int64_t bonds;              /* intact bonds (bonded model) or cohesive contacts (granular) */
+    int64_t n_elements;         /* elements present */
+    double net_displacement;    /* m */
+    double boundary_force_x;    /* N, total contact force on the moving boundary elements */
+    double boundary_force_y;    /* N */
+    double base_force_x;        /* N, total contact force on the fixed base elements */
+    double base_force_y;        /* N */
+    double axial_strain;        /* biaxial */
+    double differential_stress; /* biaxial, N/m */
+    double sea_level;           /* m, NaN when none */
+} cdem_series_sample;
+
+/* Everything stored once per file. Strings may be NULL (stored empty). */
+typedef struct {
+    const cdem_params *params;   /* the full parameter record (required) */
+    const char *params_text;     /* the original parameter-file text, or NULL */
+    const char *summary;         /* the model summary text */
+    const char *program_version; /* e.g. CDEM_VERSION */
+    const char *source;          /* "cdem-run" or "cdem2d-import:<folder>" */
+} cdem_run_meta;
+
+/* ---------------------------------------------------------------- writer */
+typedef struct cdem_h5_writer cdem_h5_writer;
+
+/* Creates path (truncating), writes the metadata and the .xmf sidecar placeholder, and
+ * flushes. Fails with CDEM_ERR_IO naming the path if it cannot be created. */
+cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta,
+                                  cdem_h5_writer **out, cdem_error *err);
+
+/* Appends one increment (all s->n elements; stress when s->has_stress), updates the .xmf
+ * sidecar and flushes the file. */
+cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increment_info *info,
+                                           const cdem_state *s, cdem_error *err);
+
+/* Appends one time-series sample (buffered; written at the next increment or close). */
+cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sample *sample,
+                                         cdem_error *err);
+
+/* Records how the run ended: "completed", "interrupted", "numerical-failure", ... and a
+ * free-text diagnosis. */
+cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason,
+                                           const char *detail, cdem_error *err);
+
+/* Flushes everything and closes; w may be NULL. Returns the first error met. */
+cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err);
+
+/* ---------------------------------------------------------------- reader */
+typedef struct cdem_h5_reader cdem_h5_reader;
+
+/* Opens a cdem file read-only. Non-HDF5, non-cdem, wrong-version, truncated or corrupt
+ * files fail with a message naming the path and the problem, never a crash. */
+cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_error *err);
+void cdem_h5_reader_close(cdem_h5_reader *r);
+
+/* Increments present, in ascending number order. */
+size_t cdem_h5_reader_increment_count(const cdem_h5_reader *r);
+cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
+                                          cdem_increment_info *info, cdem_error *err);
+
+/* Resolves "K" (an increment number), "last", "first" or "equil" (the last increment of the
+ * equilibration phase) to an index. */
+cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec,
+                                          size_t *index, cdem_error *err);
+
+/* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero). */
+cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_state *s,
+                                          cdem_increment_info *info, cdem_error *err);
+
+/* Reads the whole time series (malloc'd array, caller frees). */
+cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **samples,
+                                       size_t *count, cdem_error *err);
+
+/* Stored texts ("" when absent); valid until close. */
+const char *cdem_h5_reader_summary(const cdem_h5_reader *r);
+const char *cdem_h5_reader_params_text(const cdem_h5_reader *r);
+const char *cdem_h5_reader_stop_reason(const cdem_h5_reader *r);
+const char *cdem_h5_reader_program_version(const cdem_h5_reader *r);
+long cdem_h5_reader_seed(const cdem_h5_reader *r);
+
+/* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */
+cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err);
+
+#endif

@@ -1,0 +1,90 @@
+/* state: the element state shared by cdem-run, cdem-strain and the file format.
+ *
+ * A struct of arrays (one array per property, index = element slot), so hot loops stream
+ * through memory and each array maps one-to-one onto an HDF5 dataset. An element keeps its
+ * id for life; added elements get new ids (next_id); removed elements are compacted away.
+ * Stress arrays (sxx, syy, sxy) exist only when has_stress is set. The solver may keep its
+ * own extra per-element arrays, indexed the same way, in its own context.
+ * Ownership: cdem_state owns its arrays; cdem_state_free releases them. Growth is geometric
+ * (reserve), never inside a time step. Thread safety: none; one owner at a time.
+ * Units: m, m/s, N, kg per metre of thickness, N/m for stress (compression positive). */
+#ifndef CDEM_STATE_H
+#define CDEM_STATE_H
+
+#include "cdem_error.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Element flags (bit field, stored as uint32 in every increment). */
+enum {
+    CDEM_FLAG_WALL = 1u << 0,          /* fixed or moving wall element (base, lateral wall, platen) */
+    CDEM_FLAG_FAULT = 1u << 1,         /* element of a fault face */
+    CDEM_FLAG_MOVING = 1u << 2,        /* boundary element whose motion is prescribed by the mode */
+    CDEM_FLAG_GROWTH = 1u << 3,        /* deposited during the run (syn-tectonic sedimentation) */
+    CDEM_FLAG_WEAK = 1u << 4,          /* inside the weak and/or light interval */
+    CDEM_FLAG_BIAXIAL_EDGE = 1u << 5,  /* biaxial free-edge element carrying confining pressure */
+    CDEM_FLAG_FOOTWALL = 1u << 6,      /* removed footwall element kept fixed for display only */
+    CDEM_FLAG_MYLAR = 1u << 7,         /* CD "mylar sheet" element dragging the hanging wall */
+    CDEM_FLAG_SURFACE = 1u << 8,       /* top-surface element (overburden acts on it) */
+};
+
+/* Elements that are integrated by Newton's law: neither wall, fault nor footwall display. */
+#define CDEM_FLAGS_BOUNDARY (CDEM_FLAG_WALL | CDEM_FLAG_FAULT | CDEM_FLAG_FOOTWALL | CDEM_FLAG_MYLAR)
+
+typedef struct {
+    size_t n;        /* number of elements in use */
+    size_t capacity; /* allocated length of every array */
+    int has_stress;  /* 1: sxx, syy, sxy are allocated */
+    int32_t next_id; /* id for the next added element */
+
+    int32_t *id;     /* stable element id, unique within a run */
+    double *x, *y;   /* centre position, m */
+    double *vx, *vy; /* velocity, m/s */
+    double *fx, *fy; /* total force of the current step, N */
+    double *radius;  /* m */
+    double *mass;    /* kg per metre */
+    int32_t *layer;  /* 1..24 pre-growth layers; 25.. growth layers; 0 = wall/unassigned */
+    uint32_t *flags; /* CDEM_FLAG_* bits */
+    int32_t *born;   /* increment number at which the element was created (0 = initial) */
+    double *sxx, *syy, *sxy; /* stress, N/m, compression positive; NULL unless has_stress */
+} cdem_state;
+
+/* Initialises an empty state with room for capacity elements. */
+cdem_status cdem_state_init(cdem_state *s, size_t capacity, int with_stress, cdem_error *err);
+
+/* Releases every array; s may be NULL. Leaves s empty. */
+void cdem_state_free(cdem_state *s);
+
+/* Grows every array to hold at least capacity elements (geometric growth). */
+cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err);
+
+/* Allocates the stress arrays (zeroed) if they are missing. */
+cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err);
+
+/* Appends one element with zero velocity and force; returns its index in *index.
+ * id < 0 means "assign next_id". */
+cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, double radius,
+                              double mass, int32_t layer, uint32_t flags, int32_t born,
+                              size_t *index, cdem_error *err);
+
+/* Removes the elements whose keep[i] is 0, preserving the order of the rest. keep_out
+ * (optional, length n before the call) receives for each old index its new index or
+ * SIZE_MAX. */
+void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_index_out);
+
+/* Copies src into dst (dst is (re)initialised). */
+cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *err);
+
+/* Map from element id to index, for matching elements across increments. */
+typedef struct {
+    int32_t min_id, max_id; /* range of ids present */
+    size_t *index;          /* index[id - min_id] = slot, or SIZE_MAX when absent */
+} cdem_id_map;
+
+cdem_status cdem_id_map_build(cdem_id_map *map, const cdem_state *s, cdem_error *err);
+/* Slot of id, or SIZE_MAX when the id is not in the state. */
+size_t cdem_id_map_find(const cdem_id_map *map, int32_t id);
+void cdem_id_map_free(cdem_id_map *map);
+
+#endif
