@@ -37,8 +37,16 @@ void cdem_error_prefix(cdem_error *err, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(prefix, sizeof prefix, fmt, ap);
     va_end(ap);
+    /* Build "prefix: message" by hand: the sum may exceed the buffer and is cut there. */
     char joined[CDEM_ERROR_MSG_MAX];
-    snprintf(joined, sizeof joined, "%s: %s", prefix, err->msg);
+    size_t plen = strlen(prefix), mlen = strlen(err->msg), cap = sizeof joined - 1;
+    size_t pos = plen < cap ? plen : cap;
+    memcpy(joined, prefix, pos);
+    for (const char *sep = ": "; *sep && pos < cap; sep++)
+        joined[pos++] = *sep;
+    size_t take = mlen < cap - pos ? mlen : cap - pos;
+    memcpy(joined + pos, err->msg, take);
+    joined[pos + take] = '\0';
     memcpy(err->msg, joined, sizeof joined);
 }
 

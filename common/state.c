@@ -1,0 +1,182 @@
+/* state: see state.h. Arrays grow together (one realloc per array, geometric), so every
+ * index is valid in every array at all times. */
+#include "state.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define STATE_ARRAYS(X)                                                                            \
+    X(id, int32_t)                                                                                 \
+    X(x, double)                                                                                   \
+    X(y, double)                                                                                   \
+    X(vx, double)                                                                                  \
+    X(vy, double)                                                                                  \
+    X(fx, double)                                                                                  \
+    X(fy, double)                                                                                  \
+    X(radius, double)                                                                              \
+    X(mass, double)                                                                                \
+    X(layer, int32_t)                                                                              \
+    X(flags, uint32_t)                                                                             \
+    X(born, int32_t)
+
+#define STRESS_ARRAYS(X) X(sxx, double) X(syy, double) X(sxy, double)
+
+static int grow_array(void **p, size_t elem_size, size_t old_cap, size_t new_cap) {
+    void *q = realloc(*p, new_cap * elem_size);
+    if (!q)
+        return 0;
+    memset((char *)q + old_cap * elem_size, 0, (new_cap - old_cap) * elem_size);
+    *p = q;
+    return 1;
+}
+
+cdem_status cdem_state_init(cdem_state *s, size_t capacity, int with_stress, cdem_error *err) {
+    memset(s, 0, sizeof *s);
+    s->next_id = 0;
+    CDEM_TRY(cdem_state_reserve(s, capacity ? capacity : 16, err));
+    if (with_stress)
+        CDEM_TRY(cdem_state_enable_stress(s, err));
+    return CDEM_OK;
+}
+
+void cdem_state_free(cdem_state *s) {
+    if (!s)
+        return;
+#define FREE_ONE(name, type) free(s->name);
+    STATE_ARRAYS(FREE_ONE)
+    STRESS_ARRAYS(FREE_ONE)
+#undef FREE_ONE
+    memset(s, 0, sizeof *s);
+}
+
+cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) {
+    if (capacity <= s->capacity)
+        return CDEM_OK;
+    size_t new_cap = s->capacity ? s->capacity : 16;
+    while (new_cap < capacity)
+        new_cap += new_cap / 2 + 1;
+#define GROW_ONE(name, type)                                                                       \
+    if (!grow_array((void **)&s->name, sizeof(type), s->capacity, new_cap))                        \
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory growing element arrays to %zu",       \
+                         new_cap);
+    STATE_ARRAYS(GROW_ONE)
+    if (s->has_stress) {
+        STRESS_ARRAYS(GROW_ONE)
+    }
+#undef GROW_ONE
+    s->capacity = new_cap;
+    return CDEM_OK;
+}
+
+cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
+    if (s->has_stress)
+        return CDEM_OK;
+#define ALLOC_ONE(name, type)                                                                      \
+    s->name = calloc(s->capacity ? s->capacity : 1, sizeof(type));                                \
+    if (!s->name)                                                                                  \
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory allocating stress arrays");
+    STRESS_ARRAYS(ALLOC_ONE)
+#undef ALLOC_ONE
+    s->has_stress = 1;
+    return CDEM_OK;
+}
+
+cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, double radius,
+                              double mass, int32_t layer, uint32_t flags, int32_t born,
+                              size_t *index, cdem_error *err) {
+    CDEM_TRY(cdem_state_reserve(s, s->n + 1, err));
+    size_t i = s->n++;
+    if (id < 0)
+        id = s->next_id;
+    if (id >= s->next_id)
+        s->next_id = id + 1;
+    s->id[i] = id;
+    s->x[i] = x;
+    s->y[i] = y;
+    s->vx[i] = s->vy[i] = 0.0;
+    s->fx[i] = s->fy[i] = 0.0;
+    s->radius[i] = radius;
+    s->mass[i] = mass;
+    s->layer[i] = layer;
+    s->flags[i] = flags;
+    s->born[i] = born;
+    if (s->has_stress)
+        s->sxx[i] = s->syy[i] = s->sxy[i] = 0.0;
+    if (index)
+        *index = i;
+    return CDEM_OK;
+}
+
+void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_index_out) {
+    size_t j = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        if (!keep[i]) {
+            if (new_index_out)
+                new_index_out[i] = SIZE_MAX;
+            continue;
+        }
+        if (new_index_out)
+            new_index_out[i] = j;
+        if (j != i) {
+#define MOVE_ONE(name, type) s->name[j] = s->name[i];
+            STATE_ARRAYS(MOVE_ONE)
+            if (s->has_stress) {
+                STRESS_ARRAYS(MOVE_ONE)
+            }
+#undef MOVE_ONE
+        }
+        j++;
+    }
+    s->n = j;
+}
+
+cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *err) {
+    cdem_state_free(dst);
+    CDEM_TRY(cdem_state_init(dst, src->n, src->has_stress, err));
+#define COPY_ONE(name, type) memcpy(dst->name, src->name, src->n * sizeof(type));
+    STATE_ARRAYS(COPY_ONE)
+    if (src->has_stress) {
+        STRESS_ARRAYS(COPY_ONE)
+    }
+#undef COPY_ONE
+    dst->n = src->n;
+    dst->next_id = src->next_id;
+    return CDEM_OK;
+}
+
+cdem_status cdem_id_map_build(cdem_id_map *map, const cdem_state *s, cdem_error *err) {
+    memset(map, 0, sizeof *map);
+    if (s->n == 0)
+        return CDEM_OK;
+    int32_t lo = s->id[0], hi = s->id[0];
+    for (size_t i = 1; i < s->n; i++) {
+        if (s->id[i] < lo)
+            lo = s->id[i];
+        if (s->id[i] > hi)
+            hi = s->id[i];
+    }
+    size_t span = (size_t)((int64_t)hi - lo + 1);
+    map->index = malloc(span * sizeof *map->index);
+    if (!map->index)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory building an id map of %zu ids", span);
+    for (size_t k = 0; k < span; k++)
+        map->index[k] = SIZE_MAX;
+    for (size_t i = 0; i < s->n; i++)
+        map->index[s->id[i] - lo] = i;
+    map->min_id = lo;
+    map->max_id = hi;
+    return CDEM_OK;
+}
+
+size_t cdem_id_map_find(const cdem_id_map *map, int32_t id) {
+    if (!map->index || id < map->min_id || id > map->max_id)
+        return SIZE_MAX;
+    return map->index[id - map->min_id];
+}
+
+void cdem_id_map_free(cdem_id_map *map) {
+    if (!map)
+        return;
+    free(map->index);
+    memset(map, 0, sizeof *map);
+}
