@@ -1,0 +1,63 @@
+/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one
+ * static const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode ->
+ * ops, so the solver never switches on mode names. Checklist for a mode (see
+ * bc_planar_fault.c, the template):
+ *   name            the parameter-file word of the mode
+ *   state_size      bytes of the mode's private context (calloc'd by cdem_bc_init)
+ *   init            after the assembly is built: add/flag the mode's boundary elements
+ *                   (CDEM_FLAG_WALL / FAULT / MOVING), record its geometry
+ *   apply           deformation step k (1-based): move the prescribed elements by this step's
+ *                   boundary increment du (sign/sense decided by the mode, e.g. inversion) and
+ *                   set their velocity to the boundary velocity; walls never move otherwise
+ *   net_displacement  m, net displacement of the moving boundary so far (report)
+ *   view            one-paragraph description of the effective settings
+ *   free            releases what init allocated inside the context (NULL slot: nothing)
+ * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
+#ifndef CDEM_BC_H
+#define CDEM_BC_H
+
+#include "cdem_error.h"
+#include "model.h"
+#include "params.h"
+#include "state.h"
+
+#include <stdio.h>
+
+typedef struct {
+    const char *name;  /* mode name as written in parameter files */
+    size_t state_size; /* bytes of the private context, > 0 */
+    cdem_status (*init)(void *ctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
+                        cdem_error *err);
+    cdem_status (*apply)(void *ctx, cdem_state *s, long k, double du, double dt, cdem_error *err);
+    double (*net_displacement)(const void *ctx);
+    void (*view)(const void *ctx, FILE *out);
+    void (*free)(void *ctx); /* may be NULL when the context owns no memory */
+} cdem_bc_ops;
+
+/* A mode instance: its ops and its private context. */
+typedef struct {
+    const cdem_bc_ops *ops; /* NULL before init */
+    void *ctx;              /* calloc'd state_size bytes */
+} cdem_bc;
+
+/* The ops of a mode; CDEM_ERR_UNSUPPORTED naming the mode and the implemented ones when it
+ * has no implementation. */
+cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err);
+
+/* Comma-separated names of the implemented modes (static text). */
+const char *cdem_bc_implemented(void);
+
+/* Finds the mode of p->mode, allocates its context and runs its init on s. */
+cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
+                         cdem_error *err);
+cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
+                          cdem_error *err);
+double cdem_bc_net_displacement(const cdem_bc *bc);
+void cdem_bc_view(const cdem_bc *bc, FILE *out);
+/* Releases the context; bc may be NULL or never initialised. */
+void cdem_bc_free(cdem_bc *bc);
+
+/* The modes implemented so far (one per bc_<name>.c). */
+extern const cdem_bc_ops *const cdem_bc_planar_fault;
+
+#endif

@@ -1,0 +1,85 @@
+/* bc_registry: the table from cdem_mode to the ops of its implementation. Adding a mode is
+ * one new bc_<name>.c plus one row here; modes without a row fail with a clear message. */
+#include "bc.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    cdem_mode mode;                /* the parameter value */
+    const char *name;              /* its word, for messages when unimplemented */
+    const cdem_bc_ops *const *ops; /* implementation, or NULL while not written */
+} bc_row;
+
+static const bc_row registry[] = {
+    {CDEM_MODE_PLANAR_FAULT, "planar-fault", &cdem_bc_planar_fault},
+    {CDEM_MODE_LISTRIC_FAULT, "listric-fault", NULL},     /* later issue */
+    {CDEM_MODE_IRREGULAR_FAULT, "irregular-fault", NULL}, /* later issue */
+    {CDEM_MODE_VERTICAL_FAULTS, "vertical-faults", NULL}, /* later issue */
+    {CDEM_MODE_DETACHMENT, "detachment", NULL},           /* later issue */
+    {CDEM_MODE_REPOSE, "repose", NULL},                   /* later issue */
+    {CDEM_MODE_BIAXIAL, "biaxial", NULL},                 /* later issue */
+};
+
+const char *cdem_bc_implemented(void) {
+    return "planar-fault";
+}
+
+cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err) {
+    for (size_t i = 0; i < sizeof registry / sizeof registry[0]; i++) {
+        if (registry[i].mode != mode)
+            continue;
+        if (!registry[i].ops)
+            return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                             "boundary.mode = %s is not implemented in this build; implemented "
+                             "modes: %s",
+                             registry[i].name, cdem_bc_implemented());
+        *ops = *registry[i].ops;
+        return CDEM_OK;
+    }
+    return CDEM_FAIL(err, CDEM_ERR_RANGE, "boundary.mode = %d: unknown mode; implemented modes: %s",
+                     (int)mode, cdem_bc_implemented());
+}
+
+cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
+                         cdem_error *err) {
+    memset(bc, 0, sizeof *bc);
+    const cdem_bc_ops *ops = NULL;
+    CDEM_TRY(cdem_bc_find(p->mode, &ops, err));
+    bc->ctx = calloc(1, ops->state_size);
+    if (!bc->ctx)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the %s boundary mode", ops->name);
+    bc->ops = ops;
+    cdem_status st = ops->init(bc->ctx, p, m, s, err);
+    if (st != CDEM_OK) {
+        cdem_bc_free(bc);
+        return st;
+    }
+    return CDEM_OK;
+}
+
+cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
+                          cdem_error *err) {
+    if (!bc->ops)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_apply: boundary mode not initialised");
+    return bc->ops->apply(bc->ctx, s, k, du, dt, err);
+}
+
+double cdem_bc_net_displacement(const cdem_bc *bc) {
+    return (bc && bc->ops) ? bc->ops->net_displacement(bc->ctx) : 0.0;
+}
+
+void cdem_bc_view(const cdem_bc *bc, FILE *out) {
+    if (bc && bc->ops)
+        bc->ops->view(bc->ctx, out);
+}
+
+void cdem_bc_free(cdem_bc *bc) {
+    if (!bc)
+        return;
+    if (bc->ops && bc->ops->free && bc->ctx)
+        bc->ops->free(bc->ctx);
+    free(bc->ctx);
+    bc->ctx = NULL;
+    bc->ops = NULL;
+}

@@ -1,0 +1,289 @@
+/* integrate: see integrate.h. The step is three passes over memory: (1) half kick + drift
+ * of the free elements (fused with nothing else, so the boundary mode can move its
+ * elements after it), (2) one pass over the pair slots computing each pair force once,
+ * (3) one pass over the elements summing their slots through the CSR and finishing the
+ * kick. Pass 2 and 3 are the hot loops; both are OpenMP schedule(static) with one writer
+ * per output slot, so any thread count gives identical bits. */
+#include "integrate.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Rebuilds between re-sorts of the state into cell order. */
+#define RESORT_EVERY 20
+/* Loops shorter than this run on one thread (the fork costs more than it saves). */
+#define OMP_MIN_ITEMS 2048
+
+cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
+                                 cdem_error *err) {
+    memset(it, 0, sizeof *it);
+    if (!(m->dt > 0.0) || !isfinite(m->dt))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "integrator: model dt = %g s: must be > 0", m->dt);
+    if (!(m->damping >= 0.0) || !isfinite(m->damping))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "integrator: model damping = %g N s/m: must be >= 0",
+                         m->damping);
+    if (!(m->gravity >= 0.0) || !isfinite(m->gravity))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "integrator: model gravity = %g m/s^2: must be >= 0",
+                         m->gravity);
+    if (!(m->radius[0] > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
+                         m->radius[0]);
+    it->dt = m->dt;
+    it->damping = m->damping;
+    it->gravity = m->gravity;
+    it->max_radius = m->max_radius > 0.0 ? m->max_radius : m->radius[CDEM_NUM_RADII - 1];
+    CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
+    CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
+                                 RESORT_EVERY, err));
+    return CDEM_OK;
+}
+
+void cdem_integrator_free(cdem_integrator *it) {
+    if (!it)
+        return;
+    cdem_neighbour_free(&it->nb);
+    free(it->keep);
+    free(it->removed_ids);
+    memset(it, 0, sizeof *it);
+}
+
+void cdem_integrator_enable_escape(cdem_integrator *it) {
+    it->bounds_set = 1;
+}
+
+static int is_free(uint32_t flags) {
+    return !(flags & CDEM_FLAGS_BOUNDARY);
+}
+
+/* Marks escaping free elements in it->keep; returns how many. */
+static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t *count,
+                                cdem_error *err) {
+    *count = 0;
+    if (!it->bounds_set)
+        return CDEM_OK;
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (!(s->flags[i] & CDEM_FLAG_WALL))
+            continue;
+        xmin = fmin(xmin, s->x[i]);
+        xmax = fmax(xmax, s->x[i]);
+        ymin = fmin(ymin, s->y[i]);
+    }
+    if (!isfinite(xmin))
+        return CDEM_OK; /* no walls: nothing to escape from */
+    it->escape_xmin = xmin;
+    it->escape_xmax = xmax;
+    it->escape_ymin = ymin;
+    if (s->n > it->keepcap) {
+        size_t c = s->n + s->n / 2 + 16;
+        unsigned char *k = realloc(it->keep, c);
+        if (!k)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+        it->keep = k;
+        it->keepcap = c;
+    }
+    size_t nrem = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        int out = 0;
+        if (is_free(s->flags[i])) {
+            const double r = s->radius[i];
+            out = s->x[i] < xmin - r || s->x[i] > xmax + r || s->y[i] < ymin - it->max_radius;
+        }
+        it->keep[i] = (unsigned char)!out;
+        nrem += (size_t)out;
+    }
+    if (nrem > it->removed_cap) {
+        size_t c = nrem + it->removed_cap + 16;
+        int32_t *q = realloc(it->removed_ids, c * sizeof *q);
+        if (!q)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu ids)", c);
+        it->removed_ids = q;
+        it->removed_cap = c;
+    }
+    size_t k = 0;
+    for (size_t i = 0; i < s->n; i++)
+        if (!it->keep[i])
+            it->removed_ids[k++] = s->id[i];
+    *count = nrem;
+    return CDEM_OK;
+}
+
+static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    size_t nrem = 0;
+    CDEM_TRY(find_escapes(it, s, &nrem, err));
+    it->n_removed_last = nrem;
+    it->n_removed += (long)nrem;
+    return cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err);
+}
+
+static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, cdem_error *err) {
+    const long n = (long)s->n;
+    const double *restrict x = s->x, *restrict y = s->y;
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad) if (n > OMP_MIN_ITEMS)
+    for (long i = 0; i < n; i++)
+        bad |= !(isfinite(x[i]) && isfinite(y[i]));
+    if (!bad)
+        return CDEM_OK;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(isfinite(s->x[i]) && isfinite(s->y[i])))
+            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                             "element id %d has a non-finite position (x = %g, y = %g) at step "
+                             "%ld: the simulation blew up; likely cause: the time step is too "
+                             "large for the spring constants and element masses",
+                             (int)s->id[i], s->x[i], s->y[i], it->step);
+    return CDEM_OK;
+}
+
+/* Pair forces into slots, then per-element sums and the second half kick. */
+static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
+    cdem_neighbour *nb = &it->nb;
+    const cdem_contact_law *law = &it->law;
+    const double dt = it->dt;
+    const long np = (long)nb->np;
+    const double *restrict x = s->x, *restrict y = s->y;
+    const double *restrict vx = s->vx, *restrict vy = s->vy;
+    const int32_t *restrict pi = nb->pi, *restrict pj = nb->pj;
+    const double *restrict Rp = nb->R;
+    const uint8_t *restrict cls = nb->cls;
+    uint8_t *restrict hist = nb->hist;
+    double *restrict xs = nb->xs, *restrict pfx = nb->pfx, *restrict pfy = nb->pfy;
+#pragma omp parallel for schedule(static) if (np > OMP_MIN_ITEMS)
+    for (long p = 0; p < np; p++) {
+        const int32_t i = pi[p], j = pj[p];
+        const double dx = x[j] - x[i], dy = y[j] - y[i];
+        const double R = Rp[p];
+        const uint8_t h = hist[p];
+        if (!(h & CDEM_PAIR_BONDED) && dx * dx + dy * dy >= R * R) {
+            /* the common case: a list pair that does not touch */
+            pfx[p] = 0.0;
+            pfy[p] = 0.0;
+            if (h) {
+                hist[p] = 0;
+                xs[p] = 0.0;
+            }
+            continue;
+        }
+        cdem_contact_eval(law, cls[p], dx, dy, R, vx[j] - vx[i], vy[j] - vy[i], dt, &xs[p],
+                          &hist[p], &pfx[p], &pfy[p]);
+    }
+
+    const long n = (long)s->n;
+    const int32_t *restrict start = nb->start, *restrict entry = nb->entry;
+    const double *restrict mass = s->mass;
+    const uint32_t *restrict flags = s->flags;
+    double *restrict fx = s->fx, *restrict fy = s->fy;
+    double *restrict vxw = s->vx, *restrict vyw = s->vy;
+    const double hdt = 0.5 * dt, c = it->damping, g = it->gravity;
+#pragma omp parallel for schedule(static) if (n > OMP_MIN_ITEMS)
+    for (long i = 0; i < n; i++) {
+        double sx = 0.0, sy = 0.0;
+        for (int32_t e = start[i]; e < start[i + 1]; e++) {
+            const int32_t code = entry[e];
+            const int32_t p = code >> 1;
+            if (code & 1) {
+                sx -= pfx[p];
+                sy -= pfy[p];
+            } else {
+                sx += pfx[p];
+                sy += pfy[p];
+            }
+        }
+        if (flags[i] & CDEM_FLAGS_BOUNDARY) {
+            fx[i] = sx;
+            fy[i] = sy;
+            continue;
+        }
+        const double m = mass[i];
+        sy -= m * g;
+        if (kick) {
+            const double a = hdt / m;
+            const double den = 1.0 / (1.0 + c * a);
+            const double nvx = (vxw[i] + a * sx) * den;
+            const double nvy = (vyw[i] + a * sy) * den;
+            vxw[i] = nvx;
+            vyw[i] = nvy;
+        }
+        fx[i] = sx - c * vxw[i];
+        fy[i] = sy - c * vyw[i];
+    }
+}
+
+cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    for (size_t i = 0; i < s->n; i++)
+        if (is_free(s->flags[i]) && !(s->mass[i] > 0.0))
+            return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                             "element id %d: mass = %g kg/m: free elements need a mass > 0",
+                             (int)s->id[i], s->mass[i]);
+    CDEM_TRY(check_finite(it, s, err));
+    CDEM_TRY(rebuild(it, s, err));
+    /* the first evaluation has no previous step: no tangential increment */
+    const double dt = it->dt;
+    it->dt = 0.0;
+    forces_and_kick(it, s, 0);
+    it->dt = dt;
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
+                                 cdem_error *err) {
+    if (it->nb.n_builds == 0)
+        CDEM_TRY(cdem_integrator_prime(it, s, err));
+    it->n_removed_last = 0;
+    const long n = (long)s->n;
+    const double dt = it->dt, hdt = 0.5 * it->dt;
+    {
+        double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
+        const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
+        const uint32_t *restrict flags = s->flags;
+#pragma omp parallel for schedule(static) if (n > OMP_MIN_ITEMS)
+        for (long i = 0; i < n; i++) {
+            if (flags[i] & CDEM_FLAGS_BOUNDARY)
+                continue;
+            const double a = hdt / mass[i];
+            const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
+            vx[i] = hvx;
+            vy[i] = hvy;
+            x[i] += dt * hvx;
+            y[i] += dt * hvy;
+        }
+    }
+    it->step++;
+    if (bc)
+        CDEM_TRY(cdem_bc_apply(bc, s, k, du, dt, err));
+    if (cdem_neighbour_needs_rebuild(&it->nb, s)) {
+        CDEM_TRY(check_finite(it, s, err));
+        CDEM_TRY(rebuild(it, s, err));
+    }
+    forces_and_kick(it, s, 1);
+    return CDEM_OK;
+}
+
+long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s) {
+    (void)s;
+    const uint8_t flag =
+        it->law.model == CDEM_MATERIAL_BONDED ? CDEM_PAIR_BONDED : CDEM_PAIR_COHESIVE;
+    long count = 0;
+    for (size_t p = 0; p < it->nb.np; p++) {
+        if (it->nb.hist[p] & CDEM_PAIR_TOUCH) {
+            it->nb.hist[p] |= flag;
+            count++;
+        }
+    }
+    return count;
+}
+
+void cdem_integrator_count(const cdem_integrator *it, long *contacts, long *bonds) {
+    long c = 0, b = 0;
+    for (size_t p = 0; p < it->nb.np; p++) {
+        const uint8_t h = it->nb.hist[p];
+        c += (h & CDEM_PAIR_TOUCH) != 0;
+        b += (h & (CDEM_PAIR_COHESIVE | CDEM_PAIR_BONDED)) != 0;
+    }
+    if (contacts)
+        *contacts = c;
+    if (bonds)
+        *bonds = b;
+}

@@ -1,0 +1,74 @@
+/* integrate: the time stepper. Velocity Verlet for translational motion of free elements
+ * (not wall/fault/footwall/mylar) with viscous damping and gravity:
+ *   v_half = v + dt/(2m) F(t);  x += dt v_half;  [boundary mode moves its elements]
+ *   F_c = sum of pair forces at x(t+dt) (pair slots, then per-element CSR sums);
+ *   v(t+dt) = (v_half + dt/(2m) (F_c - m g e_y)) / (1 + c dt / (2m))
+ * i.e. the damping force -c v(t+dt) is taken implicitly, so the terminal velocity of a
+ * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
+ * state fx, fy (boundary elements: the contact force on them, for reports).
+ * Determinism: every pair force goes to its own slot; per-element sums walk the CSR in a
+ * fixed order; loops are schedule(static); so results are bit-identical for any thread
+ * count. The integrator owns the neighbour list and contact histories; it never owns the
+ * state. Escaping elements (see cdem_integrator_set_bounds) are removed at list rebuilds.
+ * Nothing allocates in a step except at list rebuilds (geometric growth).
+ * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
+#ifndef CDEM_INTEGRATE_H
+#define CDEM_INTEGRATE_H
+
+#include "bc.h"
+#include "cdem_error.h"
+#include "contact.h"
+#include "model.h"
+#include "neighbour.h"
+#include "params.h"
+#include "state.h"
+
+typedef struct {
+    double dt;            /* s, time step, > 0 */
+    double damping;       /* N s/m, viscous coefficient c, >= 0 */
+    double gravity;       /* m/s^2, applied in -y, >= 0 */
+    cdem_contact_law law; /* contact law and materials */
+    cdem_neighbour nb;    /* pair list with histories and force slots */
+    long step;            /* steps taken so far */
+
+    /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
+     * y < ymin - max_radius; x bounds follow the moving lateral walls */
+    int bounds_set;                               /* 0/1 */
+    double escape_xmin, escape_xmax, escape_ymin; /* m */
+    double max_radius;                            /* m, largest radius of the model */
+    unsigned char *keep;                          /* per-element scratch for removal (ncap) */
+    size_t keepcap;                               /* capacity of keep */
+    long n_removed;                               /* elements removed so far */
+    int32_t *removed_ids;  /* ids removed at the last rebuild (n_removed_last of them) */
+    size_t n_removed_last; /* count at the last rebuild */
+    size_t removed_cap;    /* capacity of removed_ids */
+} cdem_integrator;
+
+/* Sets up the stepper from the model constants (dt, damping, gravity, kn, ks, max radius)
+ * and material parameters. skin = 0.25 x the smallest radius. */
+cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
+                                 cdem_error *err);
+void cdem_integrator_free(cdem_integrator *it);
+
+/* Enables removal of escaping elements; the x bounds are the current extreme lateral wall
+ * positions (re-read at each rebuild), ymin the lowest base wall. */
+void cdem_integrator_enable_escape(cdem_integrator *it);
+
+/* Computes the forces of the current positions (first call before stepping; also builds
+ * the pair list). Does not move anything. */
+cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error *err);
+
+/* One time step. bc (may be NULL: walls still) is applied with deformation step k and
+ * increment du after the drift. Fails with CDEM_ERR_NUMERIC naming the element and step
+ * when a position becomes NaN/Inf. */
+cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
+                                 cdem_error *err);
+
+/* End of equilibration (and of each settling): every touching pair becomes cohesive
+ * (granular) or bonded (bonded model). Returns the number of pairs so marked. */
+long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s);
+
+/* Counts touching pairs and intact bonds / cohesive contacts. */
+void cdem_integrator_count(const cdem_integrator *it, long *contacts, long *bonds);
+
+#endif

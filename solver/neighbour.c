@@ -1,0 +1,362 @@
+/* neighbour: see neighbour.h. A build is: (1) save the histories of the current pairs by id
+ * key, (2) drop removed elements, (3) maybe permute the state into cell order, (4) bin the
+ * elements into cells (counting sort, so each cell lists ascending indices), (5) for each
+ * element i in index order scan the 3 x 3 cells around it for j > i within reach + skin,
+ * (6) restore histories by binary search on the sorted keys, (7) build the CSR.
+ * All of it is serial and ordered, so the list is the same for any thread count. */
+#include "neighbour.h"
+
+#include "contact.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static cdem_status grow(void **p, size_t elem, size_t want, cdem_error *err) {
+    void *q = realloc(*p, (want ? want : 1) * elem);
+    if (!q)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "neighbour list: out of memory for %zu entries",
+                         want);
+    *p = q;
+    return CDEM_OK;
+}
+
+static size_t next_cap(size_t cap, size_t want) {
+    size_t c = cap ? cap : 64;
+    while (c < want)
+        c += c / 2 + 1;
+    return c;
+}
+
+cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_factor,
+                                int resort_every, cdem_error *err) {
+    memset(nb, 0, sizeof *nb);
+    if (!(skin > 0.0) || !isfinite(skin))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "neighbour list: skin = %g m: must be > 0", skin);
+    if (!(reach_factor >= 1.0) || !isfinite(reach_factor))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "neighbour list: reach factor = %g: must be >= 1 (1 + breaking strain)",
+                         reach_factor);
+    nb->skin = skin;
+    nb->reach_factor = reach_factor;
+    nb->resort_every = resort_every > 0 ? resort_every : 1;
+    return CDEM_OK;
+}
+
+void cdem_neighbour_free(cdem_neighbour *nb) {
+    if (!nb)
+        return;
+    free(nb->pi);
+    free(nb->pj);
+    free(nb->R);
+    free(nb->cls);
+    free(nb->hist);
+    free(nb->xs);
+    free(nb->pfx);
+    free(nb->pfy);
+    free(nb->start);
+    free(nb->entry);
+    free(nb->x0);
+    free(nb->y0);
+    free(nb->cell_of);
+    free(nb->perm);
+    free(nb->scratch);
+    free(nb->cell_start);
+    free(nb->cell_items);
+    free(nb->carry);
+    memset(nb, 0, sizeof *nb);
+}
+
+int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s) {
+    if (nb->n_builds == 0 || nb->n != s->n)
+        return 1;
+    const double lim2 = 0.25 * nb->skin * nb->skin;
+    const double *restrict x = s->x, *restrict y = s->y;
+    const double *restrict x0 = nb->x0, *restrict y0 = nb->y0;
+    int out = 0;
+    const long n = (long)s->n;
+#pragma omp parallel for schedule(static) reduction(| : out) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        const double dx = x[i] - x0[i], dy = y[i] - y0[i];
+        /* written so that NaN also triggers a rebuild (which then reports it) */
+        out |= !(dx * dx + dy * dy <= lim2);
+    }
+    return out;
+}
+
+static cdem_status reserve_elements(cdem_neighbour *nb, size_t n, cdem_error *err) {
+    if (n <= nb->ncap)
+        return CDEM_OK;
+    size_t c = next_cap(nb->ncap, n);
+    CDEM_TRY(grow((void **)&nb->x0, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->y0, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->cell_of, sizeof(int32_t), c, err));
+    CDEM_TRY(grow((void **)&nb->perm, sizeof(size_t), c, err));
+    CDEM_TRY(grow((void **)&nb->scratch, 8, c, err));
+    CDEM_TRY(grow((void **)&nb->cell_items, sizeof(int32_t), c, err));
+    CDEM_TRY(grow((void **)&nb->start, sizeof(int32_t), c + 1, err));
+    nb->ncap = c;
+    return CDEM_OK;
+}
+
+static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err) {
+    if (np <= nb->pcap)
+        return CDEM_OK;
+    size_t c = next_cap(nb->pcap, np);
+    CDEM_TRY(grow((void **)&nb->pi, sizeof(int32_t), c, err));
+    CDEM_TRY(grow((void **)&nb->pj, sizeof(int32_t), c, err));
+    CDEM_TRY(grow((void **)&nb->R, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->cls, sizeof(uint8_t), c, err));
+    CDEM_TRY(grow((void **)&nb->hist, sizeof(uint8_t), c, err));
+    CDEM_TRY(grow((void **)&nb->xs, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->pfx, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->pfy, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->entry, sizeof(int32_t), 2 * c, err));
+    nb->pcap = c;
+    return CDEM_OK;
+}
+
+static int carry_cmp(const void *a, const void *b) {
+    const uint64_t ka = ((const cdem_pair_carry *)a)->key, kb = ((const cdem_pair_carry *)b)->key;
+    return (ka > kb) - (ka < kb);
+}
+
+/* (1) Saves every pair that has history, keyed by ids (indices refer to the current state). */
+static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_error *err) {
+    nb->ncarry = 0;
+    if (nb->n_builds == 0 || nb->n > s->n)
+        return CDEM_OK; /* no list yet (or the state was replaced): nothing valid to carry */
+    size_t k = 0;
+    for (size_t p = 0; p < nb->np; p++)
+        k += (nb->hist[p] != 0 || nb->xs[p] != 0.0);
+    if (k > nb->carrycap) {
+        size_t c = next_cap(nb->carrycap, k);
+        CDEM_TRY(grow((void **)&nb->carry, sizeof(cdem_pair_carry), c, err));
+        nb->carrycap = c;
+    }
+    k = 0;
+    for (size_t p = 0; p < nb->np; p++) {
+        if (nb->hist[p] == 0 && nb->xs[p] == 0.0)
+            continue;
+        nb->carry[k].key = cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]);
+        nb->carry[k].xs = nb->xs[p];
+        nb->carry[k].hist = nb->hist[p];
+        k++;
+    }
+    nb->ncarry = k;
+    qsort(nb->carry, k, sizeof *nb->carry, carry_cmp);
+    return CDEM_OK;
+}
+
+static const cdem_pair_carry *find_carry(const cdem_neighbour *nb, uint64_t key) {
+    size_t lo = 0, hi = nb->ncarry;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (nb->carry[mid].key < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return (lo < nb->ncarry && nb->carry[lo].key == key) ? &nb->carry[lo] : NULL;
+}
+
+#define PERMUTE(arr, type)                                                                         \
+    do {                                                                                           \
+        type *tmp_ = (type *)nb->scratch;                                                          \
+        for (size_t k_ = 0; k_ < n; k_++)                                                          \
+            tmp_[k_] = (arr)[perm[k_]];                                                            \
+        memcpy((arr), tmp_, n * sizeof(type));                                                     \
+    } while (0)
+
+static void permute_state(cdem_neighbour *nb, cdem_state *s) {
+    const size_t n = s->n;
+    const size_t *perm = nb->perm;
+    PERMUTE(s->id, int32_t);
+    PERMUTE(s->x, double);
+    PERMUTE(s->y, double);
+    PERMUTE(s->vx, double);
+    PERMUTE(s->vy, double);
+    PERMUTE(s->fx, double);
+    PERMUTE(s->fy, double);
+    PERMUTE(s->radius, double);
+    PERMUTE(s->mass, double);
+    PERMUTE(s->layer, int32_t);
+    PERMUTE(s->flags, uint32_t);
+    PERMUTE(s->born, int32_t);
+    if (s->has_stress) {
+        PERMUTE(s->sxx, double);
+        PERMUTE(s->syy, double);
+        PERMUTE(s->sxy, double);
+    }
+}
+
+cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
+                                 int resort, cdem_error *err) {
+    CDEM_TRY(save_carry(nb, s, err));
+    if (keep)
+        cdem_state_compact(s, keep, NULL);
+    const size_t n = s->n;
+    CDEM_TRY(reserve_elements(nb, n, err));
+
+    /* bounding box, largest radius, finiteness */
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(s->x[i]) || !isfinite(s->y[i]))
+            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                             "element id %d has a non-finite position (x = %g, y = %g): the "
+                             "simulation blew up; the time step is probably too large for the "
+                             "spring constants and masses",
+                             (int)s->id[i], s->x[i], s->y[i]);
+        xmin = fmin(xmin, s->x[i]);
+        xmax = fmax(xmax, s->x[i]);
+        ymin = fmin(ymin, s->y[i]);
+        ymax = fmax(ymax, s->y[i]);
+        rmax = fmax(rmax, s->radius[i]);
+    }
+    if (n == 0) {
+        xmin = xmax = ymin = ymax = 0.0;
+    }
+    double cs = 2.0 * rmax * nb->reach_factor + nb->skin;
+    size_t nx = (size_t)((xmax - xmin) / cs) + 1, ny = (size_t)((ymax - ymin) / cs) + 1;
+    while ((double)nx * (double)ny > 4.0 * (double)n + 64.0) {
+        /* a stray element far away: coarser cells keep the grid O(n) */
+        cs *= 2.0;
+        nx = (size_t)((xmax - xmin) / cs) + 1;
+        ny = (size_t)((ymax - ymin) / cs) + 1;
+    }
+    const size_t ncells = nx * ny;
+    if (ncells + 1 > nb->ccap) {
+        size_t c = next_cap(nb->ccap, ncells + 1);
+        CDEM_TRY(grow((void **)&nb->cell_start, sizeof(int32_t), c, err));
+        nb->ccap = c;
+    }
+    const double inv = 1.0 / cs;
+    for (size_t i = 0; i < n; i++) {
+        size_t cx = (size_t)((s->x[i] - xmin) * inv), cy = (size_t)((s->y[i] - ymin) * inv);
+        if (cx >= nx)
+            cx = nx - 1;
+        if (cy >= ny)
+            cy = ny - 1;
+        nb->cell_of[i] = (int32_t)(cy * nx + cx);
+    }
+    /* counting sort by cell */
+    memset(nb->cell_start, 0, (ncells + 1) * sizeof(int32_t));
+    for (size_t i = 0; i < n; i++)
+        nb->cell_start[nb->cell_of[i] + 1]++;
+    for (size_t c = 0; c < ncells; c++)
+        nb->cell_start[c + 1] += nb->cell_start[c];
+
+    int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
+    if (do_sort && n > 1) {
+        /* stable scatter by cell: new index k holds old index perm[k] */
+        size_t *perm = nb->perm;
+        for (size_t i = 0; i < n; i++)
+            perm[i] = SIZE_MAX;
+        for (size_t i = 0; i < n; i++) {
+            int32_t c = nb->cell_of[i];
+            size_t pos = (size_t)nb->cell_start[c];
+            perm[pos] = i;
+            nb->cell_start[c]++;
+        }
+        /* restore prefix sums (shifted by one cell after the scatter) */
+        for (size_t c = ncells; c > 0; c--)
+            nb->cell_start[c] = nb->cell_start[c - 1];
+        nb->cell_start[0] = 0;
+        permute_state(nb, s);
+        {
+            /* cell_of follows the permutation */
+            int32_t *tmp = (int32_t *)nb->scratch;
+            for (size_t k = 0; k < n; k++)
+                tmp[k] = nb->cell_of[perm[k]];
+            memcpy(nb->cell_of, tmp, n * sizeof(int32_t));
+        }
+        nb->n_sorts++;
+    }
+    /* cell_items: element indices in cell order (ascending index within a cell) */
+    {
+        for (size_t i = 0; i < n; i++) {
+            int32_t c = nb->cell_of[i];
+            nb->cell_items[nb->cell_start[c]++] = (int32_t)i;
+        }
+        for (size_t c = ncells; c > 0; c--)
+            nb->cell_start[c] = nb->cell_start[c - 1];
+        nb->cell_start[0] = 0;
+    }
+
+    /* enumerate pairs */
+    nb->np = 0;
+    const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
+    const uint32_t *restrict fl = s->flags;
+    const double rf = nb->reach_factor, skin = nb->skin;
+    for (size_t i = 0; i < n; i++) {
+        if (fl[i] & CDEM_FLAG_FOOTWALL)
+            continue;
+        const size_t ci = (size_t)nb->cell_of[i];
+        const size_t cx = ci % nx, cy = ci / nx;
+        const size_t x_lo = cx > 0 ? cx - 1 : 0, x_hi = cx + 1 < nx ? cx + 1 : cx;
+        const size_t y_lo = cy > 0 ? cy - 1 : 0, y_hi = cy + 1 < ny ? cy + 1 : cy;
+        for (size_t yy = y_lo; yy <= y_hi; yy++) {
+            for (size_t xx = x_lo; xx <= x_hi; xx++) {
+                const size_t c = yy * nx + xx;
+                for (int32_t k = nb->cell_start[c]; k < nb->cell_start[c + 1]; k++) {
+                    const size_t j = (size_t)nb->cell_items[k];
+                    if (j <= i)
+                        continue;
+                    const int cls = cdem_contact_class(fl[i], fl[j]);
+                    if (cls < 0)
+                        continue;
+                    const double R = rad[i] + rad[j];
+                    const double cut = R * rf + skin;
+                    const double dx = x[j] - x[i], dy = y[j] - y[i];
+                    if (dx * dx + dy * dy >= cut * cut)
+                        continue;
+                    if (nb->np == nb->pcap)
+                        CDEM_TRY(reserve_pairs(nb, nb->np + 1, err));
+                    const size_t p = nb->np++;
+                    nb->pi[p] = (int32_t)i;
+                    nb->pj[p] = (int32_t)j;
+                    nb->R[p] = R;
+                    nb->cls[p] = (uint8_t)cls;
+                    nb->hist[p] = 0;
+                    nb->xs[p] = 0.0;
+                    nb->pfx[p] = 0.0;
+                    nb->pfy[p] = 0.0;
+                }
+            }
+        }
+    }
+    /* restore histories */
+    if (nb->ncarry) {
+        for (size_t p = 0; p < nb->np; p++) {
+            const cdem_pair_carry *c =
+                find_carry(nb, cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]));
+            if (c) {
+                nb->hist[p] = c->hist;
+                nb->xs[p] = c->xs;
+            }
+        }
+    }
+    /* CSR of slots per element, ascending slot order */
+    if (nb->np > 0)
+        CDEM_TRY(reserve_pairs(nb, nb->np, err));
+    memset(nb->start, 0, (n + 1) * sizeof(int32_t));
+    for (size_t p = 0; p < nb->np; p++) {
+        nb->start[nb->pi[p] + 1]++;
+        nb->start[nb->pj[p] + 1]++;
+    }
+    for (size_t i = 0; i < n; i++)
+        nb->start[i + 1] += nb->start[i];
+    {
+        int32_t *cursor = (int32_t *)nb->scratch;
+        memcpy(cursor, nb->start, n * sizeof(int32_t));
+        for (size_t p = 0; p < nb->np; p++) {
+            nb->entry[cursor[nb->pi[p]]++] = (int32_t)(2 * p);
+            nb->entry[cursor[nb->pj[p]]++] = (int32_t)(2 * p + 1);
+        }
+    }
+    memcpy(nb->x0, s->x, n * sizeof(double));
+    memcpy(nb->y0, s->y, n * sizeof(double));
+    nb->n = n;
+    nb->n_builds++;
+    return CDEM_OK;
+}

@@ -1,0 +1,93 @@
+/* neighbour: the pair list of the solver. A cell grid (cell size >= the largest interaction
+ * reach + skin) finds the candidate pairs at each rebuild; the Verlet list keeps every pair
+ * whose gap is below the skin, and stays valid until some element has moved more than half
+ * the skin since the build (then cdem_neighbour_needs_rebuild says so). Never all-pairs.
+ * Each pair carries its contact history (contact.h) and a force slot (one writer per slot);
+ * a CSR of pair slots per element (ascending slot order) makes the per-element force sums
+ * independent of the thread count. At a rebuild the histories are carried over by element
+ * id pair, so they survive re-sorting and element removal; every `resort_every` builds the
+ * state arrays are permuted into cell order (memory locality).
+ * Between builds the caller may only append elements to the state (removal goes through
+ * the keep argument of the build). Ownership: cdem_neighbour owns its buffers (grown geometrically,
+ * only at build time); it never owns the state. Thread safety: build is serial; readers may share
+ * the lists. Units: m. */
+#ifndef CDEM_NEIGHBOUR_H
+#define CDEM_NEIGHBOUR_H
+
+#include "cdem_error.h"
+#include "state.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Carried contact history of one pair, keyed by its two element ids. */
+typedef struct {
+    uint64_t key; /* (min id << 32) | max id */
+    double xs;    /* tangential displacement, m */
+    uint8_t hist; /* CDEM_PAIR_* flags */
+} cdem_pair_carry;
+
+typedef struct {
+    /* configuration (set by init) */
+    double skin;         /* m, extra list distance beyond contact reach, > 0 */
+    double reach_factor; /* pairs interact up to R * reach_factor (1 + max breaking strain) */
+    int resort_every;    /* re-sort the state into cell order every this many builds, >= 1 */
+
+    /* pair list, struct of arrays, np used of pcap */
+    size_t np, pcap;
+    int32_t *pi, *pj;  /* element indices, pi < pj */
+    double *R;         /* m, sum of the radii */
+    uint8_t *cls;      /* CDEM_CLASS_* of the pair */
+    uint8_t *hist;     /* CDEM_PAIR_* history flags */
+    double *xs;        /* m, accumulated tangential displacement (contact frame) */
+    double *pfx, *pfy; /* N, contact force on pi of the last evaluation (pj gets minus) */
+
+    /* per-element CSR of pair slots: entries start[e]..start[e+1]-1, entry = slot*2+side
+     * (side 1: the element is pj, force negated) */
+    int32_t *start; /* n + 1 */
+    int32_t *entry; /* 2 * np */
+
+    /* per-element buffers (ncap) */
+    size_t n;         /* elements at the last build */
+    size_t ncap;      /* capacity of per-element buffers */
+    double *x0, *y0;  /* m, positions at the last build */
+    int32_t *cell_of; /* cell of each element */
+    size_t *perm;     /* re-sort permutation (new index -> old index) */
+    void *scratch;    /* permutation scratch, ncap * 8 bytes */
+
+    /* cell grid */
+    size_t ccap;         /* capacity of cell_start */
+    int32_t *cell_start; /* ncells + 1 */
+    int32_t *cell_items; /* element indices sorted by cell (ncap) */
+
+    /* carried histories */
+    size_t ncarry, carrycap;
+    cdem_pair_carry *carry;
+
+    long n_builds; /* builds so far */
+    long n_sorts;  /* re-sorts so far */
+} cdem_neighbour;
+
+/* Sets up an empty list. skin > 0 (m); reach_factor >= 1. */
+cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_factor,
+                                int resort_every, cdem_error *err);
+void cdem_neighbour_free(cdem_neighbour *nb);
+
+/* 1 when the list must be rebuilt: the element count changed, or some element moved more
+ * than skin/2 since the last build (or there was no build yet). */
+int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s);
+
+/* Rebuilds the list. keep (optional, length s->n): elements with keep[i] == 0 are removed
+ * from the state first (histories of the rest kept). resort: 1 forces a re-sort into cell
+ * order, 0 lets resort_every decide, -1 never. Fails with CDEM_ERR_NUMERIC naming the
+ * element id when a position is not finite. */
+cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
+                                 int resort, cdem_error *err);
+
+/* Key of a pair of ids (order-independent). */
+static inline uint64_t cdem_pair_key(int32_t a, int32_t b) {
+    uint32_t lo = (uint32_t)(a < b ? a : b), hi = (uint32_t)(a < b ? b : a);
+    return ((uint64_t)lo << 32) | hi;
+}
+
+#endif
