@@ -229,9 +229,9 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
 
 cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
                                  cdem_error *err) {
+    it->n_removed_last = 0;
     if (it->nb.n_builds == 0)
         CDEM_TRY(cdem_integrator_prime(it, s, err));
-    it->n_removed_last = 0;
     const long n = (long)s->n;
     const double dt = it->dt, hdt = 0.5 * it->dt;
     {

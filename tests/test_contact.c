@@ -1,0 +1,216 @@
+/* Tests of solver/contact: the pair laws of SPEC section 4 against their closed forms. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "contact.h"
+#include "state.h"
+
+#include <math.h>
+#include <string.h>
+
+#define KN 1.0e9
+#define KS 5.0e8
+
+static cdem_params base_params(cdem_material_model model) {
+    cdem_params p;
+    memset(&p, 0, sizeof p);
+    p.material = model;
+    p.first_slip = 1;
+    p.element =
+        (cdem_contact_material){.friction = 0.25, .cohesion = 5.0e6, .breaking_strain = 0.02};
+    p.wall = (cdem_contact_material){.friction = 0.5, .cohesion = 1.0e6, .breaking_strain = 0.05};
+    p.fault = (cdem_contact_material){.friction = 0.0, .cohesion = 0.0, .breaking_strain = 0.01};
+    return p;
+}
+
+static cdem_contact_law make_law(cdem_material_model model, int first_slip) {
+    cdem_params p = base_params(model);
+    p.first_slip = first_slip;
+    cdem_contact_law law;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    return law;
+}
+
+static void test_contact_normal_repulsion(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 1);
+    const double R = 200.0, delta = 1.5;
+    double xs = 0.0, fx = 0, fy = 0;
+    uint8_t h = 0;
+    /* j to the right of i, overlapping by delta: i is pushed to -x with Kn delta */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - delta, 0.0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_float_equal(fx, -KN * delta, 1e-6 * KN * delta);
+    assert_float_equal(fy, 0.0, 1e-9);
+    assert_true(h & CDEM_PAIR_TOUCH);
+    /* same along a diagonal: magnitude Kn delta along -n */
+    const double c = cos(0.3), s = sin(0.3);
+    h = 0;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, (R - delta) * c, (R - delta) * s, R, 0, 0, 0.1, &xs,
+                      &h, &fx, &fy);
+    assert_float_equal(fx, -KN * delta * c, 1e-6 * KN * delta);
+    assert_float_equal(fy, -KN * delta * s, 1e-6 * KN * delta);
+    /* separated: no force, no history */
+    xs = 3.0;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 0.1, 0.0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_true(fx == 0.0 && fy == 0.0 && xs == 0.0 && h == 0);
+}
+
+static void test_contact_bond_attraction_breaking(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_BONDED, 1);
+    const double R = 200.0, r0 = 0.02; /* element breaking strain */
+    double xs = 0.0, fx = 0, fy = 0;
+    uint8_t h = CDEM_PAIR_BONDED;
+    /* stretched by half the breaking distance: attraction Kn (r - R) toward j (+x) */
+    double stretch = 0.5 * r0 * R;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_float_equal(fx, KN * stretch, 1e-6 * KN * stretch);
+    assert_true(h & CDEM_PAIR_BONDED);
+    /* just below the threshold: still intact */
+    stretch = 0.999 * r0 * R;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_true(h & CDEM_PAIR_BONDED);
+    assert_float_equal(fx, KN * stretch, 1e-6 * KN * stretch);
+    /* at r - R = r0 R: breaks for good, force zero */
+    stretch = r0 * R * 1.0001;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_false(h & CDEM_PAIR_BONDED);
+    assert_true(fx == 0.0 && fy == 0.0);
+    /* back to a small stretch: no attraction any more */
+    stretch = 0.1 * r0 * R;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_true(fx == 0.0 && fy == 0.0);
+    /* compression: still repulsive */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_float_equal(fx, -KN * 2.0, 1e-3);
+    /* bonded model has no tangential force */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 100.0, 0.1, &xs, &h, &fx, &fy);
+    assert_true(fy == 0.0);
+    /* wall class uses the wall breaking strain (0.05): a stretch of 0.03 R holds there */
+    h = CDEM_PAIR_BONDED;
+    cdem_contact_eval(&law, CDEM_CLASS_WALL, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_true(h & CDEM_PAIR_BONDED);
+    h = CDEM_PAIR_BONDED;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    assert_false(h & CDEM_PAIR_BONDED);
+}
+
+/* Drives a tangential displacement on a pair (j at +x, tangent +y) in steps of dxs, returns
+ * the shear force on i (along +y) after each step in out[]. */
+static void drive(const cdem_contact_law *law, int cls, double R, double delta, double dxs,
+                  int nsteps, double *xs, uint8_t *h, double *out) {
+    const double dt = 0.01;
+    for (int k = 0; k < nsteps; k++) {
+        double fx, fy;
+        cdem_contact_eval(law, cls, R - delta, 0.0, R, 0.0, dxs / dt, dt, xs, h, &fx, &fy);
+        out[k] = fy;
+    }
+}
+
+static void test_contact_coulomb_limit_first_slip(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 1);
+    const double R = 200.0, delta = 0.5, fn = KN * delta;
+    const double mu = 0.25, c0 = 5.0e6, limit = mu * fn + c0; /* 1.25e8 + 5e6 */
+    double xs = 0.0, f[200];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    const double dxs = 0.011; /* Ks * dxs = 5.5e6 N per step: the limit falls mid-step */
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
+    /* below the limit: Fs = Ks Xs */
+    for (int k = 0; k < 20; k++)
+        assert_float_equal(f[k], KS * dxs * (k + 1), 1e-6 * KS * dxs * (k + 1));
+    /* the first step beyond the limit is scaled back to mu Fn + C0 exactly */
+    int kslip = (int)floor(limit / (KS * dxs)); /* 23 steps stay below */
+    assert_float_equal(f[kslip - 1], KS * dxs * kslip, 1.0);
+    assert_float_equal(f[kslip], limit, 1e-6 * limit);
+    /* then cohesion is gone: mu Fn */
+    assert_float_equal(f[kslip + 1], mu * fn, 1e-6 * fn);
+    assert_float_equal(f[199], mu * fn, 1e-6 * fn);
+    assert_false(h & CDEM_PAIR_COHESIVE);
+    assert_float_equal(xs, mu * fn / KS, 1e-9);
+    /* reversing the drive unloads elastically from the limit */
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, -dxs, 1, &xs, &h, f);
+    assert_float_equal(f[0], mu * fn - KS * dxs, 1e-6 * fn);
+}
+
+static void test_contact_cohesion_lost_at_separation(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 0);
+    const double R = 200.0, delta = 0.5, fn = KN * delta;
+    const double limit = 0.25 * fn + 5.0e6;
+    double xs = 0.0, f[200];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, 0.01, 200, &xs, &h, f);
+    /* first_slip off: it keeps sliding at mu Fn + C0 */
+    assert_float_equal(f[199], limit, 1e-6 * limit);
+    assert_true(h & CDEM_PAIR_COHESIVE);
+    /* separation deletes the history and cohesion */
+    double fx, fy;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    assert_true(h == 0 && xs == 0.0 && fx == 0.0 && fy == 0.0);
+    /* a new contact is not cohesive: limit mu Fn */
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, 0.01, 200, &xs, &h, f);
+    assert_float_equal(f[199], 0.25 * fn, 1e-6 * fn);
+}
+
+static void test_contact_wall_and_fault_materials(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 0);
+    const double R = 200.0, delta = 0.5, fn = KN * delta;
+    double xs = 0.0, f[300];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    int cls = cdem_contact_class(0, CDEM_FLAG_WALL);
+    assert_int_equal(cls, CDEM_CLASS_WALL);
+    drive(&law, cls, R, delta, 0.01, 300, &xs, &h, f);
+    assert_float_equal(f[299], 0.5 * fn + 1.0e6, 1e-6 * fn); /* wall: mu 0.5, C0 1e6 */
+    cls = cdem_contact_class(CDEM_FLAG_FAULT, 0);
+    assert_int_equal(cls, CDEM_CLASS_FAULT);
+    xs = 0.0;
+    h = CDEM_PAIR_COHESIVE;
+    drive(&law, cls, R, delta, 0.01, 10, &xs, &h, f);
+    assert_float_equal(f[9], 0.0, 1e-9); /* frictionless, cohesionless fault */
+    /* boundary-boundary pairs and display footwall elements never interact */
+    assert_int_equal(cdem_contact_class(CDEM_FLAG_WALL, CDEM_FLAG_WALL | CDEM_FLAG_MOVING), -1);
+    assert_int_equal(cdem_contact_class(CDEM_FLAG_WALL, CDEM_FLAG_FAULT), -1);
+    assert_int_equal(cdem_contact_class(0, CDEM_FLAG_FOOTWALL), -1);
+    assert_int_equal(cdem_contact_class(CDEM_FLAG_WEAK, CDEM_FLAG_GROWTH), CDEM_CLASS_ELEMENT);
+    assert_string_equal(cdem_contact_class_name(CDEM_CLASS_FAULT), "fault");
+}
+
+static void test_contact_law_rejects_bad_values(void **st) {
+    (void)st;
+    cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
+    cdem_contact_law law;
+    cdem_error err;
+    p.wall.friction = -0.1;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "wall.friction"));
+    assert_non_null(strstr(err.msg, "-0.1"));
+    p = base_params(CDEM_MATERIAL_BONDED);
+    p.fault.breaking_strain = 0.0;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "fault.breaking_strain"));
+    p = base_params(CDEM_MATERIAL_GRANULAR);
+    assert_int_equal(cdem_contact_law_init(&law, &p, 0.0, KS, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "kn"));
+    p = base_params(CDEM_MATERIAL_BONDED);
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    assert_float_equal(law.max_breaking_strain, 0.05, 1e-15);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_contact_normal_repulsion),
+        cmocka_unit_test(test_contact_bond_attraction_breaking),
+        cmocka_unit_test(test_contact_coulomb_limit_first_slip),
+        cmocka_unit_test(test_contact_cohesion_lost_at_separation),
+        cmocka_unit_test(test_contact_wall_and_fault_materials),
+        cmocka_unit_test(test_contact_law_rejects_bad_values),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,292 @@
+/* Tests of solver/integrate: velocity Verlet against closed forms (free fall, terminal
+ * velocity, energy of an undamped spring pair), NaN detection, escaping elements, and
+ * bit-identical results for 1 and 2 OpenMP threads. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "integrate.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KN  1.544871985e9
+#define RHO 2500.0
+
+static double rnd(uint64_t *s) {
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double disc_mass(double r) {
+    return RHO * M_PI * r * r;
+}
+
+/* The default model constants (SPEC 2) with dt, damping, gravity chosen by the test. */
+static cdem_model hand_model(double dt, double damping, double g) {
+    cdem_model m;
+    memset(&m, 0, sizeof m);
+    const double r[4] = {50.0, 75.0, 100.0, 125.0};
+    for (int k = 0; k < 4; k++) {
+        m.radius[k] = r[k];
+        m.mass[k] = disc_mass(r[k]);
+    }
+    m.min_mass = m.mass[0];
+    m.max_radius = 125.0;
+    m.average_radius = 87.5;
+    m.kn = m.ks = KN;
+    m.dt = dt;
+    m.damping = damping;
+    m.gravity = g;
+    return m;
+}
+
+static cdem_params hand_params(cdem_material_model model) {
+    cdem_params p;
+    memset(&p, 0, sizeof p);
+    p.material = model;
+    p.first_slip = 1;
+    p.density = RHO;
+    p.element = (cdem_contact_material){.friction = 0.25, .cohesion = 5e9, .breaking_strain = 1.0};
+    p.wall = p.element;
+    p.fault = p.element;
+    return p;
+}
+
+static void test_integrate_free_fall(void **st) {
+    (void)st;
+    const double dt = 0.028, g = 9.81;
+    cdem_model m = hand_model(dt, 0.0, g);
+    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    cdem_integrator it;
+    cdem_state s;
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&s, 4, 0, &err), CDEM_OK);
+    assert_int_equal(
+        cdem_state_append(&s, -1, 100.0, 5000.0, 50.0, disc_mass(50.0), 1, 0, 0, NULL, &err),
+        CDEM_OK);
+    s.vx[0] = 2.0;
+    s.vy[0] = 3.0;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    const int N = 1000;
+    for (int k = 0; k < N; k++)
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+    const double t = N * dt;
+    /* Verlet is exact for a constant force: only rounding remains */
+    assert_float_equal(s.y[0], 5000.0 + 3.0 * t - 0.5 * g * t * t, 1e-9 * 5000.0);
+    assert_float_equal(s.x[0], 100.0 + 2.0 * t, 1e-9 * 100.0);
+    assert_float_equal(s.vy[0], 3.0 - g * t, 1e-9 * g * t);
+    assert_float_equal(s.fy[0], -disc_mass(50.0) * g, 1e-9 * disc_mass(50.0) * g);
+    cdem_integrator_free(&it);
+
+    /* with damping: terminal velocity m g / c */
+    const double c = dt * 3.0e9;
+    m = hand_model(dt, c, g);
+    s.vx[0] = s.vy[0] = 0.0;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    for (int k = 0; k < 2000; k++)
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+    const double vterm = -disc_mass(50.0) * g / c;
+    assert_float_equal(s.vy[0], vterm, 1e-9 * fabs(vterm));
+    assert_float_equal(s.fy[0], 0.0, 1e-6 * disc_mass(50.0) * g); /* force balance */
+    cdem_integrator_free(&it);
+    cdem_state_free(&s);
+}
+
+static double pair_energy(const cdem_state *s) {
+    double e = 0.0;
+    for (size_t i = 0; i < 2; i++)
+        e += 0.5 * s->mass[i] * (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]);
+    const double dx = s->x[1] - s->x[0], dy = s->y[1] - s->y[0];
+    const double d = sqrt(dx * dx + dy * dy) - (s->radius[0] + s->radius[1]);
+    return e + 0.5 * KN * d * d;
+}
+
+/* Two elements joined by an intact bond, no damping, no gravity: velocity Verlet keeps the
+ * energy within 1e-3 (relative) over 1e4 steps of ~3 % of the period each. */
+static void test_integrate_energy_conservation(void **st) {
+    (void)st;
+    const double dt = 0.005;
+    cdem_model m = hand_model(dt, 0.0, 0.0);
+    cdem_params p = hand_params(CDEM_MATERIAL_BONDED);
+    cdem_integrator it;
+    cdem_state s;
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&s, 4, 0, &err), CDEM_OK);
+    assert_int_equal(
+        cdem_state_append(&s, -1, 0.0, 0.0, 100.0, disc_mass(100.0), 1, 0, 0, NULL, &err), CDEM_OK);
+    /* 2 m overlap along a diagonal, plus a transverse velocity (the pair also rotates) */
+    assert_int_equal(cdem_state_append(&s, -1, 198.0 * 0.8, 198.0 * 0.6, 100.0, disc_mass(100.0), 1,
+                                       0, 0, NULL, &err),
+                     CDEM_OK);
+    s.vx[1] = -0.3;
+    s.vy[1] = 0.4;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_make_cohesive(&it, &s), 1);
+    const double e0 = pair_energy(&s);
+    double worst = 0.0, rmin = INFINITY, rmax = 0.0;
+    for (int k = 0; k < 10000; k++) {
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        worst = fmax(worst, fabs(pair_energy(&s) - e0) / e0);
+        const double r = hypot(s.x[1] - s.x[0], s.y[1] - s.y[0]);
+        rmin = fmin(rmin, r);
+        rmax = fmax(rmax, r);
+    }
+    assert_true(worst < 1e-3);
+    assert_true(rmin < 199.0 && rmax > 201.0); /* it really oscillated through tension */
+    long contacts, bonds;
+    cdem_integrator_count(&it, &contacts, &bonds);
+    assert_int_equal(bonds, 1);
+    /* momentum: equal masses, zero net force: the centre of mass moves uniformly */
+    const double t = 10000 * dt;
+    assert_float_equal(0.5 * (s.x[0] + s.x[1]), 0.5 * (198.0 * 0.8 - 0.3 * t), 1e-6);
+    cdem_integrator_free(&it);
+    cdem_state_free(&s);
+}
+
+/* A box of wall elements (base + two lateral walls) holding a hexagonal packing of free
+ * elements (radii 95-100 m, spacing 199 m: touching or nearly so) with random velocities. */
+static void make_box(cdem_state *s, int nx, int ny, uint64_t seed) {
+    cdem_error err;
+    assert_int_equal(cdem_state_init(s, (size_t)(nx * ny + 400), 0, &err), CDEM_OK);
+    const double sp = 199.0, rw = 50.0;
+    const double width = nx * sp + 2.0 * sp;
+    for (double x = 0.0; x <= width + 1e-9; x += rw)
+        assert_int_equal(
+            cdem_state_append(s, -1, x, 0.0, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
+    for (double y = rw; y <= (ny + 2) * sp; y += rw) {
+        assert_int_equal(
+            cdem_state_append(s, -1, 0.0, y, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(s, -1, width, y, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
+    }
+    uint64_t g = seed;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            double rad = 100.0 - 5.0 * rnd(&g);
+            size_t k;
+            double x = sp + i * sp + (j % 2) * 0.5 * sp;
+            double y = rw + 100.0 + j * sp * 0.8660254037844386;
+            assert_int_equal(cdem_state_append(s, -1, x, y, rad, disc_mass(rad), 1, 0, 0, &k, &err),
+                             CDEM_OK);
+            s->vx[k] = (rnd(&g) - 0.5) * 2.0;
+            s->vy[k] = (rnd(&g) - 0.5) * 2.0;
+        }
+}
+
+static void run_box(int threads, int nsteps, cdem_state *out) {
+    omp_set_num_threads(threads);
+    const double dt = 0.028;
+    cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    p.element.cohesion = 1e7;
+    cdem_integrator it;
+    cdem_error err;
+    make_box(out, 50, 40, 1234);
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    cdem_integrator_enable_escape(&it);
+    for (int k = 0; k < nsteps; k++) {
+        assert_int_equal(cdem_integrator_step(&it, out, NULL, 0, 0.0, &err), CDEM_OK);
+        if (k == nsteps / 2)
+            assert_true(cdem_integrator_make_cohesive(&it, out) > 0);
+    }
+    assert_true(it.nb.np > 2048); /* the threaded path was used */
+    assert_true(it.nb.n_builds > 1);
+    cdem_integrator_free(&it);
+}
+
+static void test_integrate_deterministic_threads(void **st) {
+    (void)st;
+    cdem_state a, b;
+    run_box(1, 400, &a);
+    run_box(2, 400, &b);
+    assert_int_equal(a.n, b.n);
+    assert_memory_equal(a.id, b.id, a.n * sizeof *a.id);
+    assert_memory_equal(a.x, b.x, a.n * sizeof *a.x);
+    assert_memory_equal(a.y, b.y, a.n * sizeof *a.y);
+    assert_memory_equal(a.vx, b.vx, a.n * sizeof *a.vx);
+    assert_memory_equal(a.fy, b.fy, a.n * sizeof *a.fy);
+    /* and the elements actually moved and settled under gravity: nothing fell through */
+    double ymin = INFINITY;
+    for (size_t i = 0; i < a.n; i++)
+        if (!(a.flags[i] & CDEM_FLAG_WALL))
+            ymin = fmin(ymin, a.y[i]);
+    assert_true(ymin > 50.0);
+    cdem_state_free(&a);
+    cdem_state_free(&b);
+}
+
+static void test_integrate_nan_and_escape(void **st) {
+    (void)st;
+    const double dt = 0.028;
+    cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    cdem_integrator it;
+    cdem_state s;
+    cdem_error err;
+    make_box(&s, 5, 3, 99);
+    /* one element outside the right wall, falling: it must be removed, not lost silently */
+    size_t k;
+    assert_int_equal(
+        cdem_state_append(&s, 777, 5000.0, 500.0, 50.0, disc_mass(50.0), 1, 0, 0, &k, &err),
+        CDEM_OK);
+    const size_t n0 = s.n;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    cdem_integrator_enable_escape(&it);
+    long removed_steps = 0;
+    for (int step = 0; step < 50; step++) {
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        if (it.n_removed_last) {
+            assert_int_equal(it.removed_ids[0], 777);
+            removed_steps++;
+        }
+    }
+    assert_int_equal(it.n_removed, 1);
+    assert_int_equal(removed_steps, 1);
+    assert_int_equal(s.n, n0 - 1);
+    for (size_t i = 0; i < s.n; i++)
+        assert_int_not_equal(s.id[i], 777);
+    /* NaN velocity: the next step reports the element and the step */
+    int32_t victim = -1;
+    for (size_t i = 0; i < s.n && victim < 0; i++)
+        if (!(s.flags[i] & CDEM_FLAG_WALL)) {
+            victim = s.id[i];
+            s.vx[i] = NAN;
+        }
+    char expect[64];
+    snprintf(expect, sizeof expect, "element id %d ", (int)victim);
+    cdem_status stt = CDEM_OK;
+    for (int step = 0; step < 3 && stt == CDEM_OK; step++)
+        stt = cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err);
+    assert_int_equal(stt, CDEM_ERR_NUMERIC);
+    assert_non_null(strstr(err.msg, expect));
+    assert_non_null(strstr(err.msg, "step 51"));
+    assert_non_null(strstr(err.msg, "time step"));
+    cdem_integrator_free(&it);
+    cdem_integrator_free(NULL);
+    cdem_state_free(&s);
+    /* bad model constants are rejected with the value */
+    m.dt = -1.0;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "dt = -1"));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_integrate_free_fall),
+        cmocka_unit_test(test_integrate_energy_conservation),
+        cmocka_unit_test(test_integrate_deterministic_threads),
+        cmocka_unit_test(test_integrate_nan_and_escape),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

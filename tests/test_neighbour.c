@@ -1,0 +1,224 @@
+/* Tests of solver/neighbour: the cell/Verlet pair list equals a brute-force search, the
+ * rebuild criterion, and contact histories surviving re-sorting and element removal. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "contact.h"
+#include "neighbour.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Small deterministic generator for test packings (seeded, no clock). */
+static double rnd(uint64_t *s) {
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static const double radii[4] = {50.0, 75.0, 100.0, 125.0};
+
+/* n random elements in [0, L]^2; every 10th is a wall element. */
+static void make_cloud(cdem_state *s, size_t n, double L, uint64_t seed) {
+    cdem_error err;
+    assert_int_equal(cdem_state_init(s, n, 0, &err), CDEM_OK);
+    uint64_t g = seed;
+    for (size_t i = 0; i < n; i++) {
+        double r = radii[(int)(rnd(&g) * 4.0) % 4];
+        uint32_t fl = (i % 10 == 0) ? CDEM_FLAG_WALL : 0u;
+        assert_int_equal(
+            cdem_state_append(s, -1, rnd(&g) * L, rnd(&g) * L, r, 1.0, 0, fl, 0, NULL, &err),
+            CDEM_OK);
+    }
+}
+
+static int cmp_u64(const void *a, const void *b) {
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Keys of all pairs within R * rf + skin by brute force (test only), sorted. */
+static size_t brute_pairs(const cdem_state *s, double rf, double skin, uint64_t **out) {
+    size_t cap = 1024, k = 0;
+    uint64_t *keys = malloc(cap * sizeof *keys);
+    for (size_t i = 0; i < s->n; i++)
+        for (size_t j = i + 1; j < s->n; j++) {
+            if (cdem_contact_class(s->flags[i], s->flags[j]) < 0)
+                continue;
+            double R = s->radius[i] + s->radius[j], cut = R * rf + skin;
+            double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
+            if (dx * dx + dy * dy >= cut * cut)
+                continue;
+            if (k == cap)
+                keys = realloc(keys, (cap *= 2) * sizeof *keys);
+            keys[k++] = cdem_pair_key(s->id[i], s->id[j]);
+        }
+    qsort(keys, k, sizeof *keys, cmp_u64);
+    *out = keys;
+    return k;
+}
+
+static void assert_list_equals_brute(const cdem_neighbour *nb, const cdem_state *s) {
+    uint64_t *bk = NULL;
+    size_t nbk = brute_pairs(s, nb->reach_factor, nb->skin, &bk);
+    uint64_t *lk = malloc((nb->np + 1) * sizeof *lk);
+    for (size_t p = 0; p < nb->np; p++) {
+        assert_true(nb->pi[p] < nb->pj[p]);
+        lk[p] = cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]);
+    }
+    qsort(lk, nb->np, sizeof *lk, cmp_u64);
+    assert_int_equal(nb->np, nbk);
+    assert_true(nbk > 100);
+    assert_memory_equal(lk, bk, nbk * sizeof *bk);
+    /* CSR: every slot appears once per side */
+    assert_int_equal(nb->start[s->n], 2 * (int32_t)nb->np);
+    free(lk);
+    free(bk);
+}
+
+static void test_neighbour_matches_brute_force(void **st) {
+    (void)st;
+    cdem_state s;
+    make_cloud(&s, 800, 4000.0, 42);
+    cdem_neighbour nb;
+    cdem_error err;
+    const double skin = 12.5;
+    assert_int_equal(cdem_neighbour_init(&nb, skin, 1.0, 5, &err), CDEM_OK);
+    assert_true(cdem_neighbour_needs_rebuild(&nb, &s));
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 0, &err), CDEM_OK);
+    assert_list_equals_brute(&nb, &s);
+    assert_false(cdem_neighbour_needs_rebuild(&nb, &s));
+    /* moves below half the skin: no rebuild needed, and every touching pair is listed */
+    uint64_t g = 7;
+    for (size_t i = 0; i < s.n; i++) {
+        double a = rnd(&g) * 2.0 * M_PI;
+        s.x[i] += 0.49 * skin * cos(a);
+        s.y[i] += 0.49 * skin * sin(a);
+    }
+    assert_false(cdem_neighbour_needs_rebuild(&nb, &s));
+    uint64_t *touch = NULL;
+    size_t ntouch = brute_pairs(&s, 1.0, 0.0, &touch);
+    uint64_t *lk = malloc((nb.np + 1) * sizeof *lk);
+    for (size_t p = 0; p < nb.np; p++)
+        lk[p] = cdem_pair_key(s.id[nb.pi[p]], s.id[nb.pj[p]]);
+    qsort(lk, nb.np, sizeof *lk, cmp_u64);
+    for (size_t k = 0; k < ntouch; k++)
+        assert_non_null(bsearch(&touch[k], lk, nb.np, sizeof *lk, cmp_u64));
+    free(lk);
+    free(touch);
+    /* one element beyond half the skin: rebuild, and the new list is exact again */
+    s.x[17] += 0.6 * skin;
+    assert_true(cdem_neighbour_needs_rebuild(&nb, &s));
+    for (int round = 0; round < 3; round++) {
+        for (size_t i = 0; i < s.n; i++) {
+            s.x[i] += (rnd(&g) - 0.5) * 4.0 * skin;
+            s.y[i] += (rnd(&g) - 0.5) * 4.0 * skin;
+        }
+        assert_true(cdem_neighbour_needs_rebuild(&nb, &s));
+        assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, round == 1 ? 1 : 0, &err), CDEM_OK);
+        assert_list_equals_brute(&nb, &s);
+    }
+    assert_true(nb.n_sorts >= 1);
+    /* bonded reach: pairs up to R (1 + r0) + skin */
+    cdem_neighbour nb2;
+    assert_int_equal(cdem_neighbour_init(&nb2, skin, 1.1, 5, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_build(&nb2, &s, NULL, 0, &err), CDEM_OK);
+    assert_list_equals_brute(&nb2, &s);
+    assert_true(nb2.np > nb.np);
+    cdem_neighbour_free(&nb2);
+    cdem_neighbour_free(&nb);
+    cdem_state_free(&s);
+}
+
+/* A history value derived from the pair's ids, to check it follows the pair. */
+static double tag(uint64_t key) {
+    return (double)(key % 100003) * 1e-3 + 1.0;
+}
+
+static void test_neighbour_history_survives_resort_and_removal(void **st) {
+    (void)st;
+    cdem_state s;
+    make_cloud(&s, 600, 3000.0, 9);
+    cdem_neighbour nb;
+    cdem_error err;
+    assert_int_equal(cdem_neighbour_init(&nb, 12.5, 1.0, 1000, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, -1, &err), CDEM_OK);
+    const size_t np0 = nb.np;
+    for (size_t p = 0; p < nb.np; p++) {
+        uint64_t key = cdem_pair_key(s.id[nb.pi[p]], s.id[nb.pj[p]]);
+        nb.xs[p] = tag(key);
+        nb.hist[p] = (uint8_t)(CDEM_PAIR_TOUCH | ((key & 1) ? CDEM_PAIR_COHESIVE : 0));
+    }
+    int32_t first_id_before = s.id[0];
+    /* forced re-sort into cell order: indices change, histories follow the ids */
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 1, &err), CDEM_OK);
+    assert_int_equal(nb.np, np0);
+    for (size_t p = 0; p < nb.np; p++) {
+        uint64_t key = cdem_pair_key(s.id[nb.pi[p]], s.id[nb.pj[p]]);
+        assert_float_equal(nb.xs[p], tag(key), 0.0);
+        assert_int_equal(nb.hist[p], CDEM_PAIR_TOUCH | ((key & 1) ? CDEM_PAIR_COHESIVE : 0));
+    }
+    /* ids are sorted by cell now, not by creation: the permutation really happened */
+    int unsorted = 0;
+    for (size_t i = 1; i < s.n; i++)
+        unsorted |= s.id[i] < s.id[i - 1];
+    assert_true(unsorted);
+    /* remove every 7th element */
+    unsigned char *keep = malloc(s.n);
+    int32_t *gone = malloc(s.n * sizeof *gone);
+    size_t ngone = 0;
+    for (size_t i = 0; i < s.n; i++) {
+        keep[i] = (unsigned char)(s.id[i] % 7 != 0);
+        if (!keep[i])
+            gone[ngone++] = s.id[i];
+    }
+    size_t n_before = s.n;
+    assert_int_equal(cdem_neighbour_build(&nb, &s, keep, 0, &err), CDEM_OK);
+    assert_int_equal(s.n, n_before - ngone);
+    for (size_t i = 0; i < s.n; i++)
+        assert_int_not_equal(s.id[i] % 7, 0);
+    for (size_t p = 0; p < nb.np; p++) {
+        uint64_t key = cdem_pair_key(s.id[nb.pi[p]], s.id[nb.pj[p]]);
+        assert_float_equal(nb.xs[p], tag(key), 0.0);
+    }
+    assert_list_equals_brute(&nb, &s);
+    free(keep);
+    free(gone);
+    cdem_neighbour_free(&nb);
+    cdem_state_free(&s);
+}
+
+static void test_neighbour_rejects_bad_input(void **st) {
+    (void)st;
+    cdem_neighbour nb;
+    cdem_error err;
+    assert_int_equal(cdem_neighbour_init(&nb, 0.0, 1.0, 5, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "skin"));
+    assert_int_equal(cdem_neighbour_init(&nb, 1.0, 0.5, 5, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "reach factor"));
+    cdem_state s;
+    make_cloud(&s, 50, 1000.0, 3);
+    s.y[12] = NAN;
+    assert_int_equal(cdem_neighbour_init(&nb, 5.0, 1.0, 5, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 0, &err), CDEM_ERR_NUMERIC);
+    assert_non_null(strstr(err.msg, "element id 12"));
+    /* a stray element far away does not blow up the grid */
+    s.y[12] = 1.0e12;
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 0, &err), CDEM_OK);
+    cdem_neighbour_free(&nb);
+    cdem_neighbour_free(NULL);
+    cdem_state_free(&s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_neighbour_matches_brute_force),
+        cmocka_unit_test(test_neighbour_history_survives_resort_and_removal),
+        cmocka_unit_test(test_neighbour_rejects_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
