@@ -153,7 +153,6 @@ static void test_neighbour_history_survives_resort_and_removal(void **st) {
         nb.xs[p] = tag(key);
         nb.hist[p] = (uint8_t)(CDEM_PAIR_TOUCH | ((key & 1) ? CDEM_PAIR_COHESIVE : 0));
     }
-    int32_t first_id_before = s.id[0];
     /* forced re-sort into cell order: indices change, histories follow the ids */
     assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 1, &err), CDEM_OK);
     assert_int_equal(nb.np, np0);
