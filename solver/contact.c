@@ -25,11 +25,13 @@ int cdem_contact_class(uint32_t flags_i, uint32_t flags_j) {
     return CDEM_CLASS_ELEMENT;
 }
 
-static cdem_status check_value(const char *section, const char *key, double v, int positive,
+/* Checks material.<cls>_<key> (or model.<key> when cls is NULL). */
+static cdem_status check_value(const char *cls, const char *key, double v, int positive,
                                cdem_error *err) {
     if (!isfinite(v) || v < 0.0 || (positive && v == 0.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "contact law: %s.%s = %g: must be a finite number %s 0", section, key, v,
+                         "contact law: %s%s%s%s = %g: must be a finite number %s 0",
+                         cls ? "material." : "model.", cls ? cls : "", cls ? "_" : "", key, v,
                          positive ? ">" : ">=");
     return CDEM_OK;
 }
@@ -38,8 +40,8 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
                                   cdem_error *err) {
     if (!law || !p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_contact_law_init: NULL argument");
-    CDEM_TRY(check_value("model", "kn", kn, 1, err));
-    CDEM_TRY(check_value("model", "ks", ks, 0, err));
+    CDEM_TRY(check_value(NULL, "kn", kn, 1, err));
+    CDEM_TRY(check_value(NULL, "ks", ks, 0, err));
     const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault};
     law->model = p->material;
     law->first_slip = p->first_slip ? 1 : 0;

@@ -189,15 +189,15 @@ static void test_contact_law_rejects_bad_values(void **st) {
     cdem_error err;
     p.wall.friction = -0.1;
     assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
-    assert_non_null(strstr(err.msg, "wall.friction"));
+    assert_non_null(strstr(err.msg, "material.wall_friction"));
     assert_non_null(strstr(err.msg, "-0.1"));
     p = base_params(CDEM_MATERIAL_BONDED);
     p.fault.breaking_strain = 0.0;
     assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
-    assert_non_null(strstr(err.msg, "fault.breaking_strain"));
+    assert_non_null(strstr(err.msg, "material.fault_breaking_strain"));
     p = base_params(CDEM_MATERIAL_GRANULAR);
     assert_int_equal(cdem_contact_law_init(&law, &p, 0.0, KS, &err), CDEM_ERR_RANGE);
-    assert_non_null(strstr(err.msg, "kn"));
+    assert_non_null(strstr(err.msg, "model.kn = 0"));
     p = base_params(CDEM_MATERIAL_BONDED);
     assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
     assert_float_equal(law.max_breaking_strain, 0.05, 1e-15);
