@@ -12,8 +12,10 @@
 
 /* Rebuilds between re-sorts of the state into cell order. */
 #define RESORT_EVERY 20
-/* Loops shorter than this run on one thread (the fork costs more than it saves). */
-#define OMP_MIN_ITEMS 2048
+/* Default of cdem_integrator.par_min: loops shorter than this run on one thread. A step of
+ * the default model (~2500 elements, ~5000 pairs) takes ~0.1 ms, comparable to the cost of
+ * an OpenMP barrier when the cores are shared, so small models stay serial. */
+#define PAR_MIN_DEFAULT 16384
 
 cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
                                  cdem_error *err) {
@@ -30,6 +32,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
                          m->radius[0]);
+    it->par_min = PAR_MIN_DEFAULT;
     it->dt = m->dt;
     it->damping = m->damping;
     it->gravity = m->gravity;
@@ -122,7 +125,7 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
     const long n = (long)s->n;
     const double *restrict x = s->x, *restrict y = s->y;
     int bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : bad) if (n > OMP_MIN_ITEMS)
+#pragma omp parallel for schedule(static) reduction(| : bad) if (n > it->par_min)
     for (long i = 0; i < n; i++)
         bad |= !(isfinite(x[i]) && isfinite(y[i]));
     if (!bad)
@@ -150,7 +153,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     const uint8_t *restrict cls = nb->cls;
     uint8_t *restrict hist = nb->hist;
     double *restrict xs = nb->xs, *restrict pfx = nb->pfx, *restrict pfy = nb->pfy;
-#pragma omp parallel for schedule(static) if (np > OMP_MIN_ITEMS)
+#pragma omp parallel for schedule(static) if (np > it->par_min)
     for (long p = 0; p < np; p++) {
         const int32_t i = pi[p], j = pj[p];
         const double dx = x[j] - x[i], dy = y[j] - y[i];
@@ -177,7 +180,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     double *restrict fx = s->fx, *restrict fy = s->fy;
     double *restrict vxw = s->vx, *restrict vyw = s->vy;
     const double hdt = 0.5 * dt, c = it->damping, g = it->gravity;
-#pragma omp parallel for schedule(static) if (n > OMP_MIN_ITEMS)
+#pragma omp parallel for schedule(static) if (n > it->par_min)
     for (long i = 0; i < n; i++) {
         double sx = 0.0, sy = 0.0;
         for (int32_t e = start[i]; e < start[i + 1]; e++) {
@@ -238,7 +241,7 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
         const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
         const uint32_t *restrict flags = s->flags;
-#pragma omp parallel for schedule(static) if (n > OMP_MIN_ITEMS)
+#pragma omp parallel for schedule(static) if (n > it->par_min)
         for (long i = 0; i < n; i++) {
             if (flags[i] & CDEM_FLAGS_BOUNDARY)
                 continue;

@@ -30,6 +30,8 @@ typedef struct {
     cdem_contact_law law; /* contact law and materials */
     cdem_neighbour nb;    /* pair list with histories and force slots */
     long step;            /* steps taken so far */
+    long par_min;         /* loops over fewer items than this run on one thread (>= 0);
+                             results are bit-identical either way */
 
     /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
      * y < ymin - max_radius; x bounds follow the moving lateral walls */
