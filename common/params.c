@@ -285,6 +285,18 @@ static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
                  d->max_exclusive ? "<" : "<=", hi, sp, d->unit);
 }
 
+/* Rounds v to 4 significant digits towards +inf (up = 1) or -inf (up = 0) and formats it, so
+ * that advice such as "at least X" is itself sufficient. */
+static void format_safe(double v, int up, char *buf, size_t n) {
+    if (!(v > 0) || !isfinite(v)) {
+        snprintf(buf, n, "%g", v);
+        return;
+    }
+    double mag = pow(10.0, floor(log10(v)) - 3.0);
+    double r = (up ? ceil(v / mag) : floor(v / mag)) * mag;
+    snprintf(buf, n, "%.4g", r);
+}
+
 /* Short "allowed values" text for comments and the markdown table. */
 static void describe_allowed(const cdem_param_def *d, char *buf, size_t n) {
     switch (d->type) {
@@ -1019,8 +1031,8 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
                 snprintf(s_bet, sizeof s_bet, "%.4g", between);
                 snprintf(s_speed, sizeof s_speed, "%.4g", m.boundary_speed);
                 /* smallest display interval / largest equilibration that satisfy the rule */
-                snprintf(s_di, sizeof s_di, "%.4g", settling * m.boundary_speed / 30.0);
-                snprintf(s_eq, sizeof s_eq, "%.4g", between / 0.2);
+                format_safe(settling * m.boundary_speed / 30.0, 1, s_di, sizeof s_di);
+                format_safe(between / 0.2, 0, s_eq, sizeof s_eq);
                 format_double(p->display_interval, v1, sizeof v1);
                 format_double(p->equilibration, v2, sizeof v2);
                 rule_add(&log,
