@@ -78,8 +78,11 @@ static void inversion_lines(FILE *f, const cdem_params *p, const cdem_model *m) 
     line(f, "inversion", "at %g %% of the displacement: %.4g m %s, then %.4g m %s",
          p->inversion_percent, before, sense_word(p->fault_sense), after,
          other_sense_word(p->fault_sense));
-    line(f, "net displacement", "%.4g m %s", fabs(net),
-         net >= 0 ? sense_word(p->fault_sense) : other_sense_word(p->fault_sense));
+    if (fabs(net) <= 1e-9 * m->total_displacement)
+        line(f, "net displacement", "0 m (the block returns to its starting position)");
+    else
+        line(f, "net displacement", "%.4g m %s", fabs(net),
+             net > 0 ? sense_word(p->fault_sense) : other_sense_word(p->fault_sense));
 }
 
 static void write_mode(FILE *f, const cdem_params *p, const cdem_model *m) {
