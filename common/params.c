@@ -868,6 +868,13 @@ static void rule_add(rule_log *log, const char *fmt, ...) {
         log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
 }
 
+/* Options the biaxial test excludes ({section, key}; all BOOL or ENUM with 0 = off). */
+static const char *const biaxial_excludes[][2] = {
+    {"heterogeneity", "flexural_slip"},    {"heterogeneity", "weak_interval"},
+    {"heterogeneity", "layered_friction"}, {"surface", "erosion"},
+    {"surface", "sedimentation"},
+};
+
 static int is_fault_mode(cdem_mode m) {
     return m == CDEM_MODE_PLANAR_FAULT || m == CDEM_MODE_LISTRIC_FAULT ||
            m == CDEM_MODE_IRREGULAR_FAULT;
@@ -973,31 +980,25 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
                      "height = %s): set them in [assembly]",
                      v1, v2);
         }
-        static const struct {
-            size_t offset;
-            const char *name;
-            const char *section;
-        } biax_off[] = {
-            {P_OFF(flexural_slip), "flexural_slip", "heterogeneity"},
-            {P_OFF(weak_interval), "weak_interval", "heterogeneity"},
-            {P_OFF(layered_friction), "layered_friction", "heterogeneity"},
-            {P_OFF(erosion), "erosion", "surface"},
-            {P_OFF(sedimentation), "sedimentation", "surface"},
-        };
-        for (size_t i = 0; i < sizeof biax_off / sizeof biax_off[0]; i++) {
+        for (size_t i = 0; i < sizeof biaxial_excludes / sizeof biaxial_excludes[0]; i++) {
+            const cdem_param_def *d =
+                cdem_params_find(biaxial_excludes[i][0], biaxial_excludes[i][1]);
             int v;
-            memcpy(&v, (const char *)p + biax_off[i].offset, sizeof v);
-            if (v)
-                rule_add(&log, "mode = biaxial excludes %s: set [%s] %s = off", biax_off[i].name,
-                         biax_off[i].section, biax_off[i].name);
+            memcpy(&v, (const char *)p + d->offset, sizeof v);
+            if (v) {
+                cdem_params_format_value(p, d, v1, sizeof v1);
+                rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key, v1,
+                         d->section, d->key);
+            }
         }
     }
     if (p->mode == CDEM_MODE_REPOSE) {
         if (p->erosion)
-            rule_add(&log, "mode = repose excludes erosion: set [surface] erosion = off");
+            rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
         if (p->sedimentation)
-            rule_add(&log,
-                     "mode = repose excludes sedimentation: set [surface] sedimentation = off");
+            rule_add(
+                &log,
+                "mode = repose excludes sedimentation = on: set [surface] sedimentation = off");
     }
     if (p->mode == CDEM_MODE_IRREGULAR_FAULT && p->fault_file[0] == '\0')
         rule_add(&log, "mode = irregular-fault requires fault_file: set [boundary] fault_file to "

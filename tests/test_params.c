@@ -483,7 +483,7 @@ static const rule_case rule_cases[] = {
      "mode = biaxial excludes flexural_slip"},
     {"biaxial weak",
      {"boundary.mode=biaxial", "heterogeneity.weak_interval=upper", NULL},
-     "mode = biaxial excludes weak_interval"},
+     "mode = biaxial excludes weak_interval = upper: set [heterogeneity] weak_interval = off"},
     {"biaxial layered",
      {"boundary.mode=biaxial", "heterogeneity.layered_friction=on", NULL},
      "mode = biaxial excludes layered_friction"},
