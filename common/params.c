@@ -554,9 +554,12 @@ cdem_status cdem_params_parse_text(cdem_params *p, const char *text, const char 
         size_t len = eol ? (size_t)(eol - s) : strlen(s);
         const char *next = eol ? eol + 1 : s + len;
         char line[VALUE_MAX + 128];
-        copy_trimmed(line, sizeof line, s, len);
         char where[CDEM_PATH_MAX + 32];
         snprintf(where, sizeof where, "%s:%d", path, line_no);
+        if (len >= sizeof line)
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: line longer than %zu characters: %.40s...",
+                             where, sizeof line - 1, s);
+        copy_trimmed(line, sizeof line, s, len);
         s = next;
         if (line[0] == '\0' || line[0] == '#' || line[0] == ';')
             continue;

@@ -365,6 +365,15 @@ static void test_params_comments_whitespace_bom_crlf(void **state) {
     assert_true(p.gravity == 5.5 && p.density == 2000.0);
     assert_string_equal(p.prefix, "run#1");
     assert_string_equal(p.fault_file, "my faults/f #2.txt");
+    /* an over-long line is refused, not silently cut */
+    char *big = malloc(4000);
+    assert_non_null(big);
+    int w = snprintf(big, 4000, "[physics]\ngravity = 9.81");
+    memset(big + w, ' ', 3000);
+    snprintf(big + w + 3000, 4000 - (size_t)w - 3000, "x\n");
+    assert_int_equal(parse(&p, big, &err), CDEM_ERR_PARSE);
+    assert_msg_has(&err, "model.ini:2: line longer than ");
+    free(big);
     /* last line without a newline */
     assert_int_equal(parse(&p, "[physics]\ngravity = 7", &err), CDEM_OK);
     assert_true(p.gravity == 7.0);
