@@ -143,7 +143,8 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
 /* Pair forces into slots, then per-element sums and the second half kick. */
 static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     cdem_neighbour *nb = &it->nb;
-    const cdem_contact_law *law = &it->law;
+    const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
+    const cdem_contact_law *law = &lawc;
     const double dt = it->dt;
     const long np = (long)nb->np;
     const double *restrict x = s->x, *restrict y = s->y;
@@ -174,7 +175,8 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     }
 
     const long n = (long)s->n;
-    const int32_t *restrict start = nb->start, *restrict entry = nb->entry;
+    const int32_t *restrict istart = nb->istart, *restrict jstart = nb->jstart;
+    const int32_t *restrict jslot = nb->jslot;
     const double *restrict mass = s->mass;
     const uint32_t *restrict flags = s->flags;
     double *restrict fx = s->fx, *restrict fy = s->fy;
@@ -183,16 +185,13 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
 #pragma omp parallel for schedule(static) if (n > it->par_min)
     for (long i = 0; i < n; i++) {
         double sx = 0.0, sy = 0.0;
-        for (int32_t e = start[i]; e < start[i + 1]; e++) {
-            const int32_t code = entry[e];
-            const int32_t p = code >> 1;
-            if (code & 1) {
-                sx -= pfx[p];
-                sy -= pfy[p];
-            } else {
-                sx += pfx[p];
-                sy += pfy[p];
-            }
+        for (int32_t p = istart[i]; p < istart[i + 1]; p++) {
+            sx += pfx[p];
+            sy += pfy[p];
+        }
+        for (int32_t e = jstart[i]; e < jstart[i + 1]; e++) {
+            sx -= pfx[jslot[e]];
+            sy -= pfy[jslot[e]];
         }
         if (flags[i] & CDEM_FLAGS_BOUNDARY) {
             fx[i] = sx;
@@ -202,12 +201,10 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         const double m = mass[i];
         sy -= m * g;
         if (kick) {
-            const double a = hdt / m;
-            const double den = 1.0 / (1.0 + c * a);
-            const double nvx = (vxw[i] + a * sx) * den;
-            const double nvy = (vyw[i] + a * sy) * den;
-            vxw[i] = nvx;
-            vyw[i] = nvy;
+            /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
+            const double inv = 1.0 / (m + c * hdt);
+            vxw[i] = (m * vxw[i] + hdt * sx) * inv;
+            vyw[i] = (m * vyw[i] + hdt * sy) * inv;
         }
         fx[i] = sx - c * vxw[i];
         fy[i] = sy - c * vyw[i];

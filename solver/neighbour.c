@@ -54,8 +54,9 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->xs);
     free(nb->pfx);
     free(nb->pfy);
-    free(nb->start);
-    free(nb->entry);
+    free(nb->istart);
+    free(nb->jstart);
+    free(nb->jslot);
     free(nb->x0);
     free(nb->y0);
     free(nb->cell_of);
@@ -94,7 +95,8 @@ static cdem_status reserve_elements(cdem_neighbour *nb, size_t n, cdem_error *er
     CDEM_TRY(grow((void **)&nb->perm, sizeof(size_t), c, err));
     CDEM_TRY(grow((void **)&nb->scratch, 8, c, err));
     CDEM_TRY(grow((void **)&nb->cell_items, sizeof(int32_t), c, err));
-    CDEM_TRY(grow((void **)&nb->start, sizeof(int32_t), c + 1, err));
+    CDEM_TRY(grow((void **)&nb->istart, sizeof(int32_t), c + 1, err));
+    CDEM_TRY(grow((void **)&nb->jstart, sizeof(int32_t), c + 1, err));
     nb->ncap = c;
     return CDEM_OK;
 }
@@ -111,7 +113,7 @@ static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err)
     CDEM_TRY(grow((void **)&nb->xs, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->pfx, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->pfy, sizeof(double), c, err));
-    CDEM_TRY(grow((void **)&nb->entry, sizeof(int32_t), 2 * c, err));
+    CDEM_TRY(grow((void **)&nb->jslot, sizeof(int32_t), c, err));
     nb->pcap = c;
     return CDEM_OK;
 }
@@ -339,20 +341,21 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     /* CSR of slots per element, ascending slot order */
     if (nb->np > 0)
         CDEM_TRY(reserve_pairs(nb, nb->np, err));
-    memset(nb->start, 0, (n + 1) * sizeof(int32_t));
+    memset(nb->istart, 0, (n + 1) * sizeof(int32_t));
+    memset(nb->jstart, 0, (n + 1) * sizeof(int32_t));
     for (size_t p = 0; p < nb->np; p++) {
-        nb->start[nb->pi[p] + 1]++;
-        nb->start[nb->pj[p] + 1]++;
+        nb->istart[nb->pi[p] + 1]++;
+        nb->jstart[nb->pj[p] + 1]++;
     }
-    for (size_t i = 0; i < n; i++)
-        nb->start[i + 1] += nb->start[i];
+    for (size_t i = 0; i < n; i++) {
+        nb->istart[i + 1] += nb->istart[i];
+        nb->jstart[i + 1] += nb->jstart[i];
+    }
     {
         int32_t *cursor = (int32_t *)nb->scratch;
-        memcpy(cursor, nb->start, n * sizeof(int32_t));
-        for (size_t p = 0; p < nb->np; p++) {
-            nb->entry[cursor[nb->pi[p]]++] = (int32_t)(2 * p);
-            nb->entry[cursor[nb->pj[p]]++] = (int32_t)(2 * p + 1);
-        }
+        memcpy(cursor, nb->jstart, n * sizeof(int32_t));
+        for (size_t p = 0; p < nb->np; p++)
+            nb->jslot[cursor[nb->pj[p]]++] = (int32_t)p;
     }
     memcpy(nb->x0, s->x, n * sizeof(double));
     memcpy(nb->y0, s->y, n * sizeof(double));

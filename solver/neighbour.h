@@ -3,7 +3,7 @@
  * whose gap is below the skin, and stays valid until some element has moved more than half
  * the skin since the build (then cdem_neighbour_needs_rebuild says so). Never all-pairs.
  * Each pair carries its contact history (contact.h) and a force slot (one writer per slot);
- * a CSR of pair slots per element (ascending slot order) makes the per-element force sums
+ * fixed per-element slot lists (CSR) make the per-element force sums
  * independent of the thread count. At a rebuild the histories are carried over by element
  * id pair, so they survive re-sorting and element removal; every `resort_every` builds the
  * state arrays are permuted into cell order (memory locality).
@@ -42,10 +42,12 @@ typedef struct {
     double *xs;        /* m, accumulated tangential displacement (contact frame) */
     double *pfx, *pfy; /* N, contact force on pi of the last evaluation (pj gets minus) */
 
-    /* per-element CSR of pair slots: entries start[e]..start[e+1]-1, entry = slot*2+side
-     * (side 1: the element is pj, force negated) */
-    int32_t *start; /* n + 1 */
-    int32_t *entry; /* 2 * np */
+    /* per-element pair slots, in a fixed order: the slots where e is pi are the range
+     * istart[e]..istart[e+1]-1 (pairs are enumerated by ascending pi); the slots where e is
+     * pj are jslot[jstart[e]..jstart[e+1]-1], ascending */
+    int32_t *istart; /* n + 1 */
+    int32_t *jstart; /* n + 1 */
+    int32_t *jslot;  /* np */
 
     /* per-element buffers (ncap) */
     size_t n;         /* elements at the last build */

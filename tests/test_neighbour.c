@@ -74,8 +74,15 @@ static void assert_list_equals_brute(const cdem_neighbour *nb, const cdem_state 
     assert_int_equal(nb->np, nbk);
     assert_true(nbk > 100);
     assert_memory_equal(lk, bk, nbk * sizeof *bk);
-    /* CSR: every slot appears once per side */
-    assert_int_equal(nb->start[s->n], 2 * (int32_t)nb->np);
+    /* slot lists: every slot once as pi (contiguous ranges) and once as pj */
+    assert_int_equal(nb->istart[s->n], (int32_t)nb->np);
+    assert_int_equal(nb->jstart[s->n], (int32_t)nb->np);
+    for (size_t i = 0; i < s->n; i++) {
+        for (int32_t p = nb->istart[i]; p < nb->istart[i + 1]; p++)
+            assert_int_equal(nb->pi[p], (int32_t)i);
+        for (int32_t e = nb->jstart[i]; e < nb->jstart[i + 1]; e++)
+            assert_int_equal(nb->pj[nb->jslot[e]], (int32_t)i);
+    }
     free(lk);
     free(bk);
 }
