@@ -137,6 +137,50 @@ static double max_overlap_fraction(const cdem_state *s, const grid *g, int *cont
     return worst;
 }
 
+/* 1 when disc i rests on the base, or when the upward vertical lies in the cone of two of
+ * its contact normals (partner centre -> disc centre; lateral walls push horizontally), so
+ * compressive contact forces alone can balance its weight. */
+static int supported(const cdem_state *s, const grid *g, size_t i, double w) {
+    double r = s->radius[i], nx[64], ny[64];
+    int n = 0;
+    if (fabs(s->y[i] - r) < 1e-6 * r)
+        return 1;
+    if (fabs(s->x[i] - r) < 1e-6 * r) {
+        nx[n] = 1.0;
+        ny[n++] = 0.0;
+    }
+    if (fabs(w - s->x[i] - r) < 1e-6 * r) {
+        nx[n] = -1.0;
+        ny[n++] = 0.0;
+    }
+    int c = gcol(g, s->x[i]), rr = grow(g, s->y[i]);
+    for (int row = rr - 1; row <= rr + 1; row++)
+        for (int col = c - 1; col <= c + 1; col++) {
+            if (row < 0 || col < 0 || row >= g->nrows || col >= g->ncols)
+                continue;
+            size_t cell = (size_t)row * g->ncols + col;
+            for (size_t q = g->start[cell]; q < g->start[cell + 1] && n < 64; q++) {
+                size_t j = g->idx[q];
+                double dx = s->x[i] - s->x[j], dy = s->y[i] - s->y[j];
+                double d = hypot(dx, dy);
+                if (j != i && fabs(d - r - s->radius[j]) < 1e-6 * fmin(r, s->radius[j])) {
+                    nx[n] = dx / d;
+                    ny[n++] = dy / d;
+                }
+            }
+        }
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++) {
+            double det = nx[a] * ny[b] - ny[a] * nx[b];
+            if (fabs(det) < 1e-12)
+                continue;
+            double fa = -nx[b] / det, fb = nx[a] / det; /* (0, 1) = fa n_a + fb n_b */
+            if (fa >= -1e-9 && fb >= -1e-9)
+                return 1;
+        }
+    return 0;
+}
+
 /* ---------------------------------------------------------------- counts */
 
 static void test_assembly_paper_counts(void **unused) {
@@ -280,18 +324,16 @@ static void test_assembly_no_overlap_and_supported(void **unused) {
                 }
             assert_true(fabs(all - worst) < 1e-12);
         }
-        /* supported: every disc rests on the base, or touches >= 2 discs or walls */
+        /* supported: every disc rests on the base, or two of its contacts (discs or lateral
+         * walls) can hold it against gravity with compressive forces */
         double w = p.width * p.unit_scaling;
         long unsupported = 0, sum_contacts = 0;
         for (size_t i = 0; i < s.n; i++) {
             if (s.flags[i] & CDEM_FLAG_WALL)
                 continue;
-            double r = s.radius[i];
-            int on_base = fabs(s.y[i] - r) < 1e-6 * r;
-            int walls = (fabs(s.x[i] - r) < 1e-6 * r) + (fabs(w - s.x[i] - r) < 1e-6 * r);
-            if (!on_base && contacts[i] + walls < 2)
-                unsupported++;
             sum_contacts += contacts[i];
+            if (!supported(&s, &g, i, w))
+                unsupported++;
         }
         printf("    %g x %g units (%g m, half %d): %ld elements, max overlap %.2e of the smaller "
                "radius, mean contacts %.2f, unsupported %ld\n",
