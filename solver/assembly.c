@@ -5,7 +5,7 @@
  * rolls over that disc, downhill, until it meets a second disc, a lateral wall or the base.
  * If the two contacts hold it against gravity it stops; otherwise it rolls on over the new
  * disc, or falls again when it passes the equator of the disc it rolls on. Stops are exact
- * tangencies, so the packing has no overlap. A disc whose resting centre lies above the
+ * tangencies, so the packing has no overlap. A disc whose lowest point rests above the
  * assembly height is discarded; filling stops after a run of consecutive discards (the
  * region below the height is then saturated). The cell grid (cells of 2 x max radius, one
  * linked list per cell, plus the highest centre per grid column) makes every drop O(1), so
@@ -36,8 +36,11 @@ static const int bag_counts[CDEM_NUM_RADII] = {4, 3, 2, 1};
  * practice; a guard against a numerical cycle). */
 #define ASM_MAX_MOVES 1000
 
-/* Most elements one assembly may hold (about 0.5 GB of state); larger requests fail. */
-#define ASM_MAX_ELEMENTS 20000000.0
+/* Upper bound on the elements (and grid cells) of one assembly; larger requests fail. The
+ * bound used is the densest possible packing of smallest discs, about 2.7 times the real
+ * count, so this admits about 1.8 million real elements (the largest assembly within the
+ * parameter ranges has 125,000). */
+#define ASM_MAX_ELEMENTS 5000000.0
 
 /* Relative tolerance of a tangency, as a fraction of the contact distance. */
 #define ASM_EPS 1e-12
@@ -309,9 +312,9 @@ static int draw_class(class_bag *bag, gsl_rng *rng) {
 
 /* Orders the discs row-major by grid cell (bottom row first), then by y, x. */
 typedef struct {
-    long key; /* row * ncols + col */
-    double y, x;
-    long i; /* index in the packer */
+    long key;    /* row * ncols + col */
+    double y, x; /* centre, m (ties inside a cell) */
+    long i;      /* index in the packer */
 } sort_item;
 
 static int cmp_item(const void *pa, const void *pb) {

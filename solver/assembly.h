@@ -6,7 +6,7 @@
  * a disc and a wall, or the base). It is purely geometric, O(N) with a cell grid, and leaves
  * no overlap; the solver's equilibration settles the assembly dynamically. Radius classes
  * are drawn in number fractions 4:3:2:1 (smallest to largest); a disc is kept when its
- * centre rests at or below the assembly height. See docs/assembly.md for the reasons.
+ * lowest point rests at or below the assembly height. docs/assembly.md gives the reasons.
  * Frame: origin at the bottom-left inner corner, x right, y up; inner wall surfaces at
  * x = 0, x = width, y = 0. Units: m, kg per metre of thickness.
  * Determinism: a gsl_rng_mt19937 seeded with p->seed; same parameters -> same state, bit for
