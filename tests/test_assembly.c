@@ -244,6 +244,49 @@ static void test_assembly_count_matches_build(void **unused) {
     cdem_state_free(&s);
 }
 
+/* Every corner of the parameter ranges (width 10-100, height 2.5-7.5 units, unit scaling
+ * 100-1000 m, both radius sets, wall multiplier 1-4) builds a valid packing whose number
+ * of elements per unit area stays within 3 % of the original program's (42.1 per unit^2,
+ * the mean of its four figures in full-radius terms; 4 x that with half radii). */
+static void test_assembly_density_across_ranges(void **unused) {
+    (void)unused;
+    const double widths[] = {10, 100}, heights[] = {2.5, 7.5};
+    int k = 0;
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++)
+            for (int half = 0; half <= 1; half++, k++) {
+                if (a == 1 && b == 1 && half == 1)
+                    continue; /* the largest case has its own test */
+                cdem_params p;
+                cdem_model m;
+                double scaling = (k % 3 == 0) ? 100 : ((k % 3 == 1) ? 1000 : 617);
+                fill_params(&p, widths[a], heights[b], scaling, half, 100 + k);
+                p.wall_height_multiplier = 1 + k % 4;
+                fill_model(&m, scaling, half);
+                cdem_state s;
+                cdem_assembly_info info;
+                build(&p, &m, &s, &info);
+                double density = info.n_internal / (p.width * p.height) / (half ? 4.0 : 1.0);
+                grid g;
+                grid_build(&g, &s, 2.0 * m.radius[3]);
+                double worst = max_overlap_fraction(&s, &g, NULL, 0.0);
+                double w = p.width * p.unit_scaling, tol = 1e-9 * w;
+                long outside = 0;
+                for (size_t i = 0; i < s.n; i++)
+                    if (!(s.flags[i] & CDEM_FLAG_WALL))
+                        outside += s.x[i] - s.radius[i] < -tol || s.x[i] + s.radius[i] > w + tol ||
+                                   s.y[i] - s.radius[i] < -tol;
+                printf("    %g x %g units, %g m, half %d: %ld elements, %.2f per unit^2 "
+                       "(full-radius terms, original 42.1), max overlap %.1e\n",
+                       p.width, p.height, scaling, half, info.n_internal, density, worst);
+                assert_true(fabs(density / 42.1 - 1.0) < 0.03);
+                assert_true(worst < 1e-6);
+                assert_int_equal(outside, 0);
+                grid_free(&g);
+                cdem_state_free(&s);
+            }
+}
+
 /* ---------------------------------------------------------------- geometry */
 
 static const struct {
@@ -644,6 +687,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_assembly_paper_counts),
         cmocka_unit_test(test_assembly_count_matches_build),
+        cmocka_unit_test(test_assembly_density_across_ranges),
         cmocka_unit_test(test_assembly_inside_box),
         cmocka_unit_test(test_assembly_no_overlap_and_supported),
         cmocka_unit_test(test_assembly_no_large_gaps),
