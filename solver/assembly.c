@@ -45,6 +45,10 @@ static const int bag_counts[CDEM_NUM_RADII] = {4, 3, 2, 1};
 /* Relative tolerance of a tangency, as a fraction of the contact distance. */
 #define ASM_EPS 1e-12
 
+/* Relative gap (of the contact distance, or of r for walls) below which two surfaces count
+ * as touching at the start of a move; covers round-off at 1e5 m coordinates. */
+#define TOUCH_TOL 1e-9
+
 typedef struct {
     double w, h;       /* box: inner width and assembly height, m, > 0 */
     double rmax;       /* largest radius, m */
@@ -56,6 +60,7 @@ typedef struct {
     double *x, *y, *r; /* [cap] disc centres and radii, m */
     int *cls;          /* [cap] radius class 0..3 */
     long n, cap;       /* discs placed; capacity of the arrays */
+    long n_guard;      /* drops discarded by a numerical guard (see settle), >= 0 */
 } packer;
 
 typedef enum { ROLL_STOP, ROLL_FALL, ROLL_HIT } roll_event;
@@ -121,7 +126,15 @@ static double fall(const packer *pk, double x, double y_from, double r, long exc
                 if (dx * dx >= d * d * (1.0 - ASM_EPS))
                     continue; /* not under the falling disc (or only grazing it) */
                 double h = pk->y[k] + sqrt(d * d - dx * dx);
-                if (h > y_from + ASM_EPS * d || h <= best)
+                if (h > y_from) {
+                    /* k's top contact is above the start: k lies above (not met on the way
+                     * down), or the disc touches it now (round-off): met at once */
+                    if (pk->y[k] < y_from && h <= y_from + 1e-6 * d)
+                        h = y_from;
+                    else
+                        continue;
+                }
+                if (h <= best)
                     continue;
                 best = h;
                 sup = k;
@@ -135,17 +148,26 @@ static double fall(const packer *pk, double x, double y_from, double r, long exc
 /* Rolls a disc of radius r at (*x, *y), touching disc j, around j in direction dir (+1:
  * to the right, -1: to the left), downhill. Moves it to the first event: ROLL_STOP (it met
  * the base or the wall it rolls towards: stable), ROLL_HIT (it met disc *hit) or ROLL_FALL
- * (it reached j's equator, or starts at or below it: free fall from there). */
+ * (it reached j's equator, or starts at or below it: free fall from there). A disc or wall
+ * it already touches and would push into stops it at once (t = 0): this makes the ties at
+ * a tangency (met exactly at j's equator, landed beside a disc) safe. */
 static roll_event roll(const packer *pk, double *x, double *y, double r, long j, int dir,
                        long *hit) {
     const double xj = pk->x[j], yj = pk->y[j], d = r + pk->r[j];
-    const double th0 = atan2(*y - yj, *x - xj);
+    const double px0 = *x, py0 = *y;
+    const double th0 = atan2(py0 - yj, px0 - xj);
+    *hit = -1;
     if (th0 <= 0.0)
-        return ROLL_FALL; /* below the equator of j: j does not hold it */
+        return ROLL_FALL; /* at or below the equator of j: j does not hold it */
     double tmax = dir > 0 ? th0 : M_PI - th0;
     if (tmax <= 0.0)
         return ROLL_FALL;
-    double tbest = tmax;
+    /* already on the base or against the wall ahead */
+    if (py0 <= r * (1.0 + TOUCH_TOL) ||
+        (dir > 0 ? px0 >= pk->w - r * (1.0 + TOUCH_TOL) : px0 <= r * (1.0 + TOUCH_TOL)))
+        return ROLL_STOP;
+    /* events up to a hair past the equator count (an exact tie goes to the contact) */
+    double tbest = tmax * (1.0 + 1e-9) + 1e-12;
     roll_event ev = ROLL_FALL;
     long who = -1;
 
@@ -154,7 +176,7 @@ static roll_event roll(const packer *pk, double *x, double *y, double r, long j,
     if (s > -1.0 && s < 1.0) {
         double th = dir > 0 ? asin(s) : M_PI - asin(s);
         double t = dir > 0 ? th0 - th : th - th0;
-        if (t > ASM_EPS && t < tbest) {
+        if (t > 0.0 && t < tbest) {
             tbest = t;
             ev = ROLL_STOP;
         }
@@ -164,13 +186,14 @@ static roll_event roll(const packer *pk, double *x, double *y, double r, long j,
     if (cw > -1.0 && cw < 1.0) {
         double th = acos(cw);
         double t = dir > 0 ? th0 - th : th - th0;
-        if (t > ASM_EPS && t < tbest) {
+        if (t > 0.0 && t < tbest) {
             tbest = t;
             ev = ROLL_STOP;
         }
     }
     /* other discs: intersections of the circle of radius d around j with the circle of
      * radius r + r_k around k, entered (not left) while rolling */
+    const double v0x = dir > 0 ? sin(th0) : -sin(th0), v0y = dir > 0 ? -cos(th0) : cos(th0);
     double reach = d + r + pk->rmax;
     int c0 = col_of(pk, xj - reach), c1 = col_of(pk, xj + reach);
     int r0 = row_of(pk, yj - reach), r1 = row_of(pk, yj + reach);
@@ -179,8 +202,14 @@ static roll_event roll(const packer *pk, double *x, double *y, double r, long j,
             for (int k = pk->head[row * pk->ncols + c]; k >= 0; k = pk->next[k]) {
                 if (k == j)
                     continue;
-                double dkx = pk->x[k] - xj, dky = pk->y[k] - yj;
                 double D = r + pk->r[k];
+                double ex = pk->x[k] - px0, ey = pk->y[k] - py0;
+                if (ex * ex + ey * ey <= D * D * (1.0 + TOUCH_TOL) && ex * v0x + ey * v0y > 0.0) {
+                    /* touching k now and rolling into it */
+                    *hit = k;
+                    return ROLL_HIT;
+                }
+                double dkx = pk->x[k] - xj, dky = pk->y[k] - yj;
                 double L = sqrt(dkx * dkx + dky * dky);
                 if (L >= d + D || L <= fabs(d - D))
                     continue;
@@ -194,7 +223,7 @@ static roll_event roll(const packer *pk, double *x, double *y, double r, long j,
                         t += 2.0 * M_PI;
                     while (t > M_PI)
                         t -= 2.0 * M_PI;
-                    if (!(t > ASM_EPS && t < tbest))
+                    if (!(t > 0.0 && t < tbest))
                         continue;
                     /* entering k: the motion at the meeting point points towards k */
                     double px = xj + d * cos(th), py = yj + d * sin(th);
@@ -209,11 +238,14 @@ static roll_event roll(const packer *pk, double *x, double *y, double r, long j,
             }
         }
     }
+    if (ev == ROLL_FALL) { /* exactly at the equator */
+        *x = xj + dir * d;
+        *y = yj;
+        return ev;
+    }
     double th = dir > 0 ? th0 - tbest : th0 + tbest;
     *x = xj + d * cos(th);
     *y = yj + d * sin(th);
-    if (ev == ROLL_FALL) /* exactly at the equator */
-        *y = yj;
     if (ev == ROLL_STOP && *y < r)
         *y = r;
     *hit = who;
@@ -230,6 +262,14 @@ static int stable_on(const packer *pk, double x, double y, long j, long k) {
         return 0;
     double a = -akx / det, b = ajx / det;
     return a >= 0.0 && b >= 0.0;
+}
+
+/* 1 when a disc at (x, y) rolling around disc a in direction dir moves away from (or
+ * tangentially to) disc b's centre, i.e. does not push into b. */
+static int rolls_away(const packer *pk, double x, double y, long a, int dir, long b) {
+    double th = atan2(y - pk->y[a], x - pk->x[a]);
+    double vx = dir > 0 ? sin(th) : -sin(th), vy = dir > 0 ? -cos(th) : cos(th);
+    return (x - pk->x[b]) * vx + (y - pk->y[b]) * vy >= 0.0;
 }
 
 /* 1 when a disc of radius r at (x, y) overlaps no placed disc by more than the tolerance. */
@@ -273,7 +313,11 @@ static int settle(const packer *pk, gsl_rng *rng, double x0, double r, double *x
             }
             if (stable_on(pk, px, py, j, k))
                 goto rest;
-            dir = px > pk->x[k] ? 1 : (px < pk->x[k] ? -1 : dir);
+            /* not held: roll on over k, downhill, which must take it away from j */
+            int dk = px > pk->x[k] ? 1 : (px < pk->x[k] ? -1 : dir);
+            if (!rolls_away(pk, px, py, k, dk, j))
+                return 0; /* wedged between j and k without support: discard */
+            dir = dk;
             j = k;
         }
         if (!falling)
@@ -423,7 +467,12 @@ static void pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails) 
         double r = m->radius[cls];
         double x0 = r + gsl_rng_uniform(rng) * (pk->w - 2.0 * r);
         double x, y;
-        if (!settle(pk, rng, x0, r, &x, &y) || y - r > pk->h) {
+        if (!settle(pk, rng, x0, r, &x, &y)) {
+            pk->n_guard++;
+            fails++;
+            continue;
+        }
+        if (y - r > pk->h) {
             fails++;
             continue;
         }
@@ -485,6 +534,7 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
         memset(info, 0, sizeof *info);
         info->n_internal = pk->n;
         info->n_wall = n_wall;
+        info->n_guard_discards = pk->n_guard;
         info->wall_radius = rw;
         info->wall_spacing = rw;
         info->area_fraction = area / (pk->w * pk->h);

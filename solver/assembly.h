@@ -21,14 +21,16 @@
 #include "state.h"
 
 typedef struct {
-    long n_internal;      /* internal (free) elements generated, >= 0 */
-    long n_wall;          /* wall elements (base + left + right), >= 0 */
-    double top_mean;      /* m, mean of the top-surface profile (max y + r per column of
-                             width 2 x max radius), about height + one radius */
-    double top_max;       /* m, highest point of any internal disc (max of y + r) */
-    double area_fraction; /* sum of internal disc areas / (width x height), 0..~0.9 */
-    double wall_radius;   /* m, radius of every wall element (smallest element radius) */
-    double wall_spacing;  /* m, centre-to-centre spacing of wall elements (= wall_radius) */
+    long n_internal;       /* internal (free) elements generated, >= 0 */
+    long n_wall;           /* wall elements (base + left + right), >= 0 */
+    double top_mean;       /* m, mean of the top-surface profile (max y + r per column of
+                              width 2 x max radius), about height + one radius */
+    double top_max;        /* m, highest point of any internal disc (max of y + r) */
+    double area_fraction;  /* sum of internal disc areas / (width x height), 0..~0.9 */
+    double wall_radius;    /* m, radius of every wall element (smallest element radius) */
+    double wall_spacing;   /* m, centre-to-centre spacing of wall elements (= wall_radius) */
+    long n_guard_discards; /* drops discarded by a numerical guard (a disc wedged without
+                              support, a final overlap, too many moves); 0 in practice */
 } cdem_assembly_info;
 
 /* Builds the assembly into s, which must be initialised (cdem_state_init) and empty.

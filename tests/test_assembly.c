@@ -205,6 +205,8 @@ static void test_assembly_paper_counts(void **unused) {
                cases[k].w, cases[k].h, cases[k].half, info.n_internal, cases[k].paper, dev,
                info.n_wall, info.area_fraction, info.top_mean, info.top_max);
         assert_true(fabs(dev) <= 3.0);
+        /* the deposition never needed its numerical guards */
+        assert_int_equal(info.n_guard_discards, 0);
         size_t n_int = 0;
         for (size_t i = 0; i < s.n; i++)
             n_int += !(s.flags[i] & CDEM_FLAG_WALL);
@@ -608,6 +610,7 @@ static void test_assembly_largest_builds(void **unused) {
            "(not asserted), area fraction %.4f, max overlap %.2e\n",
            info.n_internal, info.n_wall, sec, info.area_fraction, worst);
     assert_true(info.n_internal > 100000);
+    assert_int_equal(info.n_guard_discards, 0);
     assert_true(worst < 1e-6);
     grid_free(&g);
     cdem_state_free(&s);
