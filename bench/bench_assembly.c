@@ -36,8 +36,8 @@ int main(int argc, char **argv) {
         {100, 7.5, 1000, 1, 0},
     };
     long seed = argc > 1 ? atol(argv[1]) : 1;
-    printf("%8s %6s %8s %5s %9s %9s %8s %9s %9s %8s\n", "width", "height", "scaling", "half",
-           "internal", "paper", "diff%", "walls", "phi", "seconds");
+    printf("%8s %6s %8s %5s %9s %9s %8s %9s %9s %8s %8s\n", "width", "height", "scaling", "half",
+           "internal", "paper", "diff%", "walls", "phi", "wall_s", "cpu_s");
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cdem_params p;
         memset(&p, 0, sizeof p);
@@ -53,24 +53,27 @@ int main(int argc, char **argv) {
         cdem_error err;
         cdem_error_clear(&err);
         cdem_assembly_info info;
-        struct timespec t0, t1;
+        struct timespec t0, t1, c0, c1;
         if (cdem_state_init(&s, 0, 0, &err) != CDEM_OK) {
             fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         clock_gettime(CLOCK_MONOTONIC, &t0);
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
         cdem_status st = cdem_assembly_build(&p, &m, &s, &info, &err);
         clock_gettime(CLOCK_MONOTONIC, &t1);
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
         if (st != CDEM_OK) {
             fprintf(stderr, "%s\n", err.msg);
             return 1;
         }
         double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
         double diff =
             cases[i].paper ? 100.0 * (info.n_internal - cases[i].paper) / cases[i].paper : 0.0;
-        printf("%8g %6g %8g %5d %9ld %9ld %8.2f %9ld %9.4f %8.3f\n", p.width, p.height,
+        printf("%8g %6g %8g %5d %9ld %9ld %8.2f %9ld %9.4f %8.3f %8.3f\n", p.width, p.height,
                p.unit_scaling, p.half_radii, info.n_internal, cases[i].paper, diff, info.n_wall,
-               info.area_fraction, sec);
+               info.area_fraction, sec, cpu);
         cdem_state_free(&s);
     }
     return 0;
