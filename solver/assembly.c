@@ -297,7 +297,7 @@ static int settle(const packer *pk, gsl_rng *rng, double x0, double r, double *x
         py = fall(pk, px, py, r, exclude, &j);
         moves++;
         if (j < 0)
-            break; /* on the base */
+            goto rest; /* on the base */
         int dir = px > pk->x[j] ? 1 : (px < pk->x[j] ? -1 : (gsl_rng_uniform(rng) < 0.5 ? -1 : 1));
         int falling = 0;
         while (!falling && moves < ASM_MAX_MOVES) {
@@ -321,8 +321,9 @@ static int settle(const packer *pk, gsl_rng *rng, double x0, double r, double *x
             j = k;
         }
         if (!falling)
-            return 0;
+            return 0; /* move limit while rolling */
     }
+    return 0; /* move limit */
 rest:
     if (!free_of_overlap(pk, px, py, r))
         return 0;
