@@ -561,6 +561,8 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
 
 cdem_status cdem_assembly_build(const cdem_params *p, const cdem_model *m, cdem_state *s,
                                 cdem_assembly_info *info, cdem_error *err) {
+    if (info)
+        memset(info, 0, sizeof *info);
     CDEM_TRY(check_inputs(p, m, s, err));
     double w = p->width * p->unit_scaling, h = p->height * p->unit_scaling;
     double rmin = m->radius[0], rmax = m->radius[CDEM_NUM_RADII - 1];

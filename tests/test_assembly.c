@@ -624,7 +624,10 @@ static void expect_error(const cdem_params *p, const cdem_model *m, cdem_status 
     cdem_error err;
     cdem_error_clear(&err);
     assert_int_equal(cdem_state_init(&s, 0, 0, &err), CDEM_OK);
-    assert_int_equal(cdem_assembly_build(p, m, &s, NULL, &err), code);
+    cdem_assembly_info info = {.n_internal = 99, .n_wall = 99};
+    assert_int_equal(cdem_assembly_build(p, m, &s, &info, &err), code);
+    assert_int_equal(info.n_internal, 0);
+    assert_int_equal(info.n_wall, 0);
     if (!strstr(err.msg, text))
         fail_msg("message \"%s\" lacks \"%s\"", err.msg, text);
     assert_int_equal(s.n, 0);
