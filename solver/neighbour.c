@@ -146,7 +146,8 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
         k++;
     }
     nb->ncarry = k;
-    qsort(nb->carry, k, sizeof *nb->carry, carry_cmp);
+    if (k > 1)
+        qsort(nb->carry, k, sizeof *nb->carry, carry_cmp);
     return CDEM_OK;
 }
 
@@ -198,7 +199,7 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     if (keep)
         cdem_state_compact(s, keep, NULL);
     const size_t n = s->n;
-    CDEM_TRY(reserve_elements(nb, n, err));
+    CDEM_TRY(reserve_elements(nb, n + 1, err));
 
     /* bounding box, largest radius, finiteness */
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
