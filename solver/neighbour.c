@@ -65,6 +65,7 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->cell_start);
     free(nb->cell_items);
     free(nb->carry);
+    free(nb->oldmap);
     memset(nb, 0, sizeof *nb);
 }
 
@@ -93,6 +94,7 @@ static cdem_status reserve_elements(cdem_neighbour *nb, size_t n, cdem_error *er
     CDEM_TRY(grow((void **)&nb->y0, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->cell_of, sizeof(int32_t), c, err));
     CDEM_TRY(grow((void **)&nb->perm, sizeof(size_t), c, err));
+    CDEM_TRY(grow((void **)&nb->oldmap, sizeof(size_t), c, err));
     CDEM_TRY(grow((void **)&nb->scratch, 8, c, err));
     CDEM_TRY(grow((void **)&nb->cell_items, sizeof(int32_t), c, err));
     CDEM_TRY(grow((void **)&nb->istart, sizeof(int32_t), c + 1, err));
@@ -118,12 +120,6 @@ static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err)
     return CDEM_OK;
 }
 
-static int carry_cmp(const void *a, const void *b) {
-    const uint64_t ka = ((const cdem_pair_carry *)a)->key, kb = ((const cdem_pair_carry *)b)->key;
-    return (ka > kb) - (ka < kb);
-}
-
-/* (1) Saves every pair that has history, keyed by ids (indices refer to the current state). */
 static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_error *err) {
     nb->ncarry = 0;
     if (nb->n_builds == 0 || nb->n > s->n)
@@ -140,27 +136,33 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
     for (size_t p = 0; p < nb->np; p++) {
         if (nb->hist[p] == 0 && nb->xs[p] == 0.0)
             continue;
-        nb->carry[k].key = cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]);
+        nb->carry[k].i = nb->pi[p];
+        nb->carry[k].j = nb->pj[p];
         nb->carry[k].xs = nb->xs[p];
         nb->carry[k].hist = nb->hist[p];
         k++;
     }
     nb->ncarry = k;
-    if (k > 1)
-        qsort(nb->carry, k, sizeof *nb->carry, carry_cmp);
     return CDEM_OK;
 }
 
-static const cdem_pair_carry *find_carry(const cdem_neighbour *nb, uint64_t key) {
-    size_t lo = 0, hi = nb->ncarry;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (nb->carry[mid].key < key)
-            lo = mid + 1;
-        else
-            hi = mid;
+/* Restores the saved histories: old indices -> new through oldmap, then the slot of
+ * (lo, hi) is found in lo's contiguous pi range. O(pairs). */
+static void restore_carry(cdem_neighbour *nb) {
+    for (size_t k = 0; k < nb->ncarry; k++) {
+        const cdem_pair_carry *c = &nb->carry[k];
+        const size_t a = nb->oldmap[c->i], b = nb->oldmap[c->j];
+        if (a == SIZE_MAX || b == SIZE_MAX)
+            continue; /* an element of the pair was removed */
+        const int32_t lo = (int32_t)(a < b ? a : b), hi = (int32_t)(a < b ? b : a);
+        for (int32_t p = nb->istart[lo]; p < nb->istart[lo + 1]; p++) {
+            if (nb->pj[p] == hi) {
+                nb->hist[p] = c->hist;
+                nb->xs[p] = c->xs;
+                break;
+            }
+        }
     }
-    return (lo < nb->ncarry && nb->carry[lo].key == key) ? &nb->carry[lo] : NULL;
 }
 
 #define PERMUTE(arr, type)                                                                         \
@@ -196,10 +198,15 @@ static void permute_state(cdem_neighbour *nb, cdem_state *s) {
 cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
                                  int resort, cdem_error *err) {
     CDEM_TRY(save_carry(nb, s, err));
-    if (keep)
-        cdem_state_compact(s, keep, NULL);
+    CDEM_TRY(reserve_elements(nb, s->n + 1, err));
+    const size_t n_old = s->n;
+    if (keep) {
+        cdem_state_compact(s, keep, nb->oldmap);
+    } else {
+        for (size_t i = 0; i < n_old; i++)
+            nb->oldmap[i] = i;
+    }
     const size_t n = s->n;
-    CDEM_TRY(reserve_elements(nb, n + 1, err));
 
     /* bounding box, largest radius, finiteness */
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
@@ -228,8 +235,8 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         ny = (size_t)((ymax - ymin) / cs) + 1;
     }
     const size_t ncells = nx * ny;
-    if (ncells + 1 > nb->ccap) {
-        size_t c = next_cap(nb->ccap, ncells + 1);
+    if (2 * ncells + 1 > nb->ccap) {
+        size_t c = next_cap(nb->ccap, 2 * ncells + 1);
         CDEM_TRY(grow((void **)&nb->cell_start, sizeof(int32_t), c, err));
         nb->ccap = c;
     }
@@ -242,30 +249,37 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
             cy = ny - 1;
         nb->cell_of[i] = (int32_t)(cy * nx + cx);
     }
-    /* counting sort by cell */
-    memset(nb->cell_start, 0, (ncells + 1) * sizeof(int32_t));
-    for (size_t i = 0; i < n; i++)
-        nb->cell_start[nb->cell_of[i] + 1]++;
-    for (size_t c = 0; c < ncells; c++)
-        nb->cell_start[c + 1] += nb->cell_start[c];
-
     int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
     if (do_sort && n > 1) {
-        /* stable scatter by cell: new index k holds old index perm[k] */
-        size_t *perm = nb->perm;
-        for (size_t i = 0; i < n; i++)
-            perm[i] = SIZE_MAX;
+        /* stable counting sort by (boundary element?, cell): free elements first in cell
+         * order, then the boundary elements in cell order, so the loops over elements see
+         * long runs of one kind (predictable branches); new index k holds old index perm[k] */
+        const size_t nkeys = 2 * ncells;
+        int32_t *cnt = nb->cell_start;
+        memset(cnt, 0, (nkeys + 1) * sizeof(int32_t));
         for (size_t i = 0; i < n; i++) {
-            int32_t c = nb->cell_of[i];
-            size_t pos = (size_t)nb->cell_start[c];
-            perm[pos] = i;
-            nb->cell_start[c]++;
+            const size_t key =
+                (size_t)nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? ncells : 0);
+            cnt[key + 1]++;
         }
-        /* restore prefix sums (shifted by one cell after the scatter) */
-        for (size_t c = ncells; c > 0; c--)
-            nb->cell_start[c] = nb->cell_start[c - 1];
-        nb->cell_start[0] = 0;
+        for (size_t c = 0; c < nkeys; c++)
+            cnt[c + 1] += cnt[c];
+        size_t *perm = nb->perm;
+        for (size_t i = 0; i < n; i++) {
+            const size_t key =
+                (size_t)nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? ncells : 0);
+            perm[cnt[key]++] = i;
+        }
         permute_state(nb, s);
+        {
+            /* oldmap follows: the element at new index k came from compacted index perm[k] */
+            size_t *inv = (size_t *)nb->scratch;
+            for (size_t k = 0; k < n; k++)
+                inv[perm[k]] = k;
+            for (size_t i = 0; i < n_old; i++)
+                if (nb->oldmap[i] != SIZE_MAX)
+                    nb->oldmap[i] = inv[nb->oldmap[i]];
+        }
         {
             /* cell_of follows the permutation */
             int32_t *tmp = (int32_t *)nb->scratch;
@@ -275,6 +289,12 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         }
         nb->n_sorts++;
     }
+    /* counting sort by cell */
+    memset(nb->cell_start, 0, (ncells + 1) * sizeof(int32_t));
+    for (size_t i = 0; i < n; i++)
+        nb->cell_start[nb->cell_of[i] + 1]++;
+    for (size_t c = 0; c < ncells; c++)
+        nb->cell_start[c + 1] += nb->cell_start[c];
     /* cell_items: element indices in cell order (ascending index within a cell) */
     {
         for (size_t i = 0; i < n; i++) {
@@ -328,17 +348,6 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
             }
         }
     }
-    /* restore histories */
-    if (nb->ncarry) {
-        for (size_t p = 0; p < nb->np; p++) {
-            const cdem_pair_carry *c =
-                find_carry(nb, cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]));
-            if (c) {
-                nb->hist[p] = c->hist;
-                nb->xs[p] = c->xs;
-            }
-        }
-    }
     /* CSR of slots per element, ascending slot order */
     if (nb->np > 0)
         CDEM_TRY(reserve_pairs(nb, nb->np, err));
@@ -358,6 +367,7 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         for (size_t p = 0; p < nb->np; p++)
             nb->jslot[cursor[nb->pj[p]]++] = (int32_t)p;
     }
+    restore_carry(nb);
     memcpy(nb->x0, s->x, n * sizeof(double));
     memcpy(nb->y0, s->y, n * sizeof(double));
     nb->n = n;

@@ -20,9 +20,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Carried contact history of one pair, keyed by its two element ids. */
+/* Carried contact history of one pair across a build, by the pair's element indices before
+ * the build (mapped through removal and re-sorting; ids never change meaning). */
 typedef struct {
-    uint64_t key; /* (min id << 32) | max id */
+    int32_t i, j; /* element indices before the build, i < j */
     double xs;    /* tangential displacement, m */
     uint8_t hist; /* CDEM_PAIR_* flags */
 } cdem_pair_carry;
@@ -55,6 +56,7 @@ typedef struct {
     double *x0, *y0;  /* m, positions at the last build */
     int32_t *cell_of; /* cell of each element */
     size_t *perm;     /* re-sort permutation (new index -> old index) */
+    size_t *oldmap;   /* index before the build -> index after (SIZE_MAX: removed) */
     void *scratch;    /* permutation scratch, ncap * 8 bytes */
 
     /* cell grid */
