@@ -47,6 +47,7 @@ int main(int argc, char **argv) {
         cdem_integrator_init(&it, &p, &m, &err))
         return fail(&err);
     cdem_integrator_enable_escape(&it);
+    it.boundary_forces = 0; /* as cdem_run between time-series samples */
     long equil = argc > 2 ? atol(argv[2]) : m.equil_steps;
     double t0 = now_s();
     for (long k = 0; k < equil; k++)

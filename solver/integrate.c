@@ -33,6 +33,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
                          "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
                          m->radius[0]);
     it->par_min = PAR_MIN_DEFAULT;
+    it->boundary_forces = 1;
     it->dt = m->dt;
     it->damping = m->damping;
     it->gravity = m->gravity;
@@ -182,8 +183,12 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     double *restrict fx = s->fx, *restrict fy = s->fy;
     double *restrict vxw = s->vx, *restrict vyw = s->vy;
     const double hdt = 0.5 * dt, c = it->damping, g = it->gravity;
+    const int want_boundary = it->boundary_forces || !kick;
 #pragma omp parallel for schedule(static) if (n > it->par_min)
     for (long i = 0; i < n; i++) {
+        const int boundary = (flags[i] & CDEM_FLAGS_BOUNDARY) != 0;
+        if (boundary && !want_boundary)
+            continue; /* not integrated; its force only matters for reports */
         double sx = 0.0, sy = 0.0;
         for (int32_t p = istart[i]; p < istart[i + 1]; p++) {
             sx += pfx[p];
@@ -193,7 +198,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
             sx -= pfx[jslot[e]];
             sy -= pfy[jslot[e]];
         }
-        if (flags[i] & CDEM_FLAGS_BOUNDARY) {
+        if (boundary) {
             fx[i] = sx;
             fy[i] = sy;
             continue;

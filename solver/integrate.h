@@ -5,7 +5,8 @@
  *   v(t+dt) = (v_half + dt/(2m) (F_c - m g e_y)) / (1 + c dt / (2m))
  * i.e. the damping force -c v(t+dt) is taken implicitly, so the terminal velocity of a
  * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
- * state fx, fy (boundary elements: the contact force on them, for reports).
+ * state fx, fy (boundary elements: the contact force on them, for reports, when
+ * boundary_forces is set).
  * Determinism: every pair force goes to its own slot; per-element sums walk the CSR in a
  * fixed order; loops are schedule(static); so results are bit-identical for any thread
  * count. The integrator owns the neighbour list and contact histories; it never owns the
@@ -30,6 +31,9 @@ typedef struct {
     cdem_contact_law law; /* contact law and materials */
     cdem_neighbour nb;    /* pair list with histories and force slots */
     long step;            /* steps taken so far */
+    int boundary_forces;  /* 1 (default): sum the contact force on boundary elements each step
+                             (state fx, fy); 0: skip them (faster; set it to 1 before a step
+                             whose boundary forces are reported) */
     long par_min;         /* loops over fewer items than this run on one thread (>= 0);
                              results are bit-identical either way */
 
