@@ -3,6 +3,7 @@
  * the model's full equilibration (walls still), creates the cohesive contacts, then times
  * a fixed number of deformation steps. Threads: OMP_NUM_THREADS. Usage:
  *   bench_solver [deformation_steps (default 20000)] [equilibration_steps (default: model)]
+ *                [width_units (default 10)] [half_radii 0/1 (default 0)]
  * Prints one line: threads, elements, steps, seconds, element-steps/s by the wall clock and
  * per CPU-second (the latter is the fairer figure when other jobs share the cores). */
 #include "assembly.h"
@@ -36,6 +37,10 @@ int main(int argc, char **argv) {
     long nsteps = argc > 1 ? atol(argv[1]) : 20000;
     cdem_params p;
     cdem_params_defaults(&p);
+    if (argc > 3)
+        p.width = atof(argv[3]);
+    if (argc > 4)
+        p.half_radii = atoi(argv[4]);
     cdem_model m;
     cdem_error err;
     cdem_state s;
