@@ -7,6 +7,7 @@
 #include "integrate.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -141,78 +142,123 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
     return CDEM_OK;
 }
 
-/* Pair forces into slots, then per-element sums and the second half kick. */
+/* Force of pair p on pi[p] into its slot (zero when it does not touch). */
+static inline void pair_force(const cdem_contact_law *law, long p, const double *restrict x,
+                              const double *restrict y, const double *restrict vx,
+                              const double *restrict vy, const int32_t *restrict pi,
+                              const int32_t *restrict pj, const double *restrict Rp,
+                              const uint8_t *restrict cls, uint8_t *restrict hist,
+                              double *restrict xs, double *restrict pfx, double *restrict pfy,
+                              double dt) {
+    const int32_t i = pi[p], j = pj[p];
+    const double dx = x[j] - x[i], dy = y[j] - y[i];
+    const double R = Rp[p];
+    const uint8_t h = hist[p];
+    if (!(h & CDEM_PAIR_BONDED) && dx * dx + dy * dy >= R * R) {
+        /* the common case: a list pair that does not touch */
+        pfx[p] = 0.0;
+        pfy[p] = 0.0;
+        if (h) {
+            hist[p] = 0;
+            xs[p] = 0.0;
+        }
+        return;
+    }
+    cdem_contact_eval(law, cls[p], dx, dy, R, vx[j] - vx[i], vy[j] - vy[i], dt, &xs[p], &hist[p],
+                      &pfx[p], &pfy[p]);
+}
+
+/* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
+ * kick (when kick), and the total force stored in fx, fy. */
+static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
+                                  double *restrict vxw, double *restrict vyw, double *restrict fx,
+                                  double *restrict fy, double hdt, double c, double g, int kick) {
+    const double m = mass[i];
+    sy -= m * g;
+    if (kick) {
+        /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
+        const double inv = 1.0 / (m + c * hdt);
+        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
+        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
+    }
+    fx[i] = sx - c * vxw[i];
+    fy[i] = sy - c * vyw[i];
+}
+
+/* Pair forces, per-element sums and the second half kick. Two paths give the same bits:
+ *  - serial: each pair force is added to its two elements as it is computed (a scatter in
+ *    ascending pair order), then one streaming pass finishes the elements;
+ *  - threaded: pair forces go to their slots (one writer each), then each element merges
+ *    its pi range and its pj list in ascending pair order, i.e. the same additions in the
+ *    same order as the scatter. */
 static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     cdem_neighbour *nb = &it->nb;
     const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
     const cdem_contact_law *law = &lawc;
     const double dt = it->dt;
-    const long np = (long)nb->np;
+    const long np = (long)nb->np, n = (long)s->n;
     const double *restrict x = s->x, *restrict y = s->y;
-    const double *restrict vx = s->vx, *restrict vy = s->vy;
     const int32_t *restrict pi = nb->pi, *restrict pj = nb->pj;
     const double *restrict Rp = nb->R;
     const uint8_t *restrict cls = nb->cls;
     uint8_t *restrict hist = nb->hist;
     double *restrict xs = nb->xs, *restrict pfx = nb->pfx, *restrict pfy = nb->pfy;
-#pragma omp parallel for schedule(static) if (np > it->par_min)
-    for (long p = 0; p < np; p++) {
-        const int32_t i = pi[p], j = pj[p];
-        const double dx = x[j] - x[i], dy = y[j] - y[i];
-        const double R = Rp[p];
-        const uint8_t h = hist[p];
-        if (!(h & CDEM_PAIR_BONDED) && dx * dx + dy * dy >= R * R) {
-            /* the common case: a list pair that does not touch */
-            pfx[p] = 0.0;
-            pfy[p] = 0.0;
-            if (h) {
-                hist[p] = 0;
-                xs[p] = 0.0;
-            }
-            continue;
-        }
-        cdem_contact_eval(law, cls[p], dx, dy, R, vx[j] - vx[i], vy[j] - vy[i], dt, &xs[p],
-                          &hist[p], &pfx[p], &pfy[p]);
-    }
-
-    const long n = (long)s->n;
-    const int32_t *restrict istart = nb->istart, *restrict jstart = nb->jstart;
-    const int32_t *restrict jslot = nb->jslot;
     const double *restrict mass = s->mass;
     const uint32_t *restrict flags = s->flags;
     double *restrict fx = s->fx, *restrict fy = s->fy;
     double *restrict vxw = s->vx, *restrict vyw = s->vy;
     const double hdt = 0.5 * dt, c = it->damping, g = it->gravity;
+    const int threaded = (np > it->par_min || n > it->par_min) && omp_get_max_threads() > 1;
+
+    if (!threaded) {
+        memset(fx, 0, (size_t)n * sizeof *fx);
+        memset(fy, 0, (size_t)n * sizeof *fy);
+        for (long p = 0; p < np; p++) {
+            pair_force(law, p, x, y, vxw, vyw, pi, pj, Rp, cls, hist, xs, pfx, pfy, dt);
+            const double ffx = pfx[p], ffy = pfy[p];
+            fx[pi[p]] += ffx;
+            fy[pi[p]] += ffy;
+            fx[pj[p]] -= ffx;
+            fy[pj[p]] -= ffy;
+        }
+        for (long i = 0; i < n; i++)
+            if (!(flags[i] & CDEM_FLAGS_BOUNDARY))
+                finish_element(i, fx[i], fy[i], mass, vxw, vyw, fx, fy, hdt, c, g, kick);
+        return;
+    }
+
+#pragma omp parallel for schedule(static)
+    for (long p = 0; p < np; p++)
+        pair_force(law, p, x, y, vxw, vyw, pi, pj, Rp, cls, hist, xs, pfx, pfy, dt);
+
+    const int32_t *restrict istart = nb->istart, *restrict jstart = nb->jstart;
+    const int32_t *restrict jslot = nb->jslot;
     const int want_boundary = it->boundary_forces || !kick;
-#pragma omp parallel for schedule(static) if (n > it->par_min)
+#pragma omp parallel for schedule(static)
     for (long i = 0; i < n; i++) {
         const int boundary = (flags[i] & CDEM_FLAGS_BOUNDARY) != 0;
         if (boundary && !want_boundary)
             continue; /* not integrated; its force only matters for reports */
         double sx = 0.0, sy = 0.0;
-        for (int32_t p = istart[i]; p < istart[i + 1]; p++) {
-            sx += pfx[p];
-            sy += pfy[p];
-        }
-        for (int32_t e = jstart[i]; e < jstart[i + 1]; e++) {
-            sx -= pfx[jslot[e]];
-            sy -= pfy[jslot[e]];
+        int32_t a = istart[i], b = jstart[i];
+        const int32_t ae = istart[i + 1], be = jstart[i + 1];
+        while (a < ae || b < be) {
+            if (b >= be || (a < ae && a < jslot[b])) {
+                sx += pfx[a];
+                sy += pfy[a];
+                a++;
+            } else {
+                sx -= pfx[jslot[b]];
+                sy -= pfy[jslot[b]];
+                b++;
+            }
         }
         if (boundary) {
             fx[i] = sx;
             fy[i] = sy;
             continue;
         }
-        const double m = mass[i];
-        sy -= m * g;
-        if (kick) {
-            /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
-            const double inv = 1.0 / (m + c * hdt);
-            vxw[i] = (m * vxw[i] + hdt * sx) * inv;
-            vyw[i] = (m * vyw[i] + hdt * sy) * inv;
-        }
-        fx[i] = sx - c * vxw[i];
-        fy[i] = sy - c * vyw[i];
+        finish_element(i, sx, sy, mass, vxw, vyw, fx, fy, hdt, c, g, kick);
     }
 }
 
