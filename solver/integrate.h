@@ -7,10 +7,10 @@
  * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
  * state fx, fy (boundary elements: the contact force on them, for reports, when
  * boundary_forces is set).
- * Determinism: every pair force goes to its own slot; per-element sums walk the CSR in a
- * fixed order; loops are schedule(static); so results are bit-identical for any thread
+ * Determinism: every element sums its pair forces in ascending pair order (serial scatter
+ * or threaded merge of per-pair slots), schedule(static): bit-identical for any thread
  * count. The integrator owns the neighbour list and contact histories; it never owns the
- * state. Escaping elements (see cdem_integrator_set_bounds) are removed at list rebuilds.
+ * state. Escaping elements (cdem_integrator_enable_escape) are removed at list rebuilds.
  * Nothing allocates in a step except at list rebuilds (geometric growth).
  * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
