@@ -55,7 +55,8 @@ def main():
     net = float(last.attrs["net_displacement"])
     dt = float(incs[1].attrs["time"]) / steps[1]
     gross = (steps[-1] - steps[last_equil]) * 25.0 * dt * dt
-    if abs(net - a.net_fraction * gross) > 1e-6 * gross:
+    # within one step: inversion at a rounded step can leave one step of net motion
+    if abs(net - a.net_fraction * gross) > 1e-6 * gross + 1.0001 * 25.0 * dt * dt:
         fail("net displacement %.6f m, expected %.6f m" % (net, a.net_fraction * gross))
     d = math.radians(a.dip)
     sgn = 1.0 if a.sense == "normal" else -1.0

@@ -16,7 +16,7 @@ passed=0; failed=0
 check() { # name, then the command
     name=$1; shift
     if "$@" >"$TMP/$name.log" 2>&1; then
-        passed=$((passed + 1)); echo "validate: $name: $(tail -n 1 "$TMP/$name.log")"
+        passed=$((passed + 1)); echo "validate: $name: OK $(tail -n 1 "$TMP/$name.log")"
     else
         failed=$((failed + 1)); echo "validate: $name: FAILED"; tail -n 20 "$TMP/$name.log"
     fi
