@@ -2,9 +2,9 @@
  *
  * Speed: drawing 50,000 discs one cairo_fill at a time costs one rasterisation pass per
  * disc. Instead every element is given a colour slot (fixed layer/flag colours, or one of
- * 256 bins of the colour map, each in an opaque and a weak/semi-transparent variant), the
+ * 257 bins of the colour map, each in an opaque and a weak/semi-transparent variant), the
  * elements are bucket-sorted by slot, and each slot is filled as one multi-disc path. The
- * 256-bin quantisation of values is below what the eye (and the 8-bit output) resolves.
+ * 257-bin quantisation of values is below what the eye (and the 8-bit output) resolves.
  * All outlines are stroked as one path. Elements wholly outside the view box are culled
  * (this also keeps cairo's fixed-point device coordinates in range when zoomed in).
  * Draw order: fills by slot, outlines, vectors, axes, then label, scale bar, colour bar. */
@@ -20,19 +20,19 @@
 #include <strings.h>
 
 enum {
-    SLOT_WALL = 0,                      /* wall, fault, mylar */
-    SLOT_FOOTWALL,                      /* fixed footwall display elements */
-    SLOT_EDGE,                          /* biaxial edge elements */
-    SLOT_UNDEFINED,                     /* NaN value */
-    SLOT_HIGHLIGHT,                     /* highlighted layer range */
-    SLOT_PRE0,                          /* pre-growth band colours 0, 1 */
-    SLOT_PRE1,                          /* */
-    SLOT_G1_0,                          /* growth sequence 1 band colours 0, 1 */
-    SLOT_G1_1,                          /* */
-    SLOT_G2_0,                          /* growth sequence 2 band colours 0, 1 */
-    SLOT_G2_1,                          /* */
-    SLOT_MAP,                           /* first of the colour-map bins */
-    MAP_BINS = 256,                     /* colour-map bins */
+    SLOT_WALL = 0,  /* wall, fault, mylar */
+    SLOT_FOOTWALL,  /* fixed footwall display elements */
+    SLOT_EDGE,      /* biaxial edge elements */
+    SLOT_UNDEFINED, /* NaN value */
+    SLOT_HIGHLIGHT, /* highlighted layer range */
+    SLOT_PRE0,      /* pre-growth band colours 0, 1 */
+    SLOT_PRE1,      /* */
+    SLOT_G1_0,      /* growth sequence 1 band colours 0, 1 */
+    SLOT_G1_1,      /* */
+    SLOT_G2_0,      /* growth sequence 2 band colours 0, 1 */
+    SLOT_G2_1,      /* */
+    SLOT_MAP,       /* first of the colour-map bins */
+    MAP_BINS = 257, /* colour-map bins, odd so that t = 0.5 (white, green) is a bin */
     SLOT_FIXED_N = SLOT_MAP + MAP_BINS, /* slots of one opacity variant */
     SLOT_N = 2 * SLOT_FIXED_N,          /* opaque slots, then weak (semi-transparent) ones */
 };
