@@ -437,6 +437,117 @@ static int point_visible(const cdem_render_layout *lay, double x, double y) {
            y <= lay->ymax;
 }
 
+/* Direct rasteriser for image targets. cairo fills and strokes tens of thousands of small
+ * circles slowly (each arc becomes Bezier curves, then polygons, then coverage), so on a
+ * plain ARGB32/RGB24 image surface with an identity transform the discs are written
+ * straight into the pixels: coverage from the distance of the pixel centre to the circle
+ * (one-pixel anti-aliasing ramp), blended OVER in premultiplied form, clipped to the plot
+ * area. Vector targets (PDF, SVG, recording surfaces) take the cairo path instead. */
+typedef struct {
+    cairo_surface_t *surface; /* the target image surface (borrowed) */
+    unsigned char *data;      /* its pixels */
+    int stride;               /* bytes per row */
+    int opaque;               /* 1: RGB24, alpha byte ignored */
+    int x0, y0, x1, y1;       /* clip rectangle in pixels, half-open */
+} raster_target;
+
+static int raster_target_get(cairo_t *cr, const cdem_render_layout *lay, raster_target *rt) {
+    cairo_surface_t *t = cairo_get_target(cr);
+    if (cairo_surface_get_type(t) != CAIRO_SURFACE_TYPE_IMAGE)
+        return 0;
+    cairo_format_t f = cairo_image_surface_get_format(t);
+    if (f != CAIRO_FORMAT_ARGB32 && f != CAIRO_FORMAT_RGB24)
+        return 0;
+    cairo_matrix_t m;
+    cairo_get_matrix(cr, &m);
+    double dx = 0, dy = 0;
+    cairo_surface_get_device_offset(t, &dx, &dy);
+    if (m.xx != 1 || m.yy != 1 || m.xy != 0 || m.yx != 0 || m.x0 != 0 || m.y0 != 0 || dx != 0 ||
+        dy != 0)
+        return 0;
+    cairo_surface_flush(t);
+    rt->surface = t;
+    rt->data = cairo_image_surface_get_data(t);
+    rt->stride = cairo_image_surface_get_stride(t);
+    rt->opaque = f == CAIRO_FORMAT_RGB24;
+    int w = cairo_image_surface_get_width(t), h = cairo_image_surface_get_height(t);
+    rt->x0 = (int)fmax(0.0, ceil(lay->plot_x - 0.5));
+    rt->y0 = (int)fmax(0.0, ceil(lay->plot_y - 0.5));
+    rt->x1 = (int)fmin((double)w, floor(lay->plot_x + lay->plot_w + 0.5));
+    rt->y1 = (int)fmin((double)h, floor(lay->plot_y + lay->plot_h + 0.5));
+    return rt->data != NULL;
+}
+
+/* Disc (ring_width == 0) or ring of that width centred on the circle, model units in. */
+static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, double x, double y,
+                        double radius, const cdem_rgba *c, double ring_width) {
+    double cx, cy;
+    cdem_render_layout_to_device(lay, x, y, &cx, &cy);
+    double r = radius * lay->scale;
+    double reach = r + 0.5 * ring_width + 1.0;
+    int px0 = (int)floor(cx - reach), px1 = (int)ceil(cx + reach);
+    int py0 = (int)floor(cy - reach), py1 = (int)ceil(cy + reach);
+    if (px0 < rt->x0)
+        px0 = rt->x0;
+    if (py0 < rt->y0)
+        py0 = rt->y0;
+    if (px1 > rt->x1)
+        px1 = rt->x1;
+    if (py1 > rt->y1)
+        py1 = rt->y1;
+    double small = ring_width > 0 ? fmin(1.0, ring_width) : fmin(1.0, 2.0 * r);
+    double sa = c->a, sr = c->r * sa * 255.0, sg = c->g * sa * 255.0, sb = c->b * sa * 255.0;
+    double half = 0.5 * ring_width;
+    double outer = r + half + 0.5;                       /* coverage is zero beyond */
+    double inner = ring_width > 0 ? r - half - 0.5 : -1; /* ring: zero inside this */
+    for (int py = py0; py < py1; py++) {
+        uint32_t *row = (uint32_t *)(void *)(rt->data + (size_t)py * rt->stride);
+        double ddy = py + 0.5 - cy;
+        if (fabs(ddy) >= outer)
+            continue;
+        double span = sqrt(outer * outer - ddy * ddy);
+        int xa = (int)floor(cx - span - 0.5), xb = (int)ceil(cx + span + 0.5);
+        if (xa < px0)
+            xa = px0;
+        if (xb > px1)
+            xb = px1;
+        int hole_a = xb, hole_b = xb; /* pixels [hole_a, hole_b) lie inside the ring's hole */
+        if (inner > 0 && fabs(ddy) < inner) {
+            double ispan = sqrt(inner * inner - ddy * ddy);
+            hole_a = (int)ceil(cx - ispan + 0.5);
+            hole_b = (int)floor(cx + ispan - 0.5);
+            if (hole_b <= hole_a)
+                hole_a = hole_b = xb; /* empty hole: nothing to skip */
+        }
+        for (int px = xa; px < xb; px++) {
+            if (px == hole_a) {
+                px = hole_b - 1;
+                continue;
+            }
+            double ddx = px + 0.5 - cx;
+            double d = sqrt(ddx * ddx + ddy * ddy);
+            double cov;
+            if (ring_width > 0)
+                cov = fmin(ring_width, half + 0.5 - fabs(d - r));
+            else
+                cov = (r + 0.5 - d) * small;
+            if (cov <= 0.0)
+                continue;
+            if (cov > 1.0)
+                cov = 1.0;
+            uint32_t p = row[px];
+            double keep = 1.0 - sa * cov;
+            double da = rt->opaque ? 255.0 : (double)(p >> 24);
+            double nr = sr * cov + ((p >> 16) & 255) * keep;
+            double ng = sg * cov + ((p >> 8) & 255) * keep;
+            double nb = sb * cov + (p & 255) * keep;
+            double na = rt->opaque ? 255.0 : 255.0 * sa * cov + da * keep;
+            row[px] = ((uint32_t)(na + 0.5) << 24) | ((uint32_t)(nr + 0.5) << 16) |
+                      ((uint32_t)(ng + 0.5) << 8) | (uint32_t)(nb + 0.5);
+        }
+    }
+}
+
 static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
                                  const cdem_render_scene *sc, const cdem_render_options *o,
                                  cdem_error *err) {
@@ -492,11 +603,24 @@ static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
     }
     slot_colours(sc, o, pal);
 
-    cairo_save(cr);
-    cairo_translate(cr, lay->ox - lay->xmin * lay->scale, lay->oy + lay->ymax * lay->scale);
-    cairo_scale(cr, lay->scale, -lay->scale);
-    if (o->show_fill) {
-        for (int k = 0; k < SLOT_N; k++) {
+    int outline = o->show_outline || !o->show_fill;
+    raster_target rt;
+    if (raster_target_get(cr, lay, &rt)) {
+        for (int k = 0; o->show_fill && k < SLOT_N; k++)
+            for (size_t j = start[k]; j < start[k + 1]; j++) {
+                size_t i = order[j];
+                raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &pal[k], 0.0);
+            }
+        for (size_t j = 0; outline && j < n_visible; j++) {
+            size_t i = order[j];
+            raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &o->outline, o->outline_width);
+        }
+        cairo_surface_mark_dirty(rt.surface);
+    } else {
+        cairo_save(cr);
+        cairo_translate(cr, lay->ox - lay->xmin * lay->scale, lay->oy + lay->ymax * lay->scale);
+        cairo_scale(cr, lay->scale, -lay->scale);
+        for (int k = 0; o->show_fill && k < SLOT_N; k++) {
             if (start[k + 1] == start[k])
                 continue;
             cairo_new_path(cr);
@@ -508,21 +632,20 @@ static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
             set_colour(cr, &pal[k]);
             cairo_fill(cr);
         }
-    }
-    int outline = o->show_outline || !o->show_fill;
-    if (outline && n_visible > 0) {
-        cairo_new_path(cr);
-        for (size_t j = 0; j < n_visible; j++) {
-            size_t i = order[j];
-            cairo_new_sub_path(cr);
-            cairo_arc(cr, s->x[i], s->y[i], s->radius[i], 0.0, 2.0 * render_pi);
+        if (outline && n_visible > 0) {
+            cairo_new_path(cr);
+            for (size_t j = 0; j < n_visible; j++) {
+                size_t i = order[j];
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, s->x[i], s->y[i], s->radius[i], 0.0, 2.0 * render_pi);
+            }
         }
-    }
-    cairo_restore(cr); /* the path stays, now in device space: widths below are device units */
-    if (outline && n_visible > 0) {
-        set_colour(cr, &o->outline);
-        cairo_set_line_width(cr, o->outline_width);
-        cairo_stroke(cr);
+        cairo_restore(cr); /* the path stays, in device space: widths are device units */
+        if (outline && n_visible > 0) {
+            set_colour(cr, &o->outline);
+            cairo_set_line_width(cr, o->outline_width);
+            cairo_stroke(cr);
+        }
     }
     free(slot);
     free(order);
