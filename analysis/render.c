@@ -478,6 +478,79 @@ static int raster_target_get(cairo_t *cr, const cdem_render_layout *lay, raster_
     return rt->data != NULL;
 }
 
+/* OVER-blends colour c at coverage cov (0..1] into the premultiplied pixel *p. */
+static void blend_pixel(const raster_target *rt, uint32_t *p, const cdem_rgba *c, double cov) {
+    uint32_t v = *p;
+    double sa = c->a * cov, keep = 1.0 - sa;
+    double da = rt->opaque ? 255.0 : (double)(v >> 24);
+    double nr = c->r * sa * 255.0 + ((v >> 16) & 255) * keep;
+    double ng = c->g * sa * 255.0 + ((v >> 8) & 255) * keep;
+    double nb = c->b * sa * 255.0 + (v & 255) * keep;
+    double na = rt->opaque ? 255.0 : 255.0 * sa + da * keep;
+    *p = ((uint32_t)(na + 0.5) << 24) | ((uint32_t)(nr + 0.5) << 16) | ((uint32_t)(ng + 0.5) << 8) |
+         (uint32_t)(nb + 0.5);
+}
+
+/* Anti-aliased segment of the given width (device units), round ends. */
+static void raster_segment(const raster_target *rt, double x0, double y0, double x1, double y1,
+                           double width, const cdem_rgba *c) {
+    double reach = 0.5 * width + 1.0;
+    int px0 = (int)floor(fmin(x0, x1) - reach), px1 = (int)ceil(fmax(x0, x1) + reach);
+    int py0 = (int)floor(fmin(y0, y1) - reach), py1 = (int)ceil(fmax(y0, y1) + reach);
+    if (px0 < rt->x0)
+        px0 = rt->x0;
+    if (py0 < rt->y0)
+        py0 = rt->y0;
+    if (px1 > rt->x1)
+        px1 = rt->x1;
+    if (py1 > rt->y1)
+        py1 = rt->y1;
+    double vx = x1 - x0, vy = y1 - y0, vv = vx * vx + vy * vy;
+    double half = 0.5 * width;
+    for (int py = py0; py < py1; py++) {
+        uint32_t *row = (uint32_t *)(void *)(rt->data + (size_t)py * rt->stride);
+        for (int px = px0; px < px1; px++) {
+            double wx = px + 0.5 - x0, wy = py + 0.5 - y0;
+            double t = vv > 0 ? (wx * vx + wy * vy) / vv : 0.0;
+            t = t < 0 ? 0 : (t > 1 ? 1 : t);
+            double d = hypot(wx - t * vx, wy - t * vy);
+            double cov = fmin(width, half + 0.5 - d);
+            if (cov <= 0.0)
+                continue;
+            blend_pixel(rt, row + px, c, cov > 1.0 ? 1.0 : cov);
+        }
+    }
+}
+
+/* Where line segments go: straight into the pixels (rt set) or into a cairo path that
+ * line_sink_finish strokes. */
+typedef struct {
+    cairo_t *cr;             /* the context (cairo path) */
+    const raster_target *rt; /* direct target, or NULL */
+    const cdem_rgba *colour; /* line colour */
+    double width;            /* line width, device units */
+} line_sink;
+
+static void line_sink_segment(const line_sink *ls, double x0, double y0, double x1, double y1) {
+    if (ls->rt) {
+        raster_segment(ls->rt, x0, y0, x1, y1, ls->width, ls->colour);
+    } else {
+        cairo_move_to(ls->cr, x0, y0);
+        cairo_line_to(ls->cr, x1, y1);
+    }
+}
+
+static void line_sink_finish(const line_sink *ls) {
+    if (ls->rt) {
+        cairo_surface_mark_dirty(ls->rt->surface);
+        return;
+    }
+    set_colour(ls->cr, ls->colour);
+    cairo_set_line_width(ls->cr, ls->width);
+    cairo_set_line_cap(ls->cr, CAIRO_LINE_CAP_ROUND);
+    cairo_stroke(ls->cr);
+}
+
 /* Disc (ring_width == 0) or ring of that width centred on the circle, model units in. */
 static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, double x, double y,
                         double radius, const cdem_rgba *c, double ring_width) {
@@ -496,7 +569,6 @@ static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, 
     if (py1 > rt->y1)
         py1 = rt->y1;
     double small = ring_width > 0 ? fmin(1.0, ring_width) : fmin(1.0, 2.0 * r);
-    double sa = c->a, sr = c->r * sa * 255.0, sg = c->g * sa * 255.0, sb = c->b * sa * 255.0;
     double half = 0.5 * ring_width;
     double outer = r + half + 0.5;                       /* coverage is zero beyond */
     double inner = ring_width > 0 ? r - half - 0.5 : -1; /* ring: zero inside this */
@@ -535,22 +607,14 @@ static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, 
                 continue;
             if (cov > 1.0)
                 cov = 1.0;
-            uint32_t p = row[px];
-            double keep = 1.0 - sa * cov;
-            double da = rt->opaque ? 255.0 : (double)(p >> 24);
-            double nr = sr * cov + ((p >> 16) & 255) * keep;
-            double ng = sg * cov + ((p >> 8) & 255) * keep;
-            double nb = sb * cov + (p & 255) * keep;
-            double na = rt->opaque ? 255.0 : 255.0 * sa * cov + da * keep;
-            row[px] = ((uint32_t)(na + 0.5) << 24) | ((uint32_t)(nr + 0.5) << 16) |
-                      ((uint32_t)(ng + 0.5) << 8) | (uint32_t)(nb + 0.5);
+            blend_pixel(rt, row + px, c, cov);
         }
     }
 }
 
-static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
-                                 const cdem_render_scene *sc, const cdem_render_options *o,
-                                 cdem_error *err) {
+static cdem_status draw_elements(cairo_t *cr, const raster_target *rtp,
+                                 const cdem_render_layout *lay, const cdem_render_scene *sc,
+                                 const cdem_render_options *o, cdem_error *err) {
     const cdem_state *s = sc->state;
     size_t n = s->n;
     if (n == 0)
@@ -604,8 +668,8 @@ static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
     slot_colours(sc, o, pal);
 
     int outline = o->show_outline || !o->show_fill;
-    raster_target rt;
-    if (raster_target_get(cr, lay, &rt)) {
+    if (rtp) {
+        const raster_target rt = *rtp;
         for (int k = 0; o->show_fill && k < SLOT_N; k++)
             for (size_t j = start[k]; j < start[k + 1]; j++) {
                 size_t i = order[j];
@@ -654,10 +718,11 @@ static cdem_status draw_elements(cairo_t *cr, const cdem_render_layout *lay,
     return CDEM_OK;
 }
 
-static void draw_vectors(cairo_t *cr, const cdem_render_layout *lay, const cdem_render_scene *sc,
-                         const cdem_render_options *o) {
+static void draw_vectors(cairo_t *cr, const raster_target *rt, const cdem_render_layout *lay,
+                         const cdem_render_scene *sc, const cdem_render_options *o) {
     const cdem_state *s = sc->state;
     double lw = o->line_width;
+    line_sink ls = {cr, rt, &o->vector, lw};
     cairo_new_path(cr);
     for (size_t i = 0; i < s->n; i++) {
         if (!point_visible(lay, s->x[i], s->y[i]))
@@ -672,23 +737,17 @@ static void draw_vectors(cairo_t *cr, const cdem_render_layout *lay, const cdem_
         if (len < 0.5 || len > 4.0 * (lay->width + lay->height))
             continue;
         double x1 = x0 + dx, y1 = y0 + dy;
-        cairo_move_to(cr, x0, y0);
-        cairo_line_to(cr, x1, y1);
+        line_sink_segment(&ls, x0, y0, x1, y1);
         double head = fmin(0.35 * len, 4.0 * lw + 2.0);
         double ex = dx / len, ey = dy / len;
-        cairo_move_to(cr, x1 - head * (ex + 0.5 * ey), y1 - head * (ey - 0.5 * ex));
-        cairo_line_to(cr, x1, y1);
-        cairo_line_to(cr, x1 - head * (ex - 0.5 * ey), y1 - head * (ey + 0.5 * ex));
+        line_sink_segment(&ls, x1 - head * (ex + 0.5 * ey), y1 - head * (ey - 0.5 * ex), x1, y1);
+        line_sink_segment(&ls, x1 - head * (ex - 0.5 * ey), y1 - head * (ey + 0.5 * ex), x1, y1);
     }
-    set_colour(cr, &o->vector);
-    cairo_set_line_width(cr, lw);
-    cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-    cairo_stroke(cr);
+    line_sink_finish(&ls);
 }
 
-static void draw_axes(cairo_t *cr, const cdem_render_layout *lay, const cdem_render_scene *sc,
-                      const cdem_render_options *o) {
+static void draw_axes(cairo_t *cr, const raster_target *rt, const cdem_render_layout *lay,
+                      const cdem_render_scene *sc, const cdem_render_options *o) {
     double len = sc->axis_length;
     if (!(len > 0)) {
         double rmax = 0;
@@ -700,6 +759,7 @@ static void draw_axes(cairo_t *cr, const cdem_render_layout *lay, const cdem_ren
     double half = 0.5 * len * lay->scale;
     int sets = sc->axis_perpendicular ? 2 : 1;
     for (int set = 0; set < sets; set++) {
+        line_sink ls = {cr, rt, &o->axis[set], o->line_width};
         cairo_new_path(cr);
         for (size_t k = 0; k < sc->n_axes; k++) {
             double a = sc->axis_angle[k] + (set ? 0.5 * render_pi : 0.0);
@@ -708,13 +768,9 @@ static void draw_axes(cairo_t *cr, const cdem_render_layout *lay, const cdem_ren
             double cx, cy;
             cdem_render_layout_to_device(lay, sc->axis_x[k], sc->axis_y[k], &cx, &cy);
             double ex = cos(a) * half, ey = -sin(a) * half; /* device y points down */
-            cairo_move_to(cr, cx - ex, cy - ey);
-            cairo_line_to(cr, cx + ex, cy + ey);
+            line_sink_segment(&ls, cx - ex, cy - ey, cx + ex, cy + ey);
         }
-        set_colour(cr, &o->axis[set]);
-        cairo_set_line_width(cr, o->line_width);
-        cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
-        cairo_stroke(cr);
+        line_sink_finish(&ls);
     }
 }
 
@@ -831,16 +887,18 @@ cdem_status cdem_render_draw(cairo_t *cr, double width, double height, const cde
     cairo_new_path(cr);
     cairo_rectangle(cr, lay.plot_x, lay.plot_y, lay.plot_w, lay.plot_h);
     cairo_clip(cr);
-    cdem_status st = draw_elements(cr, &lay, sc, o, err);
+    raster_target rt;
+    const raster_target *rtp = raster_target_get(cr, &lay, &rt) ? &rt : NULL;
+    cdem_status st = draw_elements(cr, rtp, &lay, sc, o, err);
     if (st != CDEM_OK) {
         cairo_restore(cr);
         cairo_restore(cr);
         return st;
     }
     if (sc->ux && o->show_vectors)
-        draw_vectors(cr, &lay, sc, o);
+        draw_vectors(cr, rtp, &lay, sc, o);
     if (sc->n_axes > 0 && o->show_axes)
-        draw_axes(cr, &lay, sc, o);
+        draw_axes(cr, rtp, &lay, sc, o);
     cairo_restore(cr);
 
     if (o->show_label && sc->label && sc->label[0]) {

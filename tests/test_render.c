@@ -339,6 +339,83 @@ static void test_render_vectors_axes_outline(void **state) {
     cdem_state_free(&s);
 }
 
+/* The direct rasteriser (image targets) and the cairo path (vector targets, here replayed
+ * from a recording surface) draw the same picture: same colours at element centres and on
+ * vectors and axes, and a small mean difference over the whole image. */
+static void test_render_raster_matches_cairo_path(void **state) {
+    (void)state;
+    cdem_state s;
+    make_state(&s);
+    cdem_render_options o;
+    make_options(&o);
+    o.line_width = 2.0;
+    o.axis[1] = (cdem_rgba){1, 0, 0, 1};
+    double v[E_N], ux[E_N] = {0}, uy[E_N] = {0};
+    for (int i = 0; i < E_N; i++)
+        v[i] = 0.2 * i;
+    v[E_LAYER1] = NAN;
+    ux[E_LAYER2] = 0.25;
+    double ax[1] = {5.0}, ay[1] = {4.5}, aa[1] = {0.3};
+    cdem_render_scene sc = {0};
+    sc.state = &s;
+    sc.values = v;
+    sc.vmin = 0;
+    sc.vmax = 2;
+    sc.quantity = "Maximum shear strain";
+    sc.ux = ux;
+    sc.uy = uy;
+    sc.vector_scale = 5;
+    sc.axis_x = ax;
+    sc.axis_y = ay;
+    sc.axis_angle = aa;
+    sc.n_axes = 1;
+    sc.axis_length = 1.0;
+    sc.axis_perpendicular = 1;
+    const int w = 480, h = 260;
+    image direct;
+    render_image(&direct, &sc, &o, w, h);
+
+    cairo_rectangle_t ext = {0, 0, w, h};
+    cairo_surface_t *rec = cairo_recording_surface_create(CAIRO_CONTENT_COLOR_ALPHA, &ext);
+    cairo_t *cr = cairo_create(rec);
+    cdem_error err;
+    assert_int_equal(cdem_render_draw(cr, w, h, &sc, &o, &err), CDEM_OK);
+    cairo_destroy(cr);
+    image viacairo = {cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h), direct.lay};
+    cr = cairo_create(viacairo.surf);
+    cairo_set_source_surface(cr, rec, 0, 0);
+    cairo_paint(cr);
+    cairo_destroy(cr);
+    cairo_surface_flush(viacairo.surf);
+    cairo_surface_destroy(rec);
+
+    static const double pts[][2] = {{1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1},   {1, 3},
+                                    {3, 3}, {5, 3}, {7, 3}, {9, 3}, {5.8, 1}, {5, 4.5}};
+    for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
+        int a[4], b[4];
+        model_pixel(&direct, pts[k][0], pts[k][1], a);
+        model_pixel(&viacairo, pts[k][0], pts[k][1], b);
+        for (int c = 0; c < 4; c++)
+            if (abs(a[c] - b[c]) > 40)
+                fail_msg("point %zu (%g, %g): direct (%d %d %d %d) vs cairo (%d %d %d %d)", k,
+                         pts[k][0], pts[k][1], a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]);
+    }
+    double sum = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            int a[4], b[4];
+            pixel_at(&direct, x, y, a);
+            pixel_at(&viacairo, x, y, b);
+            for (int c = 0; c < 3; c++)
+                sum += abs(a[c] - b[c]);
+        }
+    double mean = sum / (3.0 * w * h);
+    assert_true(mean < 2.0);
+    cairo_surface_destroy(direct.surf);
+    cairo_surface_destroy(viacairo.surf);
+    cdem_state_free(&s);
+}
+
 static void test_render_scale_bar_and_label(void **state) {
     (void)state;
     cdem_state s;
@@ -673,6 +750,7 @@ int main(void) {
         cmocka_unit_test(test_render_values_colours_and_undefined),
         cmocka_unit_test(test_render_signed_colour_bar),
         cmocka_unit_test(test_render_vectors_axes_outline),
+        cmocka_unit_test(test_render_raster_matches_cairo_path),
         cmocka_unit_test(test_render_scale_bar_and_label),
         cmocka_unit_test(test_render_rgba_matches_surface),
         cmocka_unit_test(test_render_files_png_pdf_svg),
