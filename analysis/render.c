@@ -509,11 +509,37 @@ static void raster_segment(const raster_target *rt, double x0, double y0, double
     double half = 0.5 * width;
     for (int py = py0; py < py1; py++) {
         uint32_t *row = (uint32_t *)(void *)(rt->data + (size_t)py * rt->stride);
-        for (int px = px0; px < px1; px++) {
-            double wx = px + 0.5 - x0, wy = py + 0.5 - y0;
+        double yc = py + 0.5;
+        /* parameter range of the segment within reach of this row, then its x extent */
+        double ta = 0.0, tb = 1.0;
+        if (vy != 0.0) {
+            ta = (yc - reach - y0) / vy;
+            tb = (yc + reach - y0) / vy;
+            if (ta > tb) {
+                double t = ta;
+                ta = tb;
+                tb = t;
+            }
+            ta = fmax(ta, 0.0);
+            tb = fmin(tb, 1.0);
+            if (ta > tb)
+                continue;
+        } else if (fabs(yc - y0) > reach) {
+            continue;
+        }
+        double xa = fmin(x0 + ta * vx, x0 + tb * vx) - reach;
+        double xb = fmax(x0 + ta * vx, x0 + tb * vx) + reach;
+        int qa = (int)floor(xa), qb = (int)ceil(xb);
+        if (qa < px0)
+            qa = px0;
+        if (qb > px1)
+            qb = px1;
+        for (int px = qa; px < qb; px++) {
+            double wx = px + 0.5 - x0, wy = yc - y0;
             double t = vv > 0 ? (wx * vx + wy * vy) / vv : 0.0;
             t = t < 0 ? 0 : (t > 1 ? 1 : t);
-            double d = hypot(wx - t * vx, wy - t * vy);
+            double ex = wx - t * vx, ey = wy - t * vy;
+            double d = sqrt(ex * ex + ey * ey);
             double cov = fmin(width, half + 0.5 - d);
             if (cov <= 0.0)
                 continue;
@@ -842,7 +868,7 @@ static void draw_colour_bar(cairo_t *cr, const cdem_render_layout *lay, const cd
         cairo_line_to(cr, x + w + 0.4 * fs, ty);
         cairo_stroke(cr);
         char text[64];
-        snprintf(text, sizeof text, "%.3g", v);
+        snprintf(text, sizeof text, "%.4g", v);
         cairo_text_extents_t te;
         cairo_text_extents(cr, text, &te);
         text_w = fmax(text_w, te.x_advance);
