@@ -182,10 +182,24 @@ static void time_render(const char *outdir, double width_m, double height_m, int
         b.ro.height = h;
         cdem_render_to_file(path, &sc, &b.ro, &err);
         double t_file = now_s() - t0;
+        double t_vec[2];
+        long sz_vec[2];
+        for (int v = 0; v < 2; v++) {
+            snprintf(path, sizeof path, "%s/bench_render_%zu_%d.%s", outdir, b.cur.n, mode,
+                     v ? "svg" : "pdf");
+            t0 = now_s();
+            cdem_render_to_file(path, &sc, &b.ro, &err);
+            t_vec[v] = now_s() - t0;
+            FILE *f = fopen(path, "rb");
+            fseek(f, 0, SEEK_END);
+            sz_vec[v] = ftell(f);
+            fclose(f);
+        }
         b.ro.height = 0;
         printf("render %6zu elements, %d x %d px, %-32s draw %.3f s, PNG encode %.3f s, "
-               "to_file %.3f s\n",
-               b.cur.n, width_px, h, names[mode], best, t_png, t_file);
+               "PNG to_file %.3f s, PDF %.2f s (%.1f MB), SVG %.2f s (%.1f MB)\n",
+               b.cur.n, width_px, h, names[mode], best, t_png, t_file, t_vec[0], sz_vec[0] / 1e6,
+               t_vec[1], sz_vec[1] / 1e6);
         cairo_surface_destroy(surf);
     }
     free(ax);
