@@ -478,6 +478,16 @@ static int raster_target_get(cairo_t *cr, const cdem_render_layout *lay, raster_
     return rt->data != NULL;
 }
 
+/* floor/ceil result v as an int clamped to lo..hi (NaN gives lo): no overflowing casts for
+ * huge coordinates. */
+static int clamp_px(double v, int lo, int hi) {
+    if (!(v > lo))
+        return lo;
+    if (v > hi)
+        return hi;
+    return (int)v;
+}
+
 /* OVER-blends colour c at coverage cov (0..1] into the premultiplied pixel *p. */
 static void blend_pixel(const raster_target *rt, uint32_t *p, const cdem_rgba *c, double cov) {
     uint32_t v = *p;
@@ -495,16 +505,10 @@ static void blend_pixel(const raster_target *rt, uint32_t *p, const cdem_rgba *c
 static void raster_segment(const raster_target *rt, double x0, double y0, double x1, double y1,
                            double width, const cdem_rgba *c) {
     double reach = 0.5 * width + 1.0;
-    int px0 = (int)floor(fmin(x0, x1) - reach), px1 = (int)ceil(fmax(x0, x1) + reach);
-    int py0 = (int)floor(fmin(y0, y1) - reach), py1 = (int)ceil(fmax(y0, y1) + reach);
-    if (px0 < rt->x0)
-        px0 = rt->x0;
-    if (py0 < rt->y0)
-        py0 = rt->y0;
-    if (px1 > rt->x1)
-        px1 = rt->x1;
-    if (py1 > rt->y1)
-        py1 = rt->y1;
+    int px0 = clamp_px(floor(fmin(x0, x1) - reach), rt->x0, rt->x1);
+    int px1 = clamp_px(ceil(fmax(x0, x1) + reach), rt->x0, rt->x1);
+    int py0 = clamp_px(floor(fmin(y0, y1) - reach), rt->y0, rt->y1);
+    int py1 = clamp_px(ceil(fmax(y0, y1) + reach), rt->y0, rt->y1);
     double vx = x1 - x0, vy = y1 - y0, vv = vx * vx + vy * vy;
     double half = 0.5 * width;
     for (int py = py0; py < py1; py++) {
@@ -529,11 +533,7 @@ static void raster_segment(const raster_target *rt, double x0, double y0, double
         }
         double xa = fmin(x0 + ta * vx, x0 + tb * vx) - reach;
         double xb = fmax(x0 + ta * vx, x0 + tb * vx) + reach;
-        int qa = (int)floor(xa), qb = (int)ceil(xb);
-        if (qa < px0)
-            qa = px0;
-        if (qb > px1)
-            qb = px1;
+        int qa = clamp_px(floor(xa), px0, px1), qb = clamp_px(ceil(xb), px0, px1);
         for (int px = qa; px < qb; px++) {
             double wx = px + 0.5 - x0, wy = yc - y0;
             double t = vv > 0 ? (wx * vx + wy * vy) / vv : 0.0;
@@ -584,16 +584,10 @@ static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, 
     cdem_render_layout_to_device(lay, x, y, &cx, &cy);
     double r = radius * lay->scale;
     double reach = r + 0.5 * ring_width + 1.0;
-    int px0 = (int)floor(cx - reach), px1 = (int)ceil(cx + reach);
-    int py0 = (int)floor(cy - reach), py1 = (int)ceil(cy + reach);
-    if (px0 < rt->x0)
-        px0 = rt->x0;
-    if (py0 < rt->y0)
-        py0 = rt->y0;
-    if (px1 > rt->x1)
-        px1 = rt->x1;
-    if (py1 > rt->y1)
-        py1 = rt->y1;
+    int px0 = clamp_px(floor(cx - reach), rt->x0, rt->x1);
+    int px1 = clamp_px(ceil(cx + reach), rt->x0, rt->x1);
+    int py0 = clamp_px(floor(cy - reach), rt->y0, rt->y1);
+    int py1 = clamp_px(ceil(cy + reach), rt->y0, rt->y1);
     double small = ring_width > 0 ? fmin(1.0, ring_width) : fmin(1.0, 2.0 * r);
     double half = 0.5 * ring_width;
     double outer = r + half + 0.5;                       /* coverage is zero beyond */
@@ -604,16 +598,13 @@ static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, 
         if (fabs(ddy) >= outer)
             continue;
         double span = sqrt(outer * outer - ddy * ddy);
-        int xa = (int)floor(cx - span - 0.5), xb = (int)ceil(cx + span + 0.5);
-        if (xa < px0)
-            xa = px0;
-        if (xb > px1)
-            xb = px1;
+        int xa = clamp_px(floor(cx - span - 0.5), px0, px1);
+        int xb = clamp_px(ceil(cx + span + 0.5), px0, px1);
         int hole_a = xb, hole_b = xb; /* pixels [hole_a, hole_b) lie inside the ring's hole */
         if (inner > 0 && fabs(ddy) < inner) {
             double ispan = sqrt(inner * inner - ddy * ddy);
-            hole_a = (int)ceil(cx - ispan + 0.5);
-            hole_b = (int)floor(cx + ispan - 0.5);
+            hole_a = clamp_px(ceil(cx - ispan + 0.5), xa, xb);
+            hole_b = clamp_px(floor(cx + ispan - 0.5), xa, xb);
             if (hole_b <= hole_a)
                 hole_a = hole_b = xb; /* empty hole: nothing to skip */
         }

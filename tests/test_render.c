@@ -627,6 +627,21 @@ static void test_render_bad_input_fails_cleanly(void **state) {
     assert_near_colour(px, o.background, 0);
     cairo_surface_destroy(im.surf);
 
+    /* absurd sizes (a disc and axes far larger than the image) draw without overflow */
+    s.radius[E_WALL] = 1e300;
+    double ax[1] = {5.0}, ay[1] = {2.0}, aa[1] = {0.7};
+    sc.axis_x = ax;
+    sc.axis_y = ay;
+    sc.axis_angle = aa;
+    sc.n_axes = 1;
+    sc.axis_length = 1e300;
+    render_image(&im, &sc, &o, 200, 120);
+    model_pixel(&im, 5, 4, px);
+    assert_near_colour(px, o.wall, 1); /* the giant wall disc covers the view */
+    cairo_surface_destroy(im.surf);
+    s.radius[E_WALL] = 0.45;
+    sc.n_axes = 0;
+
     cdem_error err;
     cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 100, 100);
     static const struct {
