@@ -397,7 +397,7 @@ static int element_slot(const cdem_render_scene *sc, const cdem_render_options *
         double v = sc->values[i];
         if (isnan(v))
             return SLOT_UNDEFINED;
-        if (!sc->above_tenth_max || fabs(v) >= threshold) {
+        if (!sc->above_tenth_max || fabs(v) > threshold) {
             double t =
                 hi > lo ? (v - lo) / (hi - lo) : (sc->kind == CDEM_COLORMAP_SIGNED ? 0.5 : 0.0);
             t = t < 0 ? 0 : (t > 1 ? 1 : t);

@@ -39,7 +39,7 @@ typedef struct {
     cdem_colormap_kind kind; /* magnitude (blue-green-red) or signed (blue-white-red) */
     const char *quantity;    /* colour bar title, e.g. "Total displacement"; NULL = none */
     const char *unit;        /* colour bar unit, e.g. "m"; NULL or "" = dimensionless */
-    int above_tenth_max;     /* 1: colour only elements with |v| >= 0.1 max(|vmin|,|vmax|);
+    int above_tenth_max;     /* 1: colour only elements with |v| > 0.1 max(|vmin|,|vmax|);
                                 the others keep their layer colours */
 
     const double *ux, *uy; /* optional, n displacements (m) drawn as vectors; NaN skips */

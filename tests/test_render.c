@@ -174,6 +174,7 @@ static void test_render_values_colours_and_undefined(void **state) {
     v[E_GROWTH1A] = 0.0;
     v[E_GROWTH1B] = 1.0;  /* middle: green */
     v[E_HIGHLIGHT] = 0.1; /* below 0.1 x max when that mode is on */
+    v[E_GROWTH2] = 0.2;   /* exactly 0.1 x max: not above it */
     cdem_render_scene sc = {0};
     sc.state = &s;
     sc.values = v;
@@ -195,6 +196,8 @@ static void test_render_values_colours_and_undefined(void **state) {
     assert_near_colour(px, cdem_colormap_eval(CDEM_COLORMAP_MAGNITUDE, 0.5), 1);
     model_pixel(&im, 9, 3, px); /* 0.1 / 2 = 0.05 */
     assert_near_colour(px, cdem_colormap_eval(CDEM_COLORMAP_MAGNITUDE, 0.05), 3);
+    model_pixel(&im, 5, 3, px);
+    assert_near_colour(px, cdem_colormap_eval(CDEM_COLORMAP_MAGNITUDE, 0.1), 3);
     /* walls, biaxial edges and footwall keep their colours */
     model_pixel(&im, 1, 1, px);
     assert_near_colour(px, o.wall, 1);
@@ -219,6 +222,8 @@ static void test_render_values_colours_and_undefined(void **state) {
     render_image(&im, &sc, &o, 500, 240);
     model_pixel(&im, 9, 3, px);
     assert_near_colour(px, o.highlight, 1);
+    model_pixel(&im, 5, 3, px);
+    assert_near_colour(px, o.growth2[0], 1);
     model_pixel(&im, 3, 3, px);
     assert_near_colour(px, cdem_colormap_eval(CDEM_COLORMAP_MAGNITUDE, 0.5), 1);
     cairo_surface_destroy(im.surf);
