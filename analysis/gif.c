@@ -35,6 +35,19 @@ void cdem_gif_options_default(cdem_gif_options *o) {
     o->loop_count = 0;
 }
 
+void cdem_gif_options_view(const cdem_gif_options *o, FILE *f) {
+    fprintf(f, "gif.delay = %d cs\n", o->delay_cs);
+    fprintf(f, "gif.order = %s\n", o->order == CDEM_GIF_BACKWARD ? "backward" : "forward");
+    fprintf(f, "gif.frames = %s\n", o->selection == CDEM_GIF_ODD ? "odd" : "all");
+    fprintf(f, "gif.scale = %g\n", o->scale);
+    fprintf(f, "gif.optimise = %d\n", o->optimise);
+    if (o->loop_count == 0)
+        fprintf(f, "gif.loop = forever\n");
+    else
+        fprintf(f, "gif.loop = %d\n", o->loop_count);
+    fprintf(f, "gif.palette = 6x7x6 cube + greys 51, 153, 204 + transparent (fixed)\n");
+}
+
 size_t cdem_gif_frame_order(size_t n, const cdem_gif_options *o, size_t *indices) {
     size_t count = 0;
     for (size_t k = 0; k < n; k++) {

@@ -19,6 +19,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #define CDEM_GIF_TRANSPARENT 255   /* palette index reserved for "unchanged pixel" */
 #define CDEM_GIF_MAX_SIZE    16384 /* largest output width or height, px (GIF limit 65535) */
@@ -51,6 +52,9 @@ typedef cdem_status (*cdem_gif_frame_fn)(void *user, size_t index, uint8_t *rgba
 
 /* Defaults: 10 cs delay, forward, all frames, scale 1, optimised, loop forever. */
 void cdem_gif_options_default(cdem_gif_options *o);
+
+/* Writes the effective options to f, one "key = value" line each. */
+void cdem_gif_options_view(const cdem_gif_options *o, FILE *f);
 
 /* Frame indices to write for n frames, in output order, into indices (may be NULL to only
  * count; otherwise room for n). Returns their number. */

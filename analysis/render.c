@@ -84,6 +84,59 @@ void cdem_render_options_default(cdem_render_options *o) {
     o->text = rgb(0.0, 0.0, 0.0);    /* black */
 }
 
+static unsigned colour_byte(double v) {
+    if (!(v > 0))
+        return 0;
+    if (v >= 1)
+        return 255;
+    return (unsigned)lround(v * 255.0);
+}
+
+void cdem_render_format_colour(const cdem_rgba *c, char buf[10]) {
+    snprintf(buf, 10, "#%02x%02x%02x%02x", colour_byte(c->r), colour_byte(c->g), colour_byte(c->b),
+             colour_byte(c->a));
+}
+
+void cdem_render_options_view(const cdem_render_options *o, FILE *f) {
+    static const char *const colour_names[] = {
+        "background", "wall",      "pregrowth_0", "pregrowth_1",  "growth1_0", "growth1_1",
+        "growth2_0",  "growth2_1", "highlight",   "biaxial_edge", "footwall",  "undefined",
+        "outline",    "vector",    "axis_0",      "axis_1",       "text"};
+    const cdem_rgba *cols[] = {&o->background, &o->wall,         &o->pregrowth[0], &o->pregrowth[1],
+                               &o->growth1[0], &o->growth1[1],   &o->growth2[0],   &o->growth2[1],
+                               &o->highlight,  &o->biaxial_edge, &o->footwall,     &o->undefined,
+                               &o->outline,    &o->vector,       &o->axis[0],      &o->axis[1],
+                               &o->text};
+    fprintf(f, "render.width = %d\n", o->width);
+    fprintf(f, "render.height = %d%s\n", o->height, o->height == 0 ? " (automatic)" : "");
+    if (o->has_zoom)
+        fprintf(f, "render.zoom = %.9g %.9g %.9g %.9g (m: xmin xmax ymin ymax)\n", o->zoom_xmin,
+                o->zoom_xmax, o->zoom_ymin, o->zoom_ymax);
+    else
+        fprintf(f, "render.zoom = fit all elements, margin %g\n", o->margin);
+    fprintf(f, "render.pregrowth_layers = %d\n", o->pregrowth_layers);
+    fprintf(f, "render.band_layers = %d\n", o->band_layers);
+    fprintf(f, "render.growth1_layers = %d\n", o->growth1_layers);
+    if (o->highlight_first > 0)
+        fprintf(f, "render.highlight = %d..%d\n", o->highlight_first, o->highlight_last);
+    else
+        fprintf(f, "render.highlight = none\n");
+    fprintf(f,
+            "render.show = fill %d, outline %d, colours %d, vectors %d, axes %d, scale_bar %d, "
+            "colour_bar %d, label %d\n",
+            o->show_fill, o->show_outline, o->show_colours, o->show_vectors, o->show_axes,
+            o->show_scale_bar, o->show_colour_bar, o->show_label);
+    fprintf(f, "render.font_size = %g%s\n", o->font_size, o->font_size <= 0 ? " (automatic)" : "");
+    fprintf(f, "render.outline_width = %g\n", o->outline_width);
+    fprintf(f, "render.line_width = %g\n", o->line_width);
+    fprintf(f, "render.weak_alpha = %g\n", o->weak_alpha);
+    for (size_t k = 0; k < sizeof cols / sizeof cols[0]; k++) {
+        char buf[10];
+        cdem_render_format_colour(cols[k], buf);
+        fprintf(f, "render.colour.%s = %s\n", colour_names[k], buf);
+    }
+}
+
 static int hex_digit(int c) {
     if (c >= '0' && c <= '9')
         return c - '0';

@@ -21,6 +21,7 @@
 #include <cairo.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #define CDEM_RENDER_MAX_SIZE 20000 /* largest width or height accepted, px or pt */
 
@@ -114,6 +115,14 @@ typedef struct {
 
 /* Fills o with the defaults (1200 px wide, auto height, manual colours, all toggles on). */
 void cdem_render_options_default(cdem_render_options *o);
+
+/* Writes the effective options to f, one "key = value" line each (colours as
+ * "#rrggbbaa", which cdem_render_parse_colour reads back); for --dry-run and file
+ * attributes. */
+void cdem_render_options_view(const cdem_render_options *o, FILE *f);
+
+/* Formats c as "#rrggbbaa" into buf (at least 10 bytes). */
+void cdem_render_format_colour(const cdem_rgba *c, char buf[10]);
 
 /* Parses "#rrggbb" or "#rrggbbaa" (hex, case-insensitive) into *out. */
 cdem_status cdem_render_parse_colour(const char *text, cdem_rgba *out, cdem_error *err);

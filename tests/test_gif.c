@@ -366,6 +366,27 @@ static void test_gif_rendered_frames(void **state) {
     cdem_state_free(&s);
 }
 
+static void test_gif_options_view(void **state) {
+    (void)state;
+    cdem_gif_options o;
+    cdem_gif_options_default(&o);
+    o.order = CDEM_GIF_BACKWARD;
+    o.selection = CDEM_GIF_ODD;
+    o.scale = 0.5;
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    cdem_gif_options_view(&o, f);
+    fclose(f);
+    assert_non_null(strstr(text, "gif.delay = 10 cs\n"));
+    assert_non_null(strstr(text, "gif.order = backward\n"));
+    assert_non_null(strstr(text, "gif.frames = odd\n"));
+    assert_non_null(strstr(text, "gif.scale = 0.5\n"));
+    assert_non_null(strstr(text, "gif.loop = forever\n"));
+    free(text);
+}
+
 static void test_gif_errors(void **state) {
     (void)state;
     char path[512];
@@ -429,6 +450,7 @@ int main(void) {
         cmocka_unit_test(test_gif_optimised_frames_reconstruct),
         cmocka_unit_test(test_gif_scale_and_identical_frames),
         cmocka_unit_test(test_gif_rendered_frames),
+        cmocka_unit_test(test_gif_options_view),
         cmocka_unit_test(test_gif_errors),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);

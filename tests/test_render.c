@@ -612,6 +612,38 @@ static void test_render_parse_colour(void **state) {
     assert_int_equal(cdem_render_format_from_path("a.pdf/pic", &f, &err), CDEM_ERR_UNSUPPORTED);
 }
 
+static void test_render_options_view(void **state) {
+    (void)state;
+    cdem_render_options o;
+    cdem_render_options_default(&o);
+    o.highlight_first = 5;
+    o.highlight_last = 8;
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    cdem_render_options_view(&o, f);
+    fclose(f);
+    assert_non_null(strstr(text, "render.width = 1200\n"));
+    assert_non_null(strstr(text, "render.height = 0 (automatic)\n"));
+    assert_non_null(strstr(text, "render.pregrowth_layers = 24\n"));
+    assert_non_null(strstr(text, "render.highlight = 5..8\n"));
+    assert_non_null(strstr(text, "render.colour.wall = #8b5a2bff\n"));
+    assert_non_null(strstr(text, "render.colour.undefined = #999999ff\n"));
+    /* every colour line reads back (within rounding) with cdem_render_parse_colour */
+    const char *line = strstr(text, "render.colour.outline = ");
+    assert_non_null(line);
+    char hex[10];
+    memcpy(hex, line + strlen("render.colour.outline = "), 9);
+    hex[9] = 0;
+    cdem_rgba c;
+    cdem_error err;
+    assert_int_equal(cdem_render_parse_colour(hex, &c, &err), CDEM_OK);
+    assert_true(fabs(c.r - o.outline.r) <= 0.5 / 255 + 1e-12);
+    assert_true(fabs(c.a - o.outline.a) <= 0.5 / 255 + 1e-12);
+    free(text);
+}
+
 static void test_render_bad_input_fails_cleanly(void **state) {
     (void)state;
     cdem_state s;
@@ -783,6 +815,7 @@ int main(void) {
         cmocka_unit_test(test_render_rgba_matches_surface),
         cmocka_unit_test(test_render_files_png_pdf_svg),
         cmocka_unit_test(test_render_parse_colour),
+        cmocka_unit_test(test_render_options_view),
         cmocka_unit_test(test_render_bad_input_fails_cleanly),
         cmocka_unit_test(test_render_fit_box),
     };
