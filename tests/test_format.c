@@ -594,7 +594,12 @@ static void test_format_corrupt_bytes(void **state) {
     fclose(f);
     uint64_t seed = 99;
     int opened = 0, failed = 0;
-    for (int trial = 0; trial < 120; trial++) {
+    /* CDEM_TEST_CORRUPT_TRIALS raises the count for a long hunt (the default stays fast). */
+    const char *env = getenv("CDEM_TEST_CORRUPT_TRIALS");
+    int trials = env && atoi(env) > 0 ? atoi(env) : 120;
+    if (env && getenv("CDEM_TEST_CORRUPT_SEED"))
+        seed = (uint64_t)strtoull(getenv("CDEM_TEST_CORRUPT_SEED"), NULL, 10);
+    for (int trial = 0; trial < trials; trial++) {
         memcpy(mod, orig, (size_t)size);
         /* Sweep evenly through the file, plus a seeded burst of 1-8 flipped bytes. */
         long at = trial < 60 ? (long)((double)trial / 60.0 * (double)size)
@@ -627,7 +632,8 @@ static void test_format_corrupt_bytes(void **state) {
         cdem_state_free(&s);
         cdem_h5_reader_close(r);
     }
-    print_message("corrupt bytes: %d of 120 corrupted copies opened, %d refused\n", opened, failed);
+    print_message("corrupt bytes: %d of %d corrupted copies opened, %d refused\n", opened, trials,
+                  failed);
     free(orig);
     free(mod);
     remove(bad);
