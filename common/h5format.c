@@ -539,13 +539,14 @@ static cdem_status create_series(cdem_h5_writer *w, cdem_error *err) {
     H5Pclose(gcpl);
     if (g < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create group /series", w->path);
+    /* Unfiltered on purpose: a fixed-size chunk is rewritten in place when samples are
+     * appended, so the chunk the last flushed index points to stays valid. A compressed
+     * chunk would move at every append and its old place could be reused before the next
+     * flush. The series is small (about 0.1 MB for the default run), so this costs little. */
     hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = SERIES_CHUNK;
     hid_t sp = H5Screate_simple(1, &zero, &unlimited);
     hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
     H5Pset_chunk(dcpl, 1, &chunk);
-    H5Pset_shuffle(dcpl);
-    H5Pset_deflate(dcpl, DEFLATE_LEVEL);
-    H5Pset_fletcher32(dcpl);
     cdem_status st = CDEM_OK;
     for (size_t c = 0; c < N_SERIES; c++) {
         hid_t ft = series_columns[c].type == COL_I64 ? H5T_STD_I64LE : H5T_IEEE_F64LE;
@@ -583,6 +584,19 @@ static void writer_release(cdem_h5_writer *w) {
 static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cdem_error *err) {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
+    /* Crash consistency between flushes (see the head comment): metadata reaches the disk
+     * only at a flush (no cache evictions), and freed file space is never reused, so a
+     * block the last flushed metadata still points to is never overwritten. */
+    H5AC_cache_config_t mdc;
+    memset(&mdc, 0, sizeof mdc);
+    mdc.version = H5AC__CURR_CACHE_CONFIG_VERSION;
+    if (H5Pget_mdc_config(fapl, &mdc) >= 0) {
+        mdc.evictions_enabled = 0;
+        mdc.incr_mode = H5C_incr__off;
+        mdc.flash_incr_mode = H5C_flash_incr__off;
+        mdc.decr_mode = H5C_decr__off;
+        H5Pset_mdc_config(fapl, &mdc);
+    }
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
     w->file = H5Fcreate(w->path, H5F_ACC_TRUNC, fcpl, fapl);
     H5Pclose(fapl);
@@ -609,7 +623,11 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cd
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write the root attributes", w->path);
     CDEM_TRY(write_parameters(w, meta->params, err));
     CDEM_TRY(create_series(w, err));
+    /* Links stay in the group's object header (compact), which only grows by new
+     * continuation blocks; dense storage (fractal heap + B-tree) moves and frees blocks
+     * as it grows, and freed space may be reused before the next flush. */
     hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
+    H5Pset_link_phase_change(gcpl, 65535, 65534);
     w->increments = H5Gcreate2(w->file, "increments", H5P_DEFAULT, gcpl, H5P_DEFAULT);
     H5Pclose(gcpl);
     if (w->increments < 0)
@@ -800,7 +818,8 @@ struct cdem_h5_reader {
     char *source;
     char *created;
     long seed;        /* root attribute seed */
-    int unclosed;     /* 1: the writer did not close the file (opened as SWMR reader) */
+    int unclosed;     /* 1: the writer did not close the file (status flag set) */
+    size_t n_skipped; /* unclosed file: increments left out as incompletely flushed */
     incr_entry *incr; /* increments sorted by number */
     size_t n_incr;    /* entries in incr */
     size_t cap_incr;  /* allocated entries */
@@ -960,15 +979,22 @@ static herr_t scan_increment(hid_t group, const char *name, const H5L_info_t *li
         return -1;
     }
     hid_t g = H5Gopen2(group, name, H5P_DEFAULT);
-    if (g < 0) {
-        c->status =
-            H5FAIL(c->err, CDEM_ERR_FORMAT, "%s: cannot open group /increments/%s", r->path, name);
-        return -1;
-    }
     incr_entry *e = &r->incr[r->n_incr];
     snprintf(e->name, sizeof e->name, "%s", name);
-    c->status = read_incr_info(r, g, name, &e->info, c->err);
-    H5Gclose(g);
+    if (g < 0)
+        c->status =
+            H5FAIL(c->err, CDEM_ERR_FORMAT, "%s: cannot open group /increments/%s", r->path, name);
+    else
+        c->status = read_incr_info(r, g, name, &e->info, c->err);
+    if (g >= 0)
+        H5Gclose(g);
+    if (c->status != CDEM_OK && r->unclosed) {
+        /* The writer died while flushing this increment: leave it out. */
+        r->n_skipped++;
+        c->status = CDEM_OK;
+        cdem_error_clear(c->err);
+        return 0;
+    }
     if (c->status != CDEM_OK)
         return -1;
     r->n_incr++;
@@ -1249,65 +1275,103 @@ cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_
     return CDEM_OK;
 }
 
+/* Reads `len` leading values of a 1-D numeric dataset, converted to mtype. */
+static int read_prefix(hid_t ds, hid_t mtype, hsize_t len, void *dst) {
+    if (len == 0)
+        return 0;
+    hsize_t start = 0;
+    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(1, &len, NULL);
+    int ok = fs >= 0 && ms >= 0 &&
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &len, NULL) >= 0 &&
+             H5Dread(ds, mtype, ms, fs, H5P_DEFAULT, dst) >= 0;
+    if (fs >= 0)
+        H5Sclose(fs);
+    if (ms >= 0)
+        H5Sclose(ms);
+    return ok ? 0 : -1;
+}
+
 cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **samples,
                                        size_t *count, cdem_error *err) {
     if (!r || !samples || !count)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_read_series: bad arguments");
     *samples = NULL;
     *count = 0;
-    cdem_series_sample *out = NULL;
-    double *col = NULL;
-    hsize_t len = 0;
+    hid_t ds[N_SERIES];
+    hsize_t dims[N_SERIES];
     cdem_status st = CDEM_OK;
-    for (size_t c = 0; c < N_SERIES && st == CDEM_OK; c++) {
-        const series_column *sc = &series_columns[c];
+    size_t opened = 0;
+    /* Pass 1: every column exists, is 1-D numeric; find the common length. */
+    for (; opened < N_SERIES; opened++) {
         char name[64];
-        snprintf(name, sizeof name, "series/%s", sc->name);
-        hid_t ds = H5Dopen2(r->file, name, H5P_DEFAULT);
-        if (ds < 0) {
+        snprintf(name, sizeof name, "series/%s", series_columns[opened].name);
+        ds[opened] = H5Dopen2(r->file, name, H5P_DEFAULT);
+        if (ds[opened] < 0) {
             st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt", r->path,
                         name);
             break;
         }
-        hid_t sp = H5Dget_space(ds), t = H5Dget_type(ds);
-        hsize_t dim = 0;
+        hid_t sp = H5Dget_space(ds[opened]), t = H5Dget_type(ds[opened]);
         int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+        dims[opened] = 0;
         if (rank == 1)
-            H5Sget_simple_extent_dims(sp, &dim, NULL);
+            H5Sget_simple_extent_dims(sp, &dims[opened], NULL);
         H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
-        if (rank != 1 || (cls != H5T_INTEGER && cls != H5T_FLOAT))
-            st = H5FAIL(err, CDEM_ERR_FORMAT,
-                        "%s: dataset /%s is not a 1-D numeric dataset (rank %d, class %d)", r->path,
-                        name, rank, (int)cls);
-        else if (c == 0) {
-            len = dim;
-            if (len > ((hsize_t)1 << 40) / sizeof *out)
-                st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /%s claims %llu samples", r->path, name,
-                               (unsigned long long)len);
-            else if (len > 0 && (!(out = calloc((size_t)len, sizeof *out)) ||
-                                 !(col = malloc((size_t)len * 8))))
-                st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading %llu series samples",
-                               (unsigned long long)len);
-        } else if (dim != len)
-            st =
-                CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                          "%s: dataset /%s has %llu samples but /series/%s has %llu", r->path, name,
-                          (unsigned long long)dim, series_columns[0].name, (unsigned long long)len);
-        if (st == CDEM_OK && len > 0) {
-            hid_t mt = sc->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
-            if (H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, col) < 0)
-                st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read dataset /%s (corrupt?)", r->path,
-                            name);
-            else
-                for (hsize_t i = 0; i < len; i++)
-                    memcpy((char *)&out[i] + sc->offset, (char *)col + i * 8, 8);
-        }
         if (t >= 0)
             H5Tclose(t);
         if (sp >= 0)
             H5Sclose(sp);
-        H5Dclose(ds);
+        if (rank != 1 || (cls != H5T_INTEGER && cls != H5T_FLOAT)) {
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: dataset /%s is not a 1-D numeric dataset (rank %d, class %d)",
+                           r->path, name, rank, (int)cls);
+            opened++;
+            break;
+        }
     }
+    hsize_t len = 0;
+    if (st == CDEM_OK) {
+        len = dims[0];
+        for (size_t c = 1; c < N_SERIES; c++) {
+            if (dims[c] == len)
+                continue;
+            /* A writer killed inside a flush may leave columns of different lengths: keep
+             * the common part. A closed file must be consistent. */
+            if (!r->unclosed) {
+                st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                               "%s: dataset /series/%s has %llu samples but /series/%s has %llu",
+                               r->path, series_columns[c].name, (unsigned long long)dims[c],
+                               series_columns[0].name, (unsigned long long)len);
+                break;
+            }
+            if (dims[c] < len)
+                len = dims[c];
+        }
+    }
+    cdem_series_sample *out = NULL;
+    void *col = NULL;
+    if (st == CDEM_OK && len > ((hsize_t)1 << 32))
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /series claims %llu samples", r->path,
+                       (unsigned long long)len);
+    else if (st == CDEM_OK && len > 0 &&
+             (!(out = calloc((size_t)len, sizeof *out)) || !(col = malloc((size_t)len * 8))))
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading %llu series samples",
+                       (unsigned long long)len);
+    /* Pass 2: read the columns into the samples. */
+    for (size_t c = 0; st == CDEM_OK && c < N_SERIES && len > 0; c++) {
+        const series_column *sc = &series_columns[c];
+        hid_t mt = sc->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
+        if (read_prefix(ds[c], mt, len, col) < 0) {
+            st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read dataset /series/%s (corrupt?)",
+                        r->path, sc->name);
+            break;
+        }
+        for (hsize_t i = 0; i < len; i++)
+            memcpy((char *)&out[i] + sc->offset, (char *)col + i * 8, 8);
+    }
+    for (size_t c = 0; c < opened && c < N_SERIES; c++)
+        if (ds[c] >= 0)
+            H5Dclose(ds[c]);
     free(col);
     if (st != CDEM_OK) {
         free(out);

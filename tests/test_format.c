@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -789,6 +790,99 @@ static void test_format_killed_writer_keeps_increments(void **state) {
     remove_pair(path);
 }
 
+/* A writer killed (SIGKILL) at an arbitrary moment, usually in the middle of writing an
+ * increment: the file opens and holds at least every increment reported complete. */
+static void test_format_writer_killed_mid_increment(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "midkill.h5");
+    /* CDEM_TEST_KILL_ROUNDS runs more rounds at seeded random moments (a long hunt). */
+    const char *env = getenv("CDEM_TEST_KILL_ROUNDS");
+    int rounds = env && atoi(env) > 0 ? atoi(env) : 3;
+    uint64_t seed = 17;
+    int refused = 0;
+    for (int t = 0; t < rounds; t++) {
+        const int kill_after[] = {1 + 3 * t, (int)(1 + rng_next(&seed) % 20)};
+        const useconds_t delay[] = {(useconds_t)(2000 * t), (useconds_t)(rng_next(&seed) % 6000)};
+        int which = t >= 3;
+        int fds[2];
+        assert_int_equal(pipe(fds), 0);
+        fflush(NULL);
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            close(fds[0]);
+            cdem_params p;
+            cdem_params_defaults(&p);
+            cdem_run_meta meta = {&p, "text", "summary", "v", "cdem-run"};
+            cdem_h5_writer *w = NULL;
+            cdem_error err;
+            if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
+                _exit(2);
+            cdem_state s;
+            make_state(&s, 3000, 5, 1);
+            for (int k = 0;; k++) {
+                for (int j = 0; j < 50; j++) {
+                    cdem_series_sample smp = make_sample((size_t)(50 * k + j));
+                    cdem_h5_writer_append_series(w, &smp, &err);
+                }
+                cdem_increment_info info = make_info(k, CDEM_PHASE_DEFORMATION);
+                s.x[0] = k;
+                if (cdem_h5_writer_write_increment(w, &info, &s, &err) != CDEM_OK)
+                    _exit(4);
+                if (write(fds[1], "i", 1) != 1)
+                    _exit(5);
+            }
+        }
+        close(fds[1]);
+        char c;
+        for (int k = 0; k < kill_after[which]; k++)
+            assert_int_equal(read(fds[0], &c, 1), 1);
+        /* Let it get into the next increment, then kill it. */
+        usleep(delay[which]);
+        kill(pid, SIGKILL);
+        int status = 0;
+        assert_true(waitpid(pid, &status, 0) == pid);
+        close(fds[0]);
+        cdem_error err;
+        cdem_h5_reader *r = NULL;
+        cdem_status st = cdem_h5_reader_open(path, &r, &err);
+        if (st != CDEM_OK) {
+            /* Killed inside the flush itself (a window of a few ms per increment): HDF5
+             * without SWMR does not order its metadata writes, so the file may be unusable;
+             * the reader must then refuse it cleanly. See docs/format.md. */
+            if (st != CDEM_ERR_FORMAT || !strstr(err.msg, path))
+                fail_msg("killed after %d increments: status %d: %s", kill_after[which], (int)st,
+                         err.msg);
+            refused++;
+            remove_pair(path);
+            continue;
+        }
+        size_t n = cdem_h5_reader_increment_count(r);
+        assert_true(n >= (size_t)kill_after[which]);
+        cdem_state s = {0};
+        for (size_t i = 0; i < n; i++) {
+            cdem_increment_info in;
+            if (cdem_h5_reader_load_increment(r, i, &s, &in, &err) != CDEM_OK)
+                fail_msg("killed after %d: increment %zu of %zu: %s", kill_after[which], i, n,
+                         err.msg);
+            assert_true(s.x[0] == (double)in.number);
+        }
+        cdem_series_sample *smp = NULL;
+        size_t ns = 0;
+        if (cdem_h5_reader_read_series(r, &smp, &ns, &err) != CDEM_OK)
+            fail_msg("killed after %d: series: %s", kill_after[which], err.msg);
+        assert_true(ns >= 50 * (size_t)kill_after[which]);
+        free(smp);
+        cdem_state_free(&s);
+        cdem_h5_reader_close(r);
+        remove_pair(path);
+    }
+    print_message("killed mid-increment: %d rounds, %d files refused (killed inside a flush)\n",
+                  rounds, refused);
+    assert_true(refused <= 1 + rounds / 20);
+}
+
 /* ------------------------------------------------------------------ size */
 
 /* The synthetic default run: ~2121 discs (radii 50/75/100/125 m) packed in 10 km x 5 km,
@@ -986,6 +1080,13 @@ static void test_format_deterministic_bytes(void **state) {
     remove_pair(b);
 }
 
+/* HDF5 1.10 leaks small buffers on some error paths when it meets corrupt metadata
+ * (test_format_corrupt_bytes); those leaks are HDF5's, not ours. LeakSanitizer reads this. */
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_suppressions(void) {
+    return "leak:libhdf5_serial.so\n";
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_format_roundtrip_all_fields),
@@ -998,6 +1099,7 @@ int main(void) {
         cmocka_unit_test(test_format_corrupt_bytes),
         cmocka_unit_test(test_format_find_increment_specs),
         cmocka_unit_test(test_format_killed_writer_keeps_increments),
+        cmocka_unit_test(test_format_writer_killed_mid_increment),
         cmocka_unit_test(test_format_size_of_default_run),
         cmocka_unit_test(test_format_xmf_sidecar),
         cmocka_unit_test(test_format_deterministic_bytes),
