@@ -35,10 +35,11 @@
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
  * after byte shuffle; level 9 saved < 1 % more and took 3x longer. Per-increment datasets
  * are one chunk up to CHUNK_ELEMS elements (a chunk of 8192 doubles is 64 KiB). */
-#define DEFLATE_LEVEL 4
-#define CHUNK_ELEMS   8192
-#define SERIES_CHUNK  1024
-#define SERIES_BUFFER 256
+#define DEFLATE_LEVEL   4
+#define CHUNK_ELEMS     8192
+#define SERIES_CHUNK    1024
+#define SERIES_BUFFER   256
+#define XMF_EVERY_LIMIT 1000
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
 
@@ -342,6 +343,7 @@ struct cdem_h5_writer {
     hsize_t series_len;            /* samples already in the file */
     xmf_entry *entries;            /* one per written increment, in write order */
     size_t n_entries, cap_entries; /* used / allocated entries */
+    size_t xmf_written;            /* entries in the sidecar on disk */
 };
 
 static cdem_status flush_file(cdem_h5_writer *w, cdem_error *err) {
@@ -413,7 +415,7 @@ static void xmf_data_item(FILE *f, const cdem_h5_writer *w, const xmf_entry *e, 
 }
 
 /* Rewrites the sidecar from the list of increments: temp file, then rename. */
-static cdem_status write_xmf(const cdem_h5_writer *w, cdem_error *err) {
+static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
     FILE *f = fopen(w->xmf_tmp, "w");
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot create the XDMF sidecar: %s", w->xmf_tmp,
@@ -462,6 +464,7 @@ static cdem_status write_xmf(const cdem_h5_writer *w, cdem_error *err) {
         return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", w->xmf_path,
                          w->xmf_tmp, strerror(e));
     }
+    w->xmf_written = w->n_entries;
     return CDEM_OK;
 }
 
@@ -755,7 +758,12 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
     w->entries[w->n_entries++] =
         (xmf_entry){info->number, info->time, (int64_t)s->n, s->has_stress ? 1 : 0};
     CDEM_TRY(flush_file(w, err));
-    return write_xmf(w, err);
+    /* Rewriting the whole sidecar costs O(increments); past XMF_EVERY_LIMIT increments it is
+     * rewritten only when 5 % more have accumulated (and at close), so a run's total
+     * sidecar I/O stays linear in its length. */
+    if (w->n_entries <= XMF_EVERY_LIMIT || w->n_entries - w->xmf_written >= w->n_entries / 20)
+        return write_xmf(w, err);
+    return CDEM_OK;
 }
 
 cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sample *sample,
@@ -784,6 +792,8 @@ cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
     if (!w)
         return CDEM_OK;
     cdem_status st = flush_series(w, err);
+    if (st == CDEM_OK && w->xmf_written != w->n_entries)
+        st = write_xmf(w, err);
     for (size_t c = 0; c < N_SERIES; c++) {
         if (w->series[c] >= 0 && H5Dclose(w->series[c]) < 0 && st == CDEM_OK)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close /series/%s", w->path,
