@@ -1,22 +1,21 @@
 /* h5format: see h5format.h; docs/format.md is the authority on the layout.
  *
- * Design notes a maintainer may question:
- *  - Files are created with libver bounds V110..V110 (superblock v3, object header v2).
- *    That format checksums every piece of metadata, so flipped bytes in metadata fail a
- *    checksum instead of being parsed, and it is the format single-writer/multiple-reader
- *    needs. Raw data chunks carry a Fletcher-32 checksum (last filter) for the same reason.
- *  - A v3 superblock records "open for write" while the writer runs; a writer killed
- *    before close leaves that mark, and a plain H5Fopen then refuses the file. The reader
- *    inspects the superblock itself first (it also checks the stored end-of-file address
- *    against the real size, which catches truncation before HDF5 parses anything) and opens
- *    such a file with H5F_ACC_SWMR_READ, which ignores the mark. Everything the writer had
- *    flushed (it flushes globally after every increment) is then readable.
- *  - Object time stamps are switched off (H5Pset_obj_track_times), so two runs with the
- *    same input produce the same bytes except the root attribute "created".
- *  - HDF5's automatic error printing is switched off (library code never prints); HDF5
- *    error stacks are turned into cdem_error messages naming the path and the object.
- *  - The series buffer has a fixed capacity allocated at create: append_series is called
- *    from the time-step loop and never allocates; a full buffer is written out. */
+ * Design notes a maintainer may question (docs/format.md has the measurements):
+ *  - Files are V110 (superblock v3, object header v2): every piece of metadata carries a
+ *    checksum, so flipped bytes fail a checksum instead of being parsed. Raw chunks carry
+ *    Fletcher-32. Strings are fixed-length: variable-length ones live in the global heap,
+ *    which has no checksum, and HDF5 1.10 crashes on a corrupt one.
+ *  - A v3 superblock is marked "open for write" while the writer runs; a writer killed
+ *    before close leaves the mark and a plain H5Fopen refuses the file. The reader reads
+ *    the superblock itself first (also comparing its end-of-file address with the real
+ *    size, which catches truncation before HDF5 parses anything) and opens a marked file
+ *    with the "clear_status_flags" property h5clear uses (read-only: nothing is written).
+ *  - Crash consistency between flushes: no metadata cache evictions (metadata is written
+ *    only by the flush after each increment), compact links in /increments and unfiltered
+ *    series chunks (nothing the last flushed metadata points to is freed and reused).
+ *  - Object time stamps are off: same input, same bytes except the attribute "created".
+ *  - HDF5's error printing is off; its error stack becomes part of cdem_error messages.
+ *  - append_series is called from the time-step loop: it never allocates (fixed buffer). */
 #include "h5format.h"
 
 #include <hdf5.h>
@@ -33,11 +32,11 @@
 #include <time.h>
 
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
- * after byte shuffle; level 9 saved < 1 % more and took 3x longer. Per-increment datasets
- * are one chunk up to CHUNK_ELEMS elements (a chunk of 8192 doubles is 64 KiB). */
+ * after byte shuffle; levels 6 and 9 saved 0.2 % more for 20-30 % more CPU. Per-increment
+ * datasets are one chunk up to CHUNK_ELEMS elements (8192 doubles = 64 KiB). */
 #define DEFLATE_LEVEL   4
 #define CHUNK_ELEMS     8192
-#define SERIES_CHUNK    1024
+#define SERIES_CHUNK    512
 #define SERIES_BUFFER   256
 #define XMF_EVERY_LIMIT 1000
 /* Largest element count a reader accepts (ids are int32). */
