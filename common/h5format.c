@@ -1244,6 +1244,19 @@ static cdem_status load_into(cdem_h5_reader *r, hid_t g, const incr_entry *e, cd
                          "%s: /increments/%s has %d of the 3 stress datasets sxx, syy, sxy (all "
                          "or none allowed)",
                          r->path, e->name, nstress);
+    /* Check the length before allocating for it: n comes from an attribute. */
+    hid_t ids = H5Dopen2(g, "id", H5P_DEFAULT);
+    hid_t sp = ids >= 0 ? H5Dget_space(ids) : -1;
+    hssize_t len = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    if (sp >= 0)
+        H5Sclose(sp);
+    if (ids >= 0)
+        H5Dclose(ids);
+    if (len < 0 || (hsize_t)len != n)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: dataset /increments/%s/id is %s (attribute n = %llu)", r->path,
+                         e->name, len < 0 ? "missing or unreadable" : "of another length",
+                         (unsigned long long)n);
     cdem_state_free(s);
     CDEM_TRY(cdem_state_init(s, (size_t)n, nstress == 3, err));
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {

@@ -120,7 +120,8 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err);
 
-/* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero). */
+/* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
+ * s must be zeroed ({0}) or initialised; on failure it is left empty. */
 cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_state *s,
                                           cdem_increment_info *info, cdem_error *err);
 
