@@ -1045,6 +1045,12 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
         H5Pset_file_locking(fapl, 0, 1);
     }
     r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    if (r->file < 0 && r->unclosed) {
+        /* The writer may be this very process (HDF5 then shares its open file, and the
+         * access properties must match the writer's). */
+        H5Eclear2(H5E_DEFAULT);
+        r->file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    }
     if (r->file < 0) {
         cdem_status st = H5FAIL(err, CDEM_ERR_FORMAT,
                                 "%s: cannot open as HDF5 (truncated or corrupt file?)", path);

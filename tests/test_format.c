@@ -204,7 +204,8 @@ static void test_format_roundtrip_all_fields(void **state) {
                                "boundary.fault_file=faults/my fault.txt",
                                "material.material=bonded",
                                "output.prefix=run7_",
-                               "boundary.fault_dip=37.5"};
+                               "boundary.fault_dip=37.5",
+                               "assembly.wall_height_multiplier=3"};
     for (size_t i = 0; i < sizeof overrides / sizeof overrides[0]; i++)
         assert_int_equal(cdem_params_override(&p, overrides[i], &err), CDEM_OK);
     const char *params_text = "# my model\n[time]\nruntime = 5000\n\n[assembly]\nseed = 424242\n";
@@ -466,6 +467,134 @@ static void test_format_inconsistent_datasets(void **state) {
     assert_non_null(strstr(err.msg, "expected integer"));
     cdem_h5_reader_close(r);
     cdem_state_free(&s);
+    remove_pair(path);
+}
+
+/* Caller errors are reported, not crashed on. */
+static void test_format_invalid_arguments(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "args.h5");
+    cdem_error err;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_h5_writer *w = NULL;
+    cdem_run_meta no_params = {NULL, NULL, NULL, NULL, NULL};
+    assert_int_equal(cdem_h5_writer_create(path, NULL, &w, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_writer_create(path, &no_params, &w, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "meta->params"));
+    assert_int_equal(cdem_h5_writer_create(NULL, &no_params, &w, &err), CDEM_ERR_INVALID);
+    cdem_run_meta meta = {&p, NULL, NULL, NULL, NULL};
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    cdem_state s;
+    make_state(&s, 4, 1, 0);
+    cdem_increment_info info = make_info(-3, 0);
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "increment number -3 is negative"));
+    assert_int_equal(cdem_h5_writer_write_increment(w, NULL, &s, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_writer_append_series(w, NULL, &err), CDEM_ERR_INVALID);
+    cdem_state broken = s;
+    broken.born = NULL;
+    info = make_info(0, 0);
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &broken, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "missing arrays"));
+    assert_int_equal(cdem_h5_writer_set_stop_reason(NULL, "x", "y", &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_writer_set_stop_reason(w, NULL, NULL, &err), CDEM_OK); /* "" */
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(NULL, &r, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "");
+    size_t idx;
+    assert_int_equal(cdem_h5_reader_find_increment(r, NULL, &idx, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_reader_load_increment(r, 0, NULL, NULL, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_reader_read_series(r, NULL, NULL, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_h5_reader_params(r, NULL, &err), CDEM_ERR_INVALID);
+    cdem_h5_reader_close(r);
+    assert_int_equal(cdem_h5_reader_increment_count(NULL), 0);
+    cdem_state_free(&s);
+    remove_pair(path);
+}
+
+/* A reader may open the file while the writer still has it open, in another process (the
+ * usual case: cdem-strain during a run) or in the same one: it sees the increments of the
+ * writer's last flush. */
+static void test_format_read_while_writing(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "live.h5");
+    int up[2], down[2];
+    assert_int_equal(pipe(up), 0);
+    assert_int_equal(pipe(down), 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        cdem_params p;
+        cdem_params_defaults(&p);
+        cdem_run_meta meta = {&p, NULL, NULL, NULL, NULL};
+        cdem_h5_writer *w = NULL;
+        cdem_error err;
+        cdem_state s;
+        make_state(&s, 50, 3, 0);
+        if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
+            _exit(2);
+        for (int k = 0; k < 3; k++) {
+            cdem_increment_info info = make_info(k, 0);
+            if (cdem_h5_writer_write_increment(w, &info, &s, &err) != CDEM_OK)
+                _exit(3);
+            if (k == 1) { /* let the parent read, then go on */
+                char c;
+                if (write(up[1], "r", 1) != 1 || read(down[0], &c, 1) != 1)
+                    _exit(4);
+            }
+        }
+        _exit(cdem_h5_writer_close(w, &err) == CDEM_OK ? 0 : 5);
+    }
+    char c;
+    assert_int_equal(read(up[0], &c, 1), 1);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("open while another process writes: %s", err.msg);
+    assert_int_equal(cdem_h5_reader_unclosed(r), 1);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 2);
+    cdem_state expect, t = {0};
+    make_state(&expect, 50, 3, 0);
+    assert_int_equal(cdem_h5_reader_load_increment(r, 1, &t, NULL, &err), CDEM_OK);
+    assert_same_elements(&expect, &t);
+    cdem_h5_reader_close(r);
+    assert_int_equal(write(down[1], "g", 1), 1);
+    int status = 0;
+    assert_true(waitpid(pid, &status, 0) == pid);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_unclosed(r), 0);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 3);
+    cdem_h5_reader_close(r);
+    for (int i = 0; i < 2; i++) {
+        close(up[i]);
+        close(down[i]);
+    }
+
+    /* Same process: the writer is still open while the reader reads. */
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, NULL, NULL, NULL};
+    cdem_h5_writer *w = NULL;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    cdem_increment_info info = make_info(0, 0);
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &expect, &err), CDEM_OK);
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("open while this process writes: %s", err.msg);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 1);
+    assert_int_equal(cdem_h5_reader_load_increment(r, 0, &t, NULL, &err), CDEM_OK);
+    assert_same_elements(&expect, &t);
+    cdem_h5_reader_close(r);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    cdem_state_free(&t);
+    cdem_state_free(&expect);
     remove_pair(path);
 }
 
@@ -1093,6 +1222,8 @@ int main(void) {
         cmocka_unit_test(test_format_variable_element_counts),
         cmocka_unit_test(test_format_missing_optional_stress),
         cmocka_unit_test(test_format_inconsistent_datasets),
+        cmocka_unit_test(test_format_invalid_arguments),
+        cmocka_unit_test(test_format_read_while_writing),
         cmocka_unit_test(test_format_version_mismatch),
         cmocka_unit_test(test_format_not_cdem_files),
         cmocka_unit_test(test_format_truncated_files),
