@@ -80,6 +80,17 @@ static cdem_status h5_fail_at(cdem_error *err, cdem_status code, const char *fil
 }
 #define H5FAIL(err, code, ...) h5_fail_at((err), (code), __FILE__, __LINE__, __VA_ARGS__)
 
+/* Cleanup calls after a failure would clear HDF5's error stack (every API call resets it):
+ * set it aside first (keep_errors) and put it back after (restore_errors), so H5FAIL can
+ * still report it. */
+static hid_t keep_errors(int failed) {
+    return failed ? H5Eget_current_stack() : -1;
+}
+static void restore_errors(hid_t saved) {
+    if (saved >= 0)
+        H5Eset_current_stack(saved);
+}
+
 static void quiet_hdf5(void) {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 }
@@ -190,9 +201,11 @@ static int put_attr(hid_t obj, const char *name, hid_t ftype, hid_t mtype, const
     hid_t space = H5Screate(H5S_SCALAR);
     hid_t a = H5Acreate2(obj, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT);
     int ok = a >= 0 && H5Awrite(a, mtype, value) >= 0;
+    hid_t es = keep_errors(!ok);
     if (a >= 0)
         H5Aclose(a);
     H5Sclose(space);
+    restore_errors(es);
     return ok ? 0 : -1;
 }
 
@@ -243,11 +256,13 @@ static int get_num_attr(hid_t obj, const char *name, hid_t mtype, void *value) {
     H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
     int ok = (cls == H5T_INTEGER || cls == H5T_FLOAT) && sp >= 0 &&
              H5Sget_simple_extent_npoints(sp) == 1 && H5Aread(a, mtype, value) >= 0;
+    hid_t es = keep_errors(!ok);
     if (t >= 0)
         H5Tclose(t);
     if (sp >= 0)
         H5Sclose(sp);
     H5Aclose(a);
+    restore_errors(es);
     return ok ? 0 : -1;
 }
 
@@ -289,7 +304,8 @@ static int get_str_attr(hid_t obj, const char *name, char **out) {
         }
         free(buf);
     }
-done:
+done:;
+    hid_t es = keep_errors(rc < 0);
     if (mt >= 0)
         H5Tclose(mt);
     if (t >= 0)
@@ -297,6 +313,7 @@ done:
     if (sp >= 0)
         H5Sclose(sp);
     H5Aclose(a);
+    restore_errors(es);
     return rc;
 }
 
@@ -369,10 +386,12 @@ static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
                  (ms = H5Screate_simple(1, &count, NULL)) >= 0 &&
                  H5Dwrite(w->series[c], col->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE,
                           ms, fs, H5P_DEFAULT, w->column) >= 0;
+        hid_t es = keep_errors(!ok);
         if (fs >= 0)
             H5Sclose(fs);
         if (ms >= 0)
             H5Sclose(ms);
+        restore_errors(es);
         if (!ok)
             return H5FAIL(err, CDEM_ERR_IO, "%s: cannot append %zu samples to /series/%s", w->path,
                           w->nbuf, col->name);
@@ -691,10 +710,12 @@ static cdem_status write_element_dataset(cdem_h5_writer *w, hid_t g, const char 
     hid_t ds = H5Dcreate2(g, fd->name, el_file_type(fd->type), sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     int ok = ds >= 0 && (n == 0 || H5Dwrite(ds, el_mem_type(fd->type), H5S_ALL, H5S_ALL,
                                             H5P_DEFAULT, element_array(s, k)) >= 0);
+    hid_t es = keep_errors(!ok);
     if (ds >= 0)
         H5Dclose(ds);
     H5Pclose(dcpl);
     H5Sclose(sp);
+    restore_errors(es);
     if (!ok)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write dataset /increments/%s/%s (%llu values)",
                       w->path, gname, fd->name, (unsigned long long)n);
@@ -1312,10 +1333,12 @@ static int read_prefix(hid_t ds, hid_t mtype, hsize_t len, void *dst) {
     int ok = fs >= 0 && ms >= 0 &&
              H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &len, NULL) >= 0 &&
              H5Dread(ds, mtype, ms, fs, H5P_DEFAULT, dst) >= 0;
+    hid_t es = keep_errors(!ok);
     if (fs >= 0)
         H5Sclose(fs);
     if (ms >= 0)
         H5Sclose(ms);
+    restore_errors(es);
     return ok ? 0 : -1;
 }
 
