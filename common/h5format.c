@@ -838,21 +838,22 @@ typedef struct {
 } incr_entry;
 
 struct cdem_h5_reader {
-    hid_t file;    /* open HDF5 file */
-    char *path;    /* as given */
-    char *summary; /* root texts, "" when absent */
-    char *params_text;
-    char *stop_reason;
-    char *stop_detail;
-    char *program_version;
-    char *source;
-    char *created;
-    long seed;        /* root attribute seed */
-    int unclosed;     /* 1: the writer did not close the file (status flag set) */
-    size_t n_skipped; /* unclosed file: increments left out as incompletely flushed */
-    incr_entry *incr; /* increments sorted by number */
-    size_t n_incr;    /* entries in incr */
-    size_t cap_incr;  /* allocated entries */
+    hid_t file; /* open HDF5 file */
+    char *path; /* as given */
+    /* Root text attributes, malloc'd, "" when absent. */
+    char *summary;         /* model summary */
+    char *params_text;     /* original parameter-file text */
+    char *stop_reason;     /* "running", "completed", "interrupted", ... */
+    char *stop_detail;     /* free-text diagnosis */
+    char *program_version; /* version of the writing program */
+    char *source;          /* "cdem-run" or "cdem2d-import:<folder>" */
+    char *created;         /* ISO 8601 UTC creation time */
+    long seed;             /* root attribute seed */
+    int unclosed;          /* 1: the writer did not close the file (status flag set) */
+    size_t n_skipped;      /* unclosed file: increments left out as incompletely flushed */
+    incr_entry *incr;      /* increments sorted by number */
+    size_t n_incr;         /* entries in incr */
+    size_t cap_incr;       /* allocated entries */
 };
 
 void cdem_h5_reader_close(cdem_h5_reader *r) {
@@ -953,9 +954,9 @@ static cdem_status read_incr_info(cdem_h5_reader *r, hid_t g, const char *name,
     info->sea_level = NAN;
     int64_t n = -1;
     struct {
-        const char *key;
-        hid_t type;
-        void *dst;
+        const char *key; /* attribute name */
+        hid_t type;      /* memory type to read as */
+        void *dst;       /* destination field of info */
     } fields[] = {
         {"number", H5T_NATIVE_INT32, &info->number},
         {"step", H5T_NATIVE_INT64, &info->step},
