@@ -56,6 +56,9 @@ static herr_t collect_h5_error(unsigned n, const H5E_error2_t *e, void *data) {
         return 0;
     size_t len = strlen(t->text);
     snprintf(t->text + len, sizeof t->text - len, "%s%s", t->count ? "; " : "", e->desc);
+    for (char *c = t->text + len; *c; c++)
+        if (*c == '\n' || *c == '\r')
+            *c = ' '; /* one-line messages */
     t->count++;
     return 0;
 }
@@ -605,9 +608,8 @@ static void writer_release(cdem_h5_writer *w) {
 static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cdem_error *err) {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
-    /* Crash consistency between flushes (see the head comment): metadata reaches the disk
-     * only at a flush (no cache evictions), and freed file space is never reused, so a
-     * block the last flushed metadata still points to is never overwritten. */
+    /* Crash consistency between flushes (see the head comment): with evictions off,
+     * metadata reaches the disk only at a flush, never half-way through an increment. */
     H5AC_cache_config_t mdc;
     memset(&mdc, 0, sizeof mdc);
     mdc.version = H5AC__CURR_CACHE_CONFIG_VERSION;
@@ -620,8 +622,10 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cd
     }
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
     w->file = H5Fcreate(w->path, H5F_ACC_TRUNC, fcpl, fapl);
+    hid_t es = keep_errors(w->file < 0);
     H5Pclose(fapl);
     H5Pclose(fcpl);
+    restore_errors(es);
     if (w->file < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the output file", w->path);
 
