@@ -4,15 +4,14 @@
  *
  * Layout (format version CDEM_FORMAT_VERSION):
  *   /                      attrs: format ("cdem-c"), format_version, program_version, seed,
- *                                 created, source, summary, params_text, stop_reason,
- *                                 stop_detail
+ *                                 created, summary, params_text, stop_reason, stop_detail
  *   /parameters            one attribute per parameter "section.key" (value as text) plus
  *                          a table dataset (name, value, unit)
  *   /increments/NNNNNN     one group per display increment (6-digit number), attrs: number,
- *                          step, time, phase, net_displacement, axial_strain,
- *                          differential_stress, sea_level, n;
+ *                          step, time, phase, net_displacement, axial_strain, sea_level, n;
  *                          datasets: id, x, y, radius, layer, flags, born [, sxx, syy, sxy]
- *   /series/<column>       extendible 1-D datasets sampled during the run
+ *   /series/<column>       extendible 1-D datasets sampled during the run (full list:
+ *                          docs/format.md; it also has source and differential_stress)
  * Every dataset is chunked and compressed (shuffle + deflate). The writer flushes after
  * every increment, so a file whose writer died keeps every increment completed before.
  * Ownership: writer and reader are opaque handles; _close/_free release them.
@@ -27,7 +26,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define CDEM_FORMAT_NAME    "cdem-c"
+#define CDEM_FORMAT_NAME "cdem-c"
 #define CDEM_FORMAT_VERSION 1
 
 typedef enum {
@@ -38,16 +37,16 @@ typedef enum {
 
 /* What is known about one display increment. */
 typedef struct {
-    int32_t number;             /* increment number, 0 = start of equilibration */
-    int64_t step;               /* time step at which it was written */
-    double time;                /* model time, s */
-    int32_t phase;              /* cdem_phase */
-    double net_displacement;    /* m, displacement of the moving boundary (net under inversion) */
-    double axial_strain;        /* biaxial test: platen shortening / initial height; else 0 */
+    int32_t number;          /* increment number, 0 = start of equilibration */
+    int64_t step;            /* time step at which it was written */
+    double time;             /* model time, s */
+    int32_t phase;           /* cdem_phase */
+    double net_displacement; /* m, displacement of the moving boundary (net under inversion) */
+    double axial_strain;     /* biaxial test: platen shortening / initial height; else 0 */
     double differential_stress; /* biaxial test: sigma1 - sigma3 in N/m; else 0 */
-    double sea_level;           /* m; NaN when there is no sedimentation */
-    int64_t n_elements;         /* element count of the increment (filled by the reader) */
-    int32_t has_stress;         /* 1 when sxx, syy, sxy are stored (filled by the reader) */
+    double sea_level;        /* m; NaN when there is no sedimentation */
+    int64_t n_elements;      /* element count of the increment (filled by the reader) */
+    int32_t has_stress;      /* 1 when sxx, syy, sxy are stored (filled by the reader) */
 } cdem_increment_info;
 
 /* One time-series sample. Columns with no meaning for the mode are 0. */
@@ -82,8 +81,8 @@ typedef struct cdem_h5_writer cdem_h5_writer;
 
 /* Creates path (truncating), writes the metadata and the .xmf sidecar placeholder, and
  * flushes. Fails with CDEM_ERR_IO naming the path if it cannot be created. */
-cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,
-                                  cdem_error *err);
+cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta,
+                                  cdem_h5_writer **out, cdem_error *err);
 
 /* Appends one increment (all s->n elements; stress when s->has_stress), updates the .xmf
  * sidecar and flushes the file. */
@@ -117,8 +116,8 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
 
 /* Resolves "K" (an increment number), "last", "first" or "equil" (the last increment of the
  * equilibration phase) to an index. */
-cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
-                                          cdem_error *err);
+cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec,
+                                          size_t *index, cdem_error *err);
 
 /* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
  * s must be zeroed ({0}) or initialised; on failure it is left empty. */
@@ -137,7 +136,7 @@ const char *cdem_h5_reader_program_version(const cdem_h5_reader *r);
 long cdem_h5_reader_seed(const cdem_h5_reader *r);
 /* Added after the first interface: the stop diagnosis, the source ("cdem-run", ...), the
  * creation time (ISO 8601 UTC) and whether the writer never closed the file (it died or
- * is still running; the file is then read as a single-writer/multiple-reader reader). */
+ * is still running; see docs/format.md, "A writer that dies"). */
 const char *cdem_h5_reader_stop_detail(const cdem_h5_reader *r);
 const char *cdem_h5_reader_source(const cdem_h5_reader *r);
 const char *cdem_h5_reader_created(const cdem_h5_reader *r);

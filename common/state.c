@@ -75,8 +75,8 @@ cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) 
 cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
     if (s->has_stress)
         return CDEM_OK;
-        /* All three or none: a partial failure frees what it got (a retry must not leak). */
 #define ALLOC_ONE(name, type) s->name = calloc(s->capacity ? s->capacity : 1, sizeof(type));
+    /* All three or none: a partial failure frees what it got (a retry must not leak). */
     STRESS_ARRAYS(ALLOC_ONE)
 #undef ALLOC_ONE
     if (!s->sxx || !s->syy || !s->sxy) {
@@ -86,9 +86,7 @@ cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
         STRESS_ARRAYS(DROP_ONE)
 #undef DROP_ONE
         return CDEM_FAIL(err, CDEM_ERR_NOMEM,
-                         "out of memory allocating stress arrays for %zu "
-                         "elements",
-                         s->capacity);
+                         "out of memory allocating stress arrays for %zu elements", s->capacity);
     }
     s->has_stress = 1;
     return CDEM_OK;
