@@ -1,0 +1,391 @@
+/* run: see run.h. The run loop of cdem-run:
+ *   derive the model -> build the assembly -> boundary mode init (adds its elements) ->
+ *   writer -> increment 0 -> equilibration (walls still) -> at its last step: 24 layers,
+ *   initial cohesion/bonds, increment n_equil -> deformation (mode apply every step) ->
+ *   increments on the model schedule, time-series samples every series_interval steps.
+ * Stop request: the current step finishes, a final increment is written, the stop reason
+ * "interrupted" is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop
+ * reason "numerical-failure" with the diagnosis, file closed (every increment written so
+ * far stays readable), CDEM_ERR_NUMERIC returned. opt->max_steps > 0 ends the run early
+ * ("stopped-early", CDEM_OK). Progress goes to opt->log only (never stdout); the wall clock
+ * is read only for the progress display, never for results. */
+#include "run.h"
+
+#include "assembly.h"
+#include "bc.h"
+#include "h5format.h"
+#include "integrate.h"
+#include "model.h"
+#include "stress.h"
+#include "summary.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef CDEM_VERSION
+#define CDEM_VERSION "0.0.0"
+#endif
+
+/* Everything a run owns, released by run_free. */
+typedef struct {
+    const cdem_params *p;        /* parameters (caller's) */
+    const cdem_run_options *opt; /* options (caller's) */
+    cdem_model m;                /* derived constants */
+    cdem_state s;                /* the elements */
+    cdem_assembly_info info;     /* what the assembly generator built */
+    cdem_bc bc;                  /* boundary mode */
+    cdem_integrator it;          /* time stepper */
+    cdem_h5_writer *w;           /* output file */
+    char *summary;               /* summary + mode view, malloc'd */
+    long step;                   /* last completed step */
+    int next_inc;                /* number of the next increment to write */
+    long last_written_step;      /* step of the last increment written (-1: none) */
+    double base_tol_y;           /* m, wall elements with y below this are the base */
+    long removed;                /* escaped elements removed */
+    double t_start, t_last_log;  /* s, monotonic clock (progress display only) */
+    long last_log_step;          /* step of the last progress output */
+    int tty_line_open;           /* 1 when a progress line is drawn without newline */
+} run_ctx;
+
+static double now_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int logging(const run_ctx *r) {
+    return !r->opt->quiet && r->opt->log;
+}
+
+static void end_progress_line(run_ctx *r) {
+    if (r->tty_line_open && r->opt->log) {
+        fputc('\n', r->opt->log);
+        r->tty_line_open = 0;
+    }
+}
+
+static const char *phase_name(int phase) {
+    return phase == CDEM_PHASE_EQUILIBRATION ? "equilibration"
+           : phase == CDEM_PHASE_DEFORMATION ? "deformation"
+                                             : "settling";
+}
+
+static int phase_of(const run_ctx *r, long step) {
+    return step <= r->m.equil_steps ? CDEM_PHASE_EQUILIBRATION : CDEM_PHASE_DEFORMATION;
+}
+
+static void progress(run_ctx *r, int force) {
+    if (!logging(r))
+        return;
+    const double t = now_s();
+    const long total = r->m.total_steps;
+    const double elapsed = t - r->t_start;
+    const double rate = elapsed > 0.0 ? (double)r->step / elapsed : 0.0;
+    const double left = rate > 0.0 ? (double)(total - r->step) / rate : 0.0;
+    const double net = cdem_bc_net_displacement(&r->bc);
+    const int inc_done = r->next_inc - 1;
+    if (r->opt->progress_is_tty) {
+        if (!force && t - r->t_last_log < 0.25)
+            return;
+        fprintf(r->opt->log,
+                "\r\033[K%s, increment %d/%d, net displacement %.1f m, %zu elements, %.0f "
+                "steps/s, %.0f s left",
+                phase_name(phase_of(r, r->step)), inc_done, r->m.n_increments_total, net, r->s.n,
+                rate, left);
+        fflush(r->opt->log);
+        r->tty_line_open = 1;
+    } else {
+        const long tenth = total / 10 > 0 ? total / 10 : 1;
+        if (!force && r->step - r->last_log_step < tenth && t - r->t_last_log < 30.0)
+            return;
+        fprintf(r->opt->log,
+                "cdem-run: %s, step %ld/%ld, increment %d/%d, net displacement %.1f m, %zu "
+                "elements, %.0f steps/s, %.0f s left\n",
+                phase_name(phase_of(r, r->step)), r->step, total, inc_done, r->m.n_increments_total,
+                net, r->s.n, rate, left);
+        fflush(r->opt->log);
+        r->last_log_step = r->step;
+    }
+    r->t_last_log = t;
+}
+
+/* 24 pre-growth layers of equal thickness between the lowest and highest free-element
+ * centres at the end of equilibration; layer 1 at the bottom; walls keep layer 0. */
+static void assign_layers(cdem_state *s) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        lo = fmin(lo, s->y[i]);
+        hi = fmax(hi, s->y[i]);
+    }
+    if (!(hi > lo))
+        return;
+    const double th = (hi - lo) / CDEM_PREGROWTH_LAYERS;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY) {
+            s->layer[i] = 0;
+            continue;
+        }
+        long k = (long)floor((s->y[i] - lo) / th) + 1;
+        if (k < 1)
+            k = 1;
+        if (k > CDEM_PREGROWTH_LAYERS)
+            k = CDEM_PREGROWTH_LAYERS;
+        s->layer[i] = (int32_t)k;
+    }
+}
+
+static cdem_status write_increment(run_ctx *r, cdem_error *err) {
+    if (r->p->calculate_stress)
+        CDEM_TRY(cdem_stress_compute(&r->it.nb, &r->s, err));
+    cdem_increment_info inf;
+    memset(&inf, 0, sizeof inf);
+    inf.number = r->next_inc;
+    inf.step = r->step;
+    inf.time = (double)r->step * r->m.dt;
+    inf.phase = phase_of(r, r->step);
+    inf.net_displacement = cdem_bc_net_displacement(&r->bc);
+    inf.sea_level = NAN;
+    inf.n_elements = (int64_t)r->s.n;
+    inf.has_stress = r->s.has_stress;
+    CDEM_TRY(cdem_h5_writer_write_increment(r->w, &inf, &r->s, err));
+    r->next_inc++;
+    r->last_written_step = r->step;
+    return CDEM_OK;
+}
+
+static cdem_status write_sample(run_ctx *r, cdem_error *err) {
+    cdem_series_sample q;
+    memset(&q, 0, sizeof q);
+    q.step = r->step;
+    q.time = (double)r->step * r->m.dt;
+    const cdem_state *s = &r->s;
+    double ke = 0.0, bfx = 0.0, bfy = 0.0, gfx = 0.0, gfy = 0.0;
+    for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible sums */
+        const uint32_t f = s->flags[i];
+        if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            ke += 0.5 * s->mass[i] * (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]);
+        } else if (f & CDEM_FLAG_MOVING) {
+            bfx += s->fx[i];
+            bfy += s->fy[i];
+        } else if ((f & CDEM_FLAG_WALL) && s->y[i] <= r->base_tol_y) {
+            gfx += s->fx[i];
+            gfy += s->fy[i];
+        }
+    }
+    long contacts = 0, bonds = 0;
+    cdem_integrator_count(&r->it, &contacts, &bonds);
+    q.kinetic_energy = ke;
+    q.contacts = contacts;
+    q.bonds = bonds;
+    q.n_elements = (int64_t)s->n;
+    q.net_displacement = cdem_bc_net_displacement(&r->bc);
+    q.boundary_force_x = bfx;
+    q.boundary_force_y = bfy;
+    q.base_force_x = gfx;
+    q.base_force_y = gfy;
+    q.sea_level = NAN;
+    return cdem_h5_writer_append_series(r->w, &q, err);
+}
+
+/* Features of later issues: refuse clearly rather than ignore silently. */
+static cdem_status check_supported(const cdem_params *p, cdem_error *err) {
+    struct {
+        int on;
+        const char *what;
+    } const rows[] = {
+        {p->sedimentation != 0, "surface.sedimentation = on"},
+        {p->erosion != 0, "surface.erosion = on"},
+        {p->overburden_pressure != 0.0, "surface.overburden_pressure > 0"},
+        {p->flexural_slip != 0, "heterogeneity.flexural_slip = on"},
+        {p->weak_interval != CDEM_WEAK_OFF, "heterogeneity.weak_interval (lower/upper)"},
+        {p->layered_friction != 0, "heterogeneity.layered_friction = on"},
+    };
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++)
+        if (rows[i].on)
+            return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                             "%s is not implemented in this build of the solver yet; turn it "
+                             "off to run",
+                             rows[i].what);
+    return CDEM_OK;
+}
+
+static cdem_status make_summary(run_ctx *r, cdem_error *err) {
+    char *text = NULL;
+    CDEM_TRY(cdem_summary_text(r->p, &r->m, r->info.n_internal, r->info.n_wall, 0, &text, err));
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f) {
+        free(text);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the summary text");
+    }
+    fputs(text, f);
+    const size_t tl = strlen(text);
+    if (tl == 0 || text[tl - 1] != '\n')
+        fputc('\n', f);
+    cdem_bc_view(&r->bc, f);
+    fprintf(f,
+            "Solver: velocity Verlet, dt %.6g s, Verlet-list skin %.4g m, %s contacts; "
+            "cohesion/bonds created for touching pairs at the end of equilibration.\n",
+            r->m.dt, r->it.nb.skin,
+            r->p->material == CDEM_MATERIAL_BONDED ? "bonded" : "frictional-cohesive");
+    fclose(f);
+    free(text);
+    r->summary = buf;
+    return CDEM_OK;
+}
+
+static void log_removed(run_ctx *r) {
+    if (r->it.n_removed_last == 0)
+        return;
+    r->removed += (long)r->it.n_removed_last;
+    if (!logging(r))
+        return;
+    end_progress_line(r);
+    for (size_t k = 0; k < r->it.n_removed_last; k++)
+        fprintf(r->opt->log,
+                "cdem-run: removed escaping element id %d at step %ld (%ld removed so far)\n",
+                (int)r->it.removed_ids[k], r->step, r->removed);
+}
+
+static cdem_status run_body(run_ctx *r, cdem_error *err) {
+    const cdem_params *p = r->p;
+    const cdem_run_options *opt = r->opt;
+    CDEM_TRY(check_supported(p, err));
+    CDEM_TRY(cdem_model_derive(p, &r->m, err));
+    CDEM_TRY(cdem_state_init(&r->s, 1024, p->calculate_stress, err));
+    CDEM_TRY(cdem_assembly_build(p, &r->m, &r->s, &r->info, err));
+    double ywall = INFINITY;
+    for (size_t i = 0; i < r->s.n; i++)
+        if (r->s.flags[i] & CDEM_FLAG_WALL)
+            ywall = fmin(ywall, r->s.y[i]);
+    r->base_tol_y = ywall + 0.5 * r->m.radius[0];
+    CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
+    CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
+    cdem_integrator_enable_escape(&r->it);
+    CDEM_TRY(make_summary(r, err));
+    const cdem_run_meta meta = {
+        .params = p,
+        .params_text = opt->params_text,
+        .summary = r->summary,
+        .program_version = CDEM_VERSION,
+        .source = "cdem-run",
+    };
+    CDEM_TRY(cdem_h5_writer_create(opt->output_path, &meta, &r->w, err));
+
+    r->t_start = r->t_last_log = now_s();
+    r->step = 0;
+    r->next_inc = 0;
+    r->last_written_step = -1;
+    CDEM_TRY(cdem_integrator_prime(&r->it, &r->s, err));
+    log_removed(r);
+    CDEM_TRY(write_increment(r, err));
+    CDEM_TRY(write_sample(r, err));
+
+    const long total = r->m.total_steps;
+    const long equil = r->m.equil_steps;
+    const long interval = p->series_interval > 0 ? p->series_interval : 1;
+    long next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
+    while (r->step < total) {
+        const long step = r->step + 1;
+        const int deforming = step > equil;
+        /* wall forces are summed only on the steps whose sample reports them */
+        r->it.boundary_forces = (step % interval == 0);
+        cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL,
+                                              step - equil, r->m.displacement_per_step, err);
+        if (st != CDEM_OK)
+            return st;
+        r->step = step;
+        log_removed(r);
+        if (step == equil) {
+            assign_layers(&r->s);
+            long made = cdem_integrator_make_cohesive(&r->it, &r->s);
+            if (logging(r) && !opt->progress_is_tty)
+                fprintf(opt->log, "cdem-run: end of equilibration at step %ld: %ld %s created\n",
+                        step, made,
+                        p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
+        }
+        if (step % interval == 0)
+            CDEM_TRY(write_sample(r, err));
+        while (r->next_inc <= r->m.n_increments_total && step >= next_inc_step) {
+            CDEM_TRY(write_increment(r, err));
+            next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
+        }
+        if (step % 64 == 0)
+            progress(r, 0);
+        if (opt->stop_requested && *opt->stop_requested) {
+            if (r->last_written_step != step)
+                CDEM_TRY(write_increment(r, err));
+            char detail[256];
+            snprintf(detail, sizeof detail,
+                     "stopped by a signal after step %ld of %ld (%s), last increment %d", step,
+                     total, phase_name(phase_of(r, step)), r->next_inc - 1);
+            CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "interrupted", detail, err));
+            return CDEM_FAIL(err, CDEM_ERR_INTERRUPTED, "%s; the file %s is valid", detail,
+                             opt->output_path);
+        }
+        if (opt->max_steps > 0 && step >= opt->max_steps && step < total) {
+            if (r->last_written_step != step)
+                CDEM_TRY(write_increment(r, err));
+            char detail[256];
+            snprintf(detail, sizeof detail, "max_steps = %ld reached at step %ld of %ld",
+                     opt->max_steps, step, total);
+            CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "stopped-early", detail, err));
+            return CDEM_OK;
+        }
+    }
+    if (r->last_written_step != r->step)
+        CDEM_TRY(write_increment(r, err));
+    char detail[256];
+    snprintf(detail, sizeof detail, "%ld steps, %d increments, %ld escaping elements removed",
+             r->step, r->next_inc - 1, r->removed);
+    return cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err);
+}
+
+cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_error *err) {
+    if (!p || !opt || !opt->output_path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_run: parameters, options and an output path are required");
+    run_ctx r;
+    memset(&r, 0, sizeof r);
+    r.p = p;
+    r.opt = opt;
+    cdem_status st = run_body(&r, err);
+    if (logging(&r)) {
+        progress(&r, 1);
+        end_progress_line(&r);
+    }
+    if (r.w) {
+        if (st != CDEM_OK && st != CDEM_ERR_INTERRUPTED) {
+            /* record the diagnosis in the file; keep the original error */
+            cdem_error e2;
+            cdem_error_clear(&e2);
+            (void)cdem_h5_writer_set_stop_reason(
+                r.w, st == CDEM_ERR_NUMERIC ? "numerical-failure" : "error",
+                err ? err->msg : cdem_status_str(st), &e2);
+        }
+        cdem_error e3;
+        cdem_error_clear(&e3);
+        cdem_status cst = cdem_h5_writer_close(r.w, st == CDEM_OK ? err : &e3);
+        if (st == CDEM_OK)
+            st = cst;
+    }
+    cdem_integrator_free(&r.it);
+    cdem_bc_free(&r.bc);
+    cdem_state_free(&r.s);
+    free(r.summary);
+    return st;
+}
+
+cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long *n_wall,
+                                    cdem_error *err) {
+    if (!p)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_count_elements: NULL parameters");
+    cdem_model m;
+    CDEM_TRY(cdem_model_derive(p, &m, err));
+    return cdem_assembly_count(p, &m, n_internal, n_wall, err);
+}

@@ -1,0 +1,200 @@
+/* Tests of solver/run: a short end-to-end run of a small model (10 x 2.5 units) written to
+ * CDEM_TEST_TMP and read back (increments, phases, layers, net displacement, time series,
+ * stop reason), early stop by max_steps, interruption by the stop flag, and refused
+ * parameters. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "h5format.h"
+#include "model.h"
+#include "run.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void tmp_path(char *buf, size_t n, const char *name) {
+    const char *dir = getenv("CDEM_TEST_TMP");
+    snprintf(buf, n, "%s/%s", dir && *dir ? dir : "/tmp", name);
+}
+
+static cdem_params small_params(void) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.width = 10.0;
+    p.height = 2.5;
+    p.equilibration = 100.0;
+    p.runtime = 150.0;
+    p.series_interval = 50;
+    return p;
+}
+
+static cdem_run_options quiet_options(const char *path) {
+    cdem_run_options o;
+    memset(&o, 0, sizeof o);
+    o.output_path = path;
+    o.quiet = 1;
+    return o;
+}
+
+static void test_run_small_model_end_to_end(void **st) {
+    (void)st;
+    char path[1024];
+    tmp_path(path, sizeof path, "test_run_small.h5");
+    cdem_params p = small_params();
+    p.calculate_stress = 1;
+    cdem_model m;
+    cdem_error err;
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    char *logbuf = NULL;
+    size_t loglen = 0;
+    FILE *log = open_memstream(&logbuf, &loglen);
+    cdem_run_options o = quiet_options(path);
+    o.quiet = 0;
+    o.log = log;
+    o.progress_is_tty = 0;
+    cdem_status stt = cdem_run(&p, &o, &err);
+    fclose(log);
+    if (stt != CDEM_OK)
+        fail_msg("cdem_run: %s", err.msg);
+    /* plain progress lines (not a tty) */
+    assert_non_null(strstr(logbuf, "cdem-run: deformation, step"));
+    assert_non_null(strstr(logbuf, "end of equilibration at step"));
+    free(logbuf);
+
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_increment_count(r), (size_t)m.n_increments_total + 1);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "completed");
+    size_t ie = 0;
+    assert_int_equal(cdem_h5_reader_find_increment(r, "equil", &ie, &err), CDEM_OK);
+    cdem_increment_info info;
+    cdem_state s;
+    memset(&s, 0, sizeof s);
+    assert_int_equal(cdem_h5_reader_load_increment(r, ie, &s, &info, &err), CDEM_OK);
+    assert_int_equal(info.number, m.n_increments_equil);
+    assert_int_equal(info.step, m.equil_steps);
+    assert_int_equal(info.phase, CDEM_PHASE_EQUILIBRATION);
+    assert_float_equal(info.net_displacement, 0.0, 0.0);
+    /* 24 layers of equal thickness by height: layer k holds the centres between
+     * lo + (k-1) h/24 and lo + k h/24, lo/hi the lowest/highest free-element centre */
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < s.n; i++)
+        if (!(s.flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            lo = fmin(lo, s.y[i]);
+            hi = fmax(hi, s.y[i]);
+        }
+    int seen[25] = {0};
+    for (size_t i = 0; i < s.n; i++) {
+        if (s.flags[i] & CDEM_FLAGS_BOUNDARY) {
+            assert_int_equal(s.layer[i], 0);
+            continue;
+        }
+        assert_true(s.layer[i] >= 1 && s.layer[i] <= 24);
+        const double th = (hi - lo) / 24.0;
+        assert_true(s.y[i] >= lo + (s.layer[i] - 1) * th - 1e-6);
+        assert_true(s.y[i] <= lo + s.layer[i] * th + 1e-6);
+        seen[s.layer[i]] = 1;
+    }
+    assert_true(seen[1] && seen[24]);
+    /* stress present and compressive on average at depth */
+    assert_true(info.has_stress);
+    double mean_syy = 0.0;
+    long cnt = 0;
+    for (size_t i = 0; i < s.n; i++)
+        if (!(s.flags[i] & CDEM_FLAGS_BOUNDARY) && s.layer[i] <= 6) {
+            mean_syy += s.syy[i];
+            cnt++;
+        }
+    assert_true(cnt > 10 && mean_syy / (double)cnt > 0.0);
+    /* the last increment: end of the run, deformation, net displacement of the block */
+    assert_int_equal(
+        cdem_h5_reader_load_increment(r, cdem_h5_reader_increment_count(r) - 1, &s, &info, &err),
+        CDEM_OK);
+    assert_int_equal(info.step, m.total_steps);
+    assert_int_equal(info.phase, CDEM_PHASE_DEFORMATION);
+    const double net = (double)(m.total_steps - m.equil_steps) * m.displacement_per_step;
+    assert_float_equal(info.net_displacement, net, 1e-6 * net);
+    /* the time series: one sample at step 0 and every 50 steps */
+    cdem_series_sample *ser = NULL;
+    size_t ns = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &ser, &ns, &err), CDEM_OK);
+    assert_int_equal(ns, (size_t)(m.total_steps / 50) + 1);
+    assert_int_equal(ser[ns - 1].step, (m.total_steps / 50) * 50);
+    assert_true(ser[ns - 1].contacts > 1000);
+    assert_true(ser[ns - 1].bonds > 0);          /* cohesive contacts created at the end of equil */
+    assert_int_equal(ser[1].bonds, 0);           /* and not before */
+    assert_true(ser[ns - 1].base_force_y < 0.0); /* the assembly's weight pushes the base down */
+    free(ser);
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+}
+
+static void test_run_stops_early_and_on_signal(void **st) {
+    (void)st;
+    char path[1024];
+    tmp_path(path, sizeof path, "test_run_stop.h5");
+    cdem_params p = small_params();
+    cdem_error err;
+    cdem_run_options o = quiet_options(path);
+    o.max_steps = 300;
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_OK);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
+    cdem_increment_info info;
+    assert_int_equal(
+        cdem_h5_reader_increment_info(r, cdem_h5_reader_increment_count(r) - 1, &info, &err),
+        CDEM_OK);
+    assert_int_equal(info.step, 300);
+    cdem_h5_reader_close(r);
+
+    volatile sig_atomic_t flag = 1; /* as if SIGINT arrived before the first step */
+    o.max_steps = 0;
+    o.stop_requested = &flag;
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_INTERRUPTED);
+    assert_non_null(strstr(err.msg, "stopped by a signal after step 1"));
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "interrupted");
+    assert_int_equal(cdem_h5_reader_increment_count(r), 2); /* start + final */
+    assert_int_equal(cdem_h5_reader_increment_info(r, 1, &info, &err), CDEM_OK);
+    assert_int_equal(info.step, 1);
+    cdem_h5_reader_close(r);
+}
+
+static void test_run_refuses_bad_requests(void **st) {
+    (void)st;
+    char path[1024];
+    tmp_path(path, sizeof path, "test_run_refused.h5");
+    cdem_params p = small_params();
+    cdem_error err;
+    cdem_run_options o = quiet_options(path);
+    p.mode = CDEM_MODE_DETACHMENT;
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_UNSUPPORTED);
+    assert_non_null(strstr(err.msg, "detachment"));
+    p = small_params();
+    p.sedimentation = 1;
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_UNSUPPORTED);
+    assert_non_null(strstr(err.msg, "sedimentation"));
+    p = small_params();
+    o.output_path = "/nonexistent-dir/x.h5";
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_IO);
+    assert_int_equal(cdem_run(&p, NULL, &err), CDEM_ERR_INVALID);
+    long ni = 0, nw = 0;
+    assert_int_equal(cdem_run_count_elements(&p, &ni, &nw, &err), CDEM_OK);
+    assert_true(ni > 500 && nw > 100);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_run_small_model_end_to_end),
+        cmocka_unit_test(test_run_stops_early_and_on_signal),
+        cmocka_unit_test(test_run_refuses_bad_requests),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
