@@ -143,7 +143,22 @@ static void test_run_stops_early_and_on_signal(void **st) {
     cdem_error err;
     cdem_run_options o = quiet_options(path);
     o.max_steps = 300;
+    /* on a tty: one line redrawn in place (carriage return, erase line) */
+    char *logbuf = NULL;
+    size_t loglen = 0;
+    FILE *log = open_memstream(&logbuf, &loglen);
+    o.quiet = 0;
+    o.progress_is_tty = 1;
+    o.log = log;
     assert_int_equal(cdem_run(&p, &o, &err), CDEM_OK);
+    fclose(log);
+    assert_non_null(strstr(logbuf, "\r\033[Kequilibration, increment "));
+    assert_non_null(strstr(logbuf, "steps/s"));
+    assert_null(strstr(logbuf, "cdem-run: equilibration, step")); /* no plain log lines */
+    assert_int_equal(logbuf[loglen - 1], '\n');                   /* line closed at the end */
+    free(logbuf);
+    o.quiet = 1;
+    o.log = NULL;
     cdem_h5_reader *r = NULL;
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
     assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
