@@ -16,7 +16,8 @@
  * four radii (50..125 m), seeded; plus a row of base wall elements (radius 50 m) at
  * y = -50 m. Dense like a settled assembly: every element has its lattice neighbours within
  * the strain search radius 2 x 125 m. Elements beyond n_target are not added. */
-static void make_packing(cdem_state *s, size_t n_target, double w, double h, unsigned long seed) {
+__attribute__((unused)) static void make_packing(cdem_state *s, size_t n_target, double w, double h,
+                                                 unsigned long seed) {
     cdem_error err;
     cdem_state_init(s, n_target + 64, 0, &err);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
@@ -36,7 +37,8 @@ static void make_packing(cdem_state *s, size_t n_target, double w, double h, uns
 }
 
 /* Applies x' = (x0, y0) + F (x - (x0, y0)) to every non-wall element of s. */
-static void deform_affine(cdem_state *s, const double F[4], double x0, double y0) {
+__attribute__((unused)) static void deform_affine(cdem_state *s, const double F[4], double x0,
+                                                  double y0) {
     for (size_t i = 0; i < s->n; i++) {
         if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
             continue;
