@@ -37,7 +37,8 @@ LIBANALYSIS := $(BUILD)/libcdemanalysis.a
 LIBS        := $(LIBANALYSIS) $(LIBSOLVER) $(LIBCOMMON)
 
 .PHONY: all test asan validate bench deps demo clean format tests-build
-all: $(BUILD)/cdem-run $(BUILD)/cdem-strain
+PROGRAMS := $(if $(wildcard solver/main.c),$(BUILD)/cdem-run) $(if $(wildcard analysis/main.c),$(BUILD)/cdem-strain)
+all: $(PROGRAMS)
 
 deps:
 	@sh scripts/deps.sh

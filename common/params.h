@@ -22,17 +22,20 @@
 typedef enum { CDEM_MATERIAL_GRANULAR = 0, CDEM_MATERIAL_BONDED = 1 } cdem_material_model;
 
 typedef enum {
-    CDEM_MODE_PLANAR_FAULT = 0,    /* planar normal/reverse fault, optional inversion */
-    CDEM_MODE_LISTRIC_FAULT,       /* left wall sculpted into a listric fault, footwall removed */
-    CDEM_MODE_IRREGULAR_FAULT,     /* as listric, fault shape read from fault_file */
-    CDEM_MODE_VERTICAL_FAULTS,     /* two vertical faults: caldera or piston */
-    CDEM_MODE_DETACHMENT,          /* lateral wall(s) move inward over the base */
-    CDEM_MODE_REPOSE,              /* lateral wall(s) removed after equilibration */
-    CDEM_MODE_BIAXIAL,             /* platens shorten a 10 x 5 unit sample, gravity off */
+    CDEM_MODE_PLANAR_FAULT = 0, /* planar normal/reverse fault, optional inversion */
+    CDEM_MODE_LISTRIC_FAULT,    /* left wall sculpted into a listric fault, footwall removed */
+    CDEM_MODE_IRREGULAR_FAULT,  /* as listric, fault shape read from fault_file */
+    CDEM_MODE_VERTICAL_FAULTS,  /* two vertical faults: caldera or piston */
+    CDEM_MODE_DETACHMENT,       /* lateral wall(s) move inward over the base */
+    CDEM_MODE_REPOSE,           /* lateral wall(s) removed after equilibration */
+    CDEM_MODE_BIAXIAL,          /* platens shorten a 10 x 5 unit sample, gravity off */
 } cdem_mode;
 
 typedef enum { CDEM_SENSE_NORMAL = 0, CDEM_SENSE_REVERSE = 1 } cdem_fault_sense;
-typedef enum { CDEM_KIN_CH = 0, CDEM_KIN_CD = 1 } cdem_fault_kinematics; /* constant heave / displacement */
+typedef enum {
+    CDEM_KIN_CH = 0,
+    CDEM_KIN_CD = 1
+} cdem_fault_kinematics; /* constant heave / displacement */
 typedef enum { CDEM_VERT_CALDERA = 0, CDEM_VERT_PISTON = 1 } cdem_vertical_sense;
 typedef enum { CDEM_WALLS_RIGHT = 0, CDEM_WALLS_BOTH = 1 } cdem_walls_choice;
 typedef enum { CDEM_WEAK_OFF = 0, CDEM_WEAK_LOWER = 1, CDEM_WEAK_UPPER = 2 } cdem_weak_interval;
@@ -63,7 +66,8 @@ typedef struct {
     /* [time] */
     double runtime;          /* total simulated time in s, >= 100 */
     double equilibration;    /* equilibration time in s, >= 100 and < runtime */
-    double display_interval; /* m of boundary displacement between increments (s for repose), 0.1-1000 */
+    double display_interval; /* m of boundary displacement between increments (s for repose),
+                                0.1-1000 */
 
     /* [physics] */
     double gravity;       /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
@@ -72,49 +76,49 @@ typedef struct {
     int calculate_stress; /* 0/1: store per-element stress in every increment */
 
     /* [material] */
-    cdem_material_model material;       /* granular (frictional-cohesive) or bonded */
-    int first_slip;                     /* 0/1: cohesion lost at first slip (1) or at separation (0) */
-    cdem_contact_material element;      /* element-element contacts */
-    cdem_contact_material wall;         /* element-wall contacts (base, lateral walls, platens) */
-    cdem_contact_material fault;        /* element-fault contacts */
+    cdem_material_model material;  /* granular (frictional-cohesive) or bonded */
+    int first_slip;                /* 0/1: cohesion lost at first slip (1) or at separation (0) */
+    cdem_contact_material element; /* element-element contacts */
+    cdem_contact_material wall;    /* element-wall contacts (base, lateral walls, platens) */
+    cdem_contact_material fault;   /* element-fault contacts */
 
     /* [heterogeneity] */
-    int flexural_slip;                   /* 0/1: contacts between different pre-growth layers have no strength */
-    cdem_weak_interval weak_interval;    /* off, lower or upper interval */
-    double weak_thickness_percent;       /* % of assembly height in the interval, 0-100 */
-    double weak_strength_percent;        /* % of material strength kept in the interval, 0-100 */
-    double weak_density_percent;         /* % of density in the interval, 50-100 */
-    int layered_friction;                /* 0/1: layers 5-8, 13-16, 21-24 take layered_friction_value */
-    double layered_friction_value;       /* friction coefficient of those layers, >= 0 */
+    int flexural_slip; /* 0/1: contacts between different pre-growth layers have no strength */
+    cdem_weak_interval weak_interval; /* off, lower or upper interval */
+    double weak_thickness_percent;    /* % of assembly height in the interval, 0-100 */
+    double weak_strength_percent;     /* % of material strength kept in the interval, 0-100 */
+    double weak_density_percent;      /* % of density in the interval, 50-100 */
+    int layered_friction;          /* 0/1: layers 5-8, 13-16, 21-24 take layered_friction_value */
+    double layered_friction_value; /* friction coefficient of those layers, >= 0 */
 
     /* [boundary] */
-    cdem_mode mode;                      /* faulting / boundary mode */
-    cdem_fault_sense fault_sense;        /* planar/listric/irregular: normal or reverse */
-    double fault_location;               /* fraction of the base length, 0-1 (exclusive) */
-    double fault_dip;                    /* degrees, planar: dip; listric: basal dip */
-    int inversion;                       /* 0/1: reverse the sense during the run */
-    double inversion_percent;            /* % of total displacement at which it inverts, 0-100 */
-    cdem_fault_kinematics kinematics;    /* listric/irregular: CH or CD */
-    char fault_file[CDEM_PATH_MAX];      /* irregular: text file of x y vertices in m */
-    double vertical_fault_location;      /* two vertical faults: first fault, fraction of base */
-    double vertical_fault_spacing;       /* distance to the second fault, fraction of base */
-    cdem_vertical_sense vertical_sense;  /* caldera (block down) or piston (block up) */
-    cdem_walls_choice detachment_walls;  /* right wall moving, or both */
-    cdem_walls_choice repose_walls;      /* right wall removed, or both */
-    double confining_pressure;           /* biaxial: N/m on the free edges, >= 0 */
+    cdem_mode mode;                     /* faulting / boundary mode */
+    cdem_fault_sense fault_sense;       /* planar/listric/irregular: normal or reverse */
+    double fault_location;              /* fraction of the base length, 0-1 (exclusive) */
+    double fault_dip;                   /* degrees, planar: dip; listric: basal dip */
+    int inversion;                      /* 0/1: reverse the sense during the run */
+    double inversion_percent;           /* % of total displacement at which it inverts, 0-100 */
+    cdem_fault_kinematics kinematics;   /* listric/irregular: CH or CD */
+    char fault_file[CDEM_PATH_MAX];     /* irregular: text file of x y vertices in m */
+    double vertical_fault_location;     /* two vertical faults: first fault, fraction of base */
+    double vertical_fault_spacing;      /* distance to the second fault, fraction of base */
+    cdem_vertical_sense vertical_sense; /* caldera (block down) or piston (block up) */
+    cdem_walls_choice detachment_walls; /* right wall moving, or both */
+    cdem_walls_choice repose_walls;     /* right wall removed, or both */
+    double confining_pressure;          /* biaxial: N/m on the free edges, >= 0 */
 
     /* [surface] */
-    double overburden_pressure;          /* N/m on the top surface; 0 = off */
-    int erosion;                         /* 0/1 */
-    double erosion_base_level;           /* multiple of assembly height, 1.0-10.0 */
-    int sedimentation;                   /* 0/1: syn-tectonic growth strata */
-    cdem_sea_level_rise sea_level_rise;  /* null, low, mid, high, very-high */
-    int growth_sequence1_layers;         /* growth layers in growth sequence 1, >= 1 */
+    double overburden_pressure;         /* N/m on the top surface; 0 = off */
+    int erosion;                        /* 0/1 */
+    double erosion_base_level;          /* multiple of assembly height, 1.0-10.0 */
+    int sedimentation;                  /* 0/1: syn-tectonic growth strata */
+    cdem_sea_level_rise sea_level_rise; /* null, low, mid, high, very-high */
+    int growth_sequence1_layers;        /* growth layers in growth sequence 1, >= 1 */
 
     /* [output] */
-    char prefix[64];                     /* prefix for per-increment exports (cdem282.txt) */
-    double total_strain_max;             /* colour-bar maximum for total strain, 0.1-5.0 */
-    int series_interval;                 /* time steps between time-series samples, >= 1 */
+    char prefix[64];         /* prefix for per-increment exports (cdem282.txt) */
+    double total_strain_max; /* colour-bar maximum for total strain, 0.1-5.0 */
+    int series_interval;     /* time steps between time-series samples, >= 1 */
 } cdem_params;
 
 typedef enum {
@@ -127,18 +131,18 @@ typedef enum {
 } cdem_param_type;
 
 typedef struct {
-    const char *section;  /* INI section, e.g. "assembly" */
-    const char *key;      /* key within the section, e.g. "width" */
-    cdem_param_type type; /* how the value is parsed and stored */
-    size_t offset;        /* offsetof(cdem_params, field) */
-    size_t size;          /* STRING: buffer size; otherwise unused (0) */
-    const char *unit;     /* "m", "s", "N/m", "" for none */
-    const char *def;      /* default, as it would be written in a file */
-    double min, max;      /* inclusive numeric range (DOUBLE/INT/LONG) */
-    int min_exclusive;    /* 1: value must be > min */
-    int max_exclusive;    /* 1: value must be < max */
+    const char *section;        /* INI section, e.g. "assembly" */
+    const char *key;            /* key within the section, e.g. "width" */
+    cdem_param_type type;       /* how the value is parsed and stored */
+    size_t offset;              /* offsetof(cdem_params, field) */
+    size_t size;                /* STRING: buffer size; otherwise unused (0) */
+    const char *unit;           /* "m", "s", "N/m", "" for none */
+    const char *def;            /* default, as it would be written in a file */
+    double min, max;            /* inclusive numeric range (DOUBLE/INT/LONG) */
+    int min_exclusive;          /* 1: value must be > min */
+    int max_exclusive;          /* 1: value must be < max */
     const char *const *choices; /* ENUM: NULL-terminated words */
-    const char *help;     /* one line */
+    const char *help;           /* one line */
 } cdem_param_def;
 
 /* The table, in file order. */
@@ -168,11 +172,14 @@ cdem_status cdem_params_override(cdem_params *p, const char *assignment, cdem_er
 cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err);
 
 /* Formats a parameter's current value as it would be written in a file. */
-void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, char *buf,
-                              size_t n);
+void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, char *buf, size_t n);
 
 /* Writes a complete, commented parameter file with the values of p. */
 void cdem_params_write(const cdem_params *p, FILE *out);
+
+/* Writes the parameter table as a markdown table (section, key, type, default, unit,
+ * range/values, help) for docs/parameters.md. Added for `cdem-run --params-markdown`. */
+void cdem_params_write_markdown(FILE *out);
 
 /* Words of enum values (for summaries and messages). */
 const char *cdem_mode_name(cdem_mode mode);

@@ -1,0 +1,1055 @@
+/* params: the parameter table, the INI parser, overrides, validation and the writers.
+ *
+ * One static const table (param_table) describes every field of cdem_params; everything
+ * else in this file is a loop over it. Defaults are stored as the text a user would write
+ * and are parsed by the same code as a file, so a default can never escape its own range
+ * check. The INI parser is hand-written (not libinih) because every message must carry the
+ * exact line number and the offending text, and because overrides (-s section.key=value)
+ * must go through the same assignment code as file lines.
+ * Key names are the field names of cdem_params; nested contact materials are flattened
+ * with an underscore (element.friction -> [material] element_friction).
+ * Nothing here allocates except cdem_params_load (the file text). */
+#include "params.h"
+
+#include "model.h"
+
+#include <assert.h>
+#include <ctype.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#define P_OFF(field) offsetof(cdem_params, field)
+
+/* Upper bound used for "no upper limit" rows; printed as "no upper limit". */
+#define NOMAX HUGE_VAL
+
+static const char *const material_words[] = {"granular", "bonded", NULL};
+static const char *const mode_words[] = {
+    "planar-fault", "listric-fault", "irregular-fault", "vertical-faults",
+    "detachment",   "repose",        "biaxial",         NULL};
+static const char *const sense_words[] = {"normal", "reverse", NULL};
+static const char *const kin_words[] = {"ch", "cd", NULL};
+static const char *const vert_words[] = {"caldera", "piston", NULL};
+static const char *const walls_words[] = {"right", "both", NULL};
+static const char *const weak_words[] = {"off", "lower", "upper", NULL};
+static const char *const sea_words[] = {"null", "low", "mid", "high", "very-high", NULL};
+
+/* Boolean spellings: bool_true_words[i] and bool_false_words[i] are a pair. */
+static const char *const bool_true_words[] = {"true", "yes", "on", "1", NULL};
+static const char *const bool_false_words[] = {"false", "no", "off", "0", NULL};
+
+/* Sections in file order. */
+static const char *const section_names[] = {"assembly", "time",          "physics",
+                                            "material", "heterogeneity", "boundary",
+                                            "surface",  "output",        NULL};
+
+/* clang-format off */
+static const cdem_param_def param_table[] = {
+    /* section, key, type, offset, size, unit, default, min, max, min_excl, max_excl, choices, help */
+    {"assembly", "width", CDEM_PTYPE_DOUBLE, P_OFF(width), 0, "units", "10", 10, 100, 0, 0, NULL,
+     "assembly width in model units"},
+    {"assembly", "height", CDEM_PTYPE_DOUBLE, P_OFF(height), 0, "units", "5", 2.5, 7.5, 0, 0, NULL,
+     "assembly height in model units"},
+    {"assembly", "unit_scaling", CDEM_PTYPE_DOUBLE, P_OFF(unit_scaling), 0, "m", "1000", 100, 1000, 0, 0, NULL,
+     "length of one model unit"},
+    {"assembly", "half_radii", CDEM_PTYPE_BOOL, P_OFF(half_radii), 0, "", "off", 0, 1, 0, 0, NULL,
+     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step)"},
+    {"assembly", "wall_height_multiplier", CDEM_PTYPE_INT, P_OFF(wall_height_multiplier), 0, "", "1", 1, 4, 0, 0, NULL,
+     "lateral wall height as a multiple of the assembly height"},
+    {"assembly", "seed", CDEM_PTYPE_LONG, P_OFF(seed), 0, "", "1", 0, 2147483647.0, 0, 0, NULL,
+     "random seed of the packing and of all other randomness"},
+
+    {"time", "runtime", CDEM_PTYPE_DOUBLE, P_OFF(runtime), 0, "s", "2000", 100, 1e6, 0, 0, NULL,
+     "total simulated time (simulation time, not geological time)"},
+    {"time", "equilibration", CDEM_PTYPE_DOUBLE, P_OFF(equilibration), 0, "s", "400", 100, 1e6, 0, 0, NULL,
+     "equilibration time before any boundary moves; must be shorter than runtime"},
+    {"time", "display_interval", CDEM_PTYPE_DOUBLE, P_OFF(display_interval), 0, "m", "5", 0.1, 1000, 0, 0, NULL,
+     "boundary displacement between display increments (seconds for mode = repose)"},
+
+    {"physics", "gravity", CDEM_PTYPE_DOUBLE, P_OFF(gravity), 0, "m/s^2", "9.81", 0.5, 25, 0, 0, NULL,
+     "gravitational acceleration (not applied in the biaxial test)"},
+    {"physics", "density", CDEM_PTYPE_DOUBLE, P_OFF(density), 0, "kg/m^3", "2500", 1500, 3500, 0, 0, NULL,
+     "element density"},
+    {"physics", "keep_constants", CDEM_PTYPE_BOOL, P_OFF(keep_constants), 0, "", "off", 0, 1, 0, 0, NULL,
+     "keep the 1000 m spring and damping constants whatever the unit scaling"},
+    {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
+     "store per-element stress in every increment"},
+
+    {"material", "material", CDEM_PTYPE_ENUM, P_OFF(material), 0, "", "granular", 0, 0, 0, 0, material_words,
+     "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)"},
+    {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
+     "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
+    {"material", "element_friction", CDEM_PTYPE_DOUBLE, P_OFF(element.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
+     "element-element friction coefficient"},
+    {"material", "element_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(element.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
+     "element-element cohesion force"},
+    {"material", "element_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(element.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
+     "bonded: element-element bond breaks when r - R >= breaking_strain * R"},
+    {"material", "wall_friction", CDEM_PTYPE_DOUBLE, P_OFF(wall.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
+     "element-wall friction coefficient (base, lateral walls, platens)"},
+    {"material", "wall_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(wall.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
+     "element-wall cohesion force"},
+    {"material", "wall_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(wall.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
+     "bonded: element-wall breaking strain"},
+    {"material", "fault_friction", CDEM_PTYPE_DOUBLE, P_OFF(fault.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
+     "element-fault friction coefficient (set 0 for CH kinematics)"},
+    {"material", "fault_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(fault.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
+     "element-fault cohesion force (set 0 for CH kinematics)"},
+    {"material", "fault_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(fault.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
+     "bonded: element-fault breaking strain"},
+
+    {"heterogeneity", "flexural_slip", CDEM_PTYPE_BOOL, P_OFF(flexural_slip), 0, "", "off", 0, 1, 0, 0, NULL,
+     "contacts between different pre-growth layers have no friction/cohesion (or no bond)"},
+    {"heterogeneity", "weak_interval", CDEM_PTYPE_ENUM, P_OFF(weak_interval), 0, "", "off", 0, 0, 0, 0, weak_words,
+     "weak and/or light interval at the bottom (lower) or top (upper) of the assembly"},
+    {"heterogeneity", "weak_thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_thickness_percent), 0, "%", "50", 0, 100, 0, 0, NULL,
+     "thickness of the weak interval, % of the assembly height"},
+    {"heterogeneity", "weak_strength_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_strength_percent), 0, "%", "0", 0, 100, 0, 0, NULL,
+     "strength kept in the weak interval, % of the material values (0 = frictionless/unbonded)"},
+    {"heterogeneity", "weak_density_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_density_percent), 0, "%", "100", 50, 100, 0, 0, NULL,
+     "density of the weak interval, % of the density"},
+    {"heterogeneity", "layered_friction", CDEM_PTYPE_BOOL, P_OFF(layered_friction), 0, "", "off", 0, 1, 0, 0, NULL,
+     "layers 5-8, 13-16 and 21-24 take layered_friction_value (granular only)"},
+    {"heterogeneity", "layered_friction_value", CDEM_PTYPE_DOUBLE, P_OFF(layered_friction_value), 0, "", "0.1", 0, 10, 0, 0, NULL,
+     "friction coefficient of layers 5-8, 13-16 and 21-24"},
+
+    {"boundary", "mode", CDEM_PTYPE_ENUM, P_OFF(mode), 0, "", "planar-fault", 0, 0, 0, 0, mode_words,
+     "boundary / faulting mode"},
+    {"boundary", "fault_sense", CDEM_PTYPE_ENUM, P_OFF(fault_sense), 0, "", "normal", 0, 0, 0, 0, sense_words,
+     "planar/listric/irregular fault: normal or reverse displacement"},
+    {"boundary", "fault_location", CDEM_PTYPE_DOUBLE, P_OFF(fault_location), 0, "", "0.5", 0, 1, 1, 1, NULL,
+     "fault location at the base, fraction of the base length"},
+    {"boundary", "fault_dip", CDEM_PTYPE_DOUBLE, P_OFF(fault_dip), 0, "degrees", "30", 0, 90, 1, 0, NULL,
+     "planar: fault dip; listric: dip of the lowest segment (it steepens to 90)"},
+    {"boundary", "inversion", CDEM_PTYPE_BOOL, P_OFF(inversion), 0, "", "off", 0, 1, 0, 0, NULL,
+     "invert the fault sense during the run (planar/listric/irregular)"},
+    {"boundary", "inversion_percent", CDEM_PTYPE_DOUBLE, P_OFF(inversion_percent), 0, "%", "50", 0, 100, 1, 1, NULL,
+     "% of the total displacement at which the sense inverts"},
+    {"boundary", "kinematics", CDEM_PTYPE_ENUM, P_OFF(kinematics), 0, "", "ch", 0, 0, 0, 0, kin_words,
+     "listric/irregular: constant heave (ch) or constant displacement (cd, mylar sheet)"},
+    {"boundary", "fault_file", CDEM_PTYPE_STRING, P_OFF(fault_file), CDEM_PATH_MAX, "", "", 0, 0, 0, 0, NULL,
+     "irregular fault: text file of x y vertices in m, from the base up-dip"},
+    {"boundary", "vertical_fault_location", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_location), 0, "", "0.35", 0, 1, 1, 1, NULL,
+     "two vertical faults: first fault, fraction of the base length"},
+    {"boundary", "vertical_fault_spacing", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_spacing), 0, "", "0.3", 0, 1, 1, 1, NULL,
+     "two vertical faults: distance to the second fault, fraction of the base length"},
+    {"boundary", "vertical_sense", CDEM_PTYPE_ENUM, P_OFF(vertical_sense), 0, "", "caldera", 0, 0, 0, 0, vert_words,
+     "two vertical faults: caldera (block down, extension) or piston (block up, compression)"},
+    {"boundary", "detachment_walls", CDEM_PTYPE_ENUM, P_OFF(detachment_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
+     "detachment: right wall moving, or both walls moving inward"},
+    {"boundary", "repose_walls", CDEM_PTYPE_ENUM, P_OFF(repose_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
+     "repose-collapse: right wall removed, or both, after equilibration"},
+    {"boundary", "confining_pressure", CDEM_PTYPE_DOUBLE, P_OFF(confining_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
+     "biaxial: confining pressure on the free edges (Pa in 3-D; 0 = uniaxial)"},
+
+    {"surface", "overburden_pressure", CDEM_PTYPE_DOUBLE, P_OFF(overburden_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
+     "vertical pressure on the top surface (0 = off)"},
+    {"surface", "erosion", CDEM_PTYPE_BOOL, P_OFF(erosion), 0, "", "off", 0, 1, 0, 0, NULL,
+     "remove elements above the erosion base level"},
+    {"surface", "erosion_base_level", CDEM_PTYPE_DOUBLE, P_OFF(erosion_base_level), 0, "", "1", 1, 10, 0, 0, NULL,
+     "erosion base level, multiple of the assembly height"},
+    {"surface", "sedimentation", CDEM_PTYPE_BOOL, P_OFF(sedimentation), 0, "", "off", 0, 1, 0, 0, NULL,
+     "syn-tectonic sedimentation below sea level (growth strata)"},
+    {"surface", "sea_level_rise", CDEM_PTYPE_ENUM, P_OFF(sea_level_rise), 0, "", "null", 0, 0, 0, 0, sea_words,
+     "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0"},
+    {"surface", "growth_sequence1_layers", CDEM_PTYPE_INT, P_OFF(growth_sequence1_layers), 0, "", "10", 1, 1000, 0, 0, NULL,
+     "growth layers coloured as growth sequence 1 (the rest are sequence 2)"},
+
+    {"output", "prefix", CDEM_PTYPE_STRING, P_OFF(prefix), sizeof(((cdem_params *)0)->prefix), "", "cdem", 0, 0, 0, 0, NULL,
+     "prefix of per-increment export files (cdem282.txt)"},
+    {"output", "total_strain_max", CDEM_PTYPE_DOUBLE, P_OFF(total_strain_max), 0, "", "2", 0.1, 5, 0, 0, NULL,
+     "colour-bar maximum for total strain"},
+    {"output", "series_interval", CDEM_PTYPE_INT, P_OFF(series_interval), 0, "steps", "100", 1, 1000000, 0, 0, NULL,
+     "time steps between time-series samples"},
+};
+/* clang-format on */
+
+#define N_PARAMS (sizeof param_table / sizeof param_table[0])
+
+const cdem_param_def *cdem_params_table(size_t *count) {
+    if (count)
+        *count = N_PARAMS;
+    return param_table;
+}
+
+const cdem_param_def *cdem_params_find(const char *section, const char *key) {
+    if (!section || !key)
+        return NULL;
+    for (size_t i = 0; i < N_PARAMS; i++)
+        if (strcmp(param_table[i].section, section) == 0 && strcmp(param_table[i].key, key) == 0)
+            return &param_table[i];
+    return NULL;
+}
+
+const char *cdem_mode_name(cdem_mode mode) {
+    if ((int)mode < 0 || (size_t)mode >= sizeof mode_words / sizeof mode_words[0] - 1)
+        return "unknown";
+    return mode_words[mode];
+}
+
+/* ---------- small text helpers ---------- */
+
+static int is_blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* Copies text[0..len) into buf (cut to n-1), trimming surrounding whitespace. */
+static void copy_trimmed(char *buf, size_t n, const char *text, size_t len) {
+    while (len > 0 && is_blank(*text)) {
+        text++;
+        len--;
+    }
+    while (len > 0 && is_blank(text[len - 1]))
+        len--;
+    if (len >= n)
+        len = n - 1;
+    memcpy(buf, text, len);
+    buf[len] = '\0';
+}
+
+/* Levenshtein distance of the first 63 characters of a and b (no allocation). */
+static size_t edit_distance(const char *a, const char *b) {
+    enum { CAP = 63 };
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > CAP)
+        la = CAP;
+    if (lb > CAP)
+        lb = CAP;
+    size_t prev[CAP + 1], cur[CAP + 1];
+    for (size_t j = 0; j <= lb; j++)
+        prev[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        cur[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t sub = prev[j - 1] +
+                         (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
+            size_t del = prev[j] + 1, ins = cur[j - 1] + 1;
+            size_t best = sub < del ? sub : del;
+            cur[j] = best < ins ? best : ins;
+        }
+        memcpy(prev, cur, (lb + 1) * sizeof prev[0]);
+    }
+    return prev[lb];
+}
+
+/* A suggestion is offered when the distance is small compared with the word. */
+static int close_enough(size_t dist, const char *word) {
+    size_t len = strlen(word);
+    size_t limit = len / 3 > 2 ? len / 3 : 2;
+    return dist <= limit;
+}
+
+/* Appends "w1, w2, w3" to buf. */
+static void join_words(const char *const *words, char *buf, size_t n) {
+    size_t pos = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; words[i] && pos < n; i++) {
+        int w = snprintf(buf + pos, n - pos, "%s%s", i ? ", " : "", words[i]);
+        if (w < 0)
+            break;
+        pos += (size_t)w;
+    }
+}
+
+/* Formats a double so that strtod gives back exactly the same value, as short as possible. */
+static void format_double(double v, char *buf, size_t n) {
+    if (v == floor(v) && fabs(v) < 1e7) { /* whole numbers up to 7 digits: "2000", not "2e+03" */
+        snprintf(buf, n, "%.0f", v);
+        return;
+    }
+    for (int prec = 1; prec <= 17; prec++) {
+        snprintf(buf, n, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            return;
+    }
+}
+
+/* Describes the allowed range: "between 0.5 and 25 m/s^2", "> 0 and <= 90 degrees",
+ * ">= 100 s". */
+static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
+    char lo[32], hi[32];
+    format_double(d->min, lo, sizeof lo);
+    format_double(d->max, hi, sizeof hi);
+    const char *sp = d->unit[0] ? " " : "";
+    if (d->max == NOMAX)
+        snprintf(buf, n, "%s %s%s%s", d->min_exclusive ? ">" : ">=", lo, sp, d->unit);
+    else if (!d->min_exclusive && !d->max_exclusive)
+        snprintf(buf, n, "between %s and %s%s%s", lo, hi, sp, d->unit);
+    else
+        snprintf(buf, n, "%s %s and %s %s%s%s", d->min_exclusive ? ">" : ">=", lo,
+                 d->max_exclusive ? "<" : "<=", hi, sp, d->unit);
+}
+
+/* Rounds v to 4 significant digits towards +inf (up = 1) or -inf (up = 0) and formats it, so
+ * that advice such as "at least X" is itself sufficient. */
+static void format_safe(double v, int up, char *buf, size_t n) {
+    if (!(v > 0) || !isfinite(v)) {
+        snprintf(buf, n, "%g", v);
+        return;
+    }
+    double mag = pow(10.0, floor(log10(v)) - 3.0);
+    double r = (up ? ceil(v / mag) : floor(v / mag)) * mag;
+    snprintf(buf, n, "%.4g", r);
+}
+
+/* Short "allowed values" text for comments and the markdown table. */
+static void describe_allowed(const cdem_param_def *d, char *buf, size_t n) {
+    switch (d->type) {
+    case CDEM_PTYPE_BOOL:
+        snprintf(buf, n, "on/off");
+        break;
+    case CDEM_PTYPE_ENUM:
+        join_words(d->choices, buf, n);
+        break;
+    case CDEM_PTYPE_STRING:
+        snprintf(buf, n, "text, at most %zu characters", d->size - 1);
+        break;
+    default: {
+        char lo[32], hi[32];
+        format_double(d->min, lo, sizeof lo);
+        format_double(d->max, hi, sizeof hi);
+        if (d->max == NOMAX)
+            snprintf(buf, n, "%s %s", d->min_exclusive ? ">" : ">=", lo);
+        else if (!d->min_exclusive && !d->max_exclusive)
+            snprintf(buf, n, "%s to %s", lo, hi);
+        else
+            snprintf(buf, n, "%s %s and %s %s", d->min_exclusive ? ">" : ">=", lo,
+                     d->max_exclusive ? "<" : "<=", hi);
+    }
+    }
+}
+
+static int in_range(const cdem_param_def *d, double v) {
+    if (!isfinite(v))
+        return 0;
+    if (d->min_exclusive ? !(v > d->min) : !(v >= d->min))
+        return 0;
+    if (d->max != NOMAX && (d->max_exclusive ? !(v < d->max) : !(v <= d->max)))
+        return 0;
+    return 1;
+}
+
+static const char *type_noun(cdem_param_type t) {
+    switch (t) {
+    case CDEM_PTYPE_INT:
+    case CDEM_PTYPE_LONG:
+        return "a whole number";
+    default:
+        return "a number";
+    }
+}
+
+/* ---------- assignment: the one path for file lines, defaults and overrides ---------- */
+
+/* Sets one parameter from its value text. where = "model.ini:12" or "-s a.b=c"; the message
+ * reads "<where>: <key> = <value>: <problem>". */
+static cdem_status assign_value(cdem_params *p, const cdem_param_def *d, const char *value,
+                                const char *where, cdem_error *err) {
+    char *field = (char *)p + d->offset;
+    switch (d->type) {
+    case CDEM_PTYPE_DOUBLE:
+    case CDEM_PTYPE_INT:
+    case CDEM_PTYPE_LONG: {
+        char range[160];
+        describe_range(d, range, sizeof range);
+        if (value[0] == '\0')
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: %s = : missing value; expected %s %s", where,
+                             d->key, type_noun(d->type), range);
+        char *end = NULL;
+        errno = 0;
+        double v = 0.0;
+        if (d->type == CDEM_PTYPE_DOUBLE) {
+            v = strtod(value, &end);
+        } else {
+            long long iv = strtoll(value, &end, 10);
+            v = (double)iv;
+        }
+        if (end == value || *end != '\0' || (d->type == CDEM_PTYPE_DOUBLE && !isfinite(v)))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: %s = %s: not %s; expected %s %s", where,
+                             d->key, value, type_noun(d->type), type_noun(d->type), range);
+        if (errno == ERANGE || !in_range(d, v))
+            return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s: %s = %s: must be %s", where, d->key, value,
+                             range);
+        if (d->type == CDEM_PTYPE_DOUBLE)
+            memcpy(field, &v, sizeof v);
+        else if (d->type == CDEM_PTYPE_INT) {
+            int iv = (int)v;
+            memcpy(field, &iv, sizeof iv);
+        } else {
+            long lv = (long)v;
+            memcpy(field, &lv, sizeof lv);
+        }
+        return CDEM_OK;
+    }
+    case CDEM_PTYPE_BOOL: {
+        int b = -1;
+        for (size_t i = 0; bool_true_words[i]; i++) {
+            if (strcasecmp(value, bool_true_words[i]) == 0)
+                b = 1;
+            if (strcasecmp(value, bool_false_words[i]) == 0)
+                b = 0;
+        }
+        if (b < 0)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "%s: %s = %s: must be one of true, false, yes, no, on, off, 1, 0",
+                             where, d->key, value);
+        memcpy(field, &b, sizeof b);
+        return CDEM_OK;
+    }
+    case CDEM_PTYPE_ENUM: {
+        for (int i = 0; d->choices[i]; i++) {
+            if (strcasecmp(value, d->choices[i]) == 0) {
+                memcpy(field, &i, sizeof i);
+                return CDEM_OK;
+            }
+        }
+        char words[256];
+        join_words(d->choices, words, sizeof words);
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s: %s = %s: must be one of %s", where, d->key,
+                         value, words);
+    }
+    case CDEM_PTYPE_STRING: {
+        size_t len = strlen(value);
+        if (len >= d->size)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "%s: %s = %.40s...: too long (%zu characters; at most %zu)", where,
+                             d->key, value, len, d->size - 1);
+        memcpy(field, value, len + 1);
+        return CDEM_OK;
+    }
+    }
+    return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: %s: unknown parameter type", where, d->key);
+}
+
+void cdem_params_defaults(cdem_params *p) {
+    memset(p, 0, sizeof *p);
+    for (size_t i = 0; i < N_PARAMS; i++) {
+        cdem_status st = assign_value(p, &param_table[i], param_table[i].def, "defaults", NULL);
+        assert(st == CDEM_OK && "a default in param_table violates its own range");
+        (void)st;
+    }
+}
+
+/* Reports an unknown key with the closest known name (or the section it belongs to). */
+static cdem_status fail_unknown_key(const char *where, const char *section, const char *key,
+                                    cdem_error *err) {
+    for (size_t i = 0; i < N_PARAMS; i++)
+        if (strcmp(param_table[i].key, key) == 0)
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [%s] %s: unknown key; it belongs in [%s]",
+                             where, section, key, param_table[i].section);
+    const cdem_param_def *best = NULL;
+    size_t best_d = (size_t)-1;
+    /* Prefer keys of the same section on ties, so the suggestion stays local. */
+    for (int pass = 0; pass < 2; pass++)
+        for (size_t i = 0; i < N_PARAMS; i++) {
+            int same = strcmp(param_table[i].section, section) == 0;
+            if (same != (pass == 0))
+                continue;
+            size_t dist = edit_distance(key, param_table[i].key);
+            if (dist < best_d) {
+                best_d = dist;
+                best = &param_table[i];
+            }
+        }
+    if (best && close_enough(best_d, key)) {
+        if (strcmp(best->section, section) == 0)
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [%s] %s: unknown key; did you mean '%s'?",
+                             where, section, key, best->key);
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "%s: [%s] %s: unknown key; did you mean '%s' (it belongs in [%s])?", where,
+                         section, key, best->key, best->section);
+    }
+    return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                     "%s: [%s] %s: unknown key; `cdem-run --print-defaults` lists every key", where,
+                     section, key);
+}
+
+static int known_section(const char *name) {
+    for (size_t i = 0; section_names[i]; i++)
+        if (strcmp(section_names[i], name) == 0)
+            return 1;
+    return 0;
+}
+
+static cdem_status fail_unknown_section(const char *where, const char *name, cdem_error *err) {
+    const char *best = NULL;
+    size_t best_d = (size_t)-1;
+    for (size_t i = 0; section_names[i]; i++) {
+        size_t dist = edit_distance(name, section_names[i]);
+        if (dist < best_d) {
+            best_d = dist;
+            best = section_names[i];
+        }
+    }
+    if (best && close_enough(best_d, name))
+        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: unknown section [%s]; did you mean [%s]?", where,
+                         name, best);
+    char words[256];
+    join_words(section_names, words, sizeof words);
+    return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: unknown section [%s]; sections are %s", where, name,
+                     words);
+}
+
+/* Splits a value at an inline comment ('#' or ';' after whitespace) and handles a quoted
+ * value ("..." may contain '#' and ';'). Writes the cleaned value into buf. Returns 0 when
+ * a quote is not closed or text follows the closing quote. */
+static int clean_value(const char *text, size_t len, char *buf, size_t n) {
+    while (len > 0 && is_blank(*text)) {
+        text++;
+        len--;
+    }
+    if (len > 0 && text[0] == '"') {
+        const char *close = memchr(text + 1, '"', len - 1);
+        if (!close)
+            return 0;
+        size_t rest = len - (size_t)(close + 1 - text);
+        const char *r = close + 1;
+        while (rest > 0 && is_blank(*r)) {
+            r++;
+            rest--;
+        }
+        if (rest > 0 && *r != '#' && *r != ';')
+            return 0;
+        size_t vlen = (size_t)(close - text - 1);
+        if (vlen >= n)
+            vlen = n - 1;
+        memcpy(buf, text + 1, vlen);
+        buf[vlen] = '\0';
+        return 1;
+    }
+    size_t cut = len;
+    for (size_t i = 0; i < len; i++)
+        if ((text[i] == '#' || text[i] == ';') && (i == 0 || is_blank(text[i - 1]))) {
+            cut = i;
+            break;
+        }
+    copy_trimmed(buf, n, text, cut);
+    return 1;
+}
+
+/* Value buffer: long enough for a path plus slack so "too long" can be reported. */
+#define VALUE_MAX (CDEM_PATH_MAX + 64)
+
+cdem_status cdem_params_parse_text(cdem_params *p, const char *text, const char *path,
+                                   cdem_error *err) {
+    if (!p || !text)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_parse_text: NULL argument");
+    if (!path)
+        path = "<text>";
+    cdem_params work = *p;     /* commit only on success */
+    int set_on_line[N_PARAMS]; /* line where each key was set; 0 = not yet */
+    memset(set_on_line, 0, sizeof set_on_line);
+    char section[64] = "";
+    int have_section = 0;
+    const char *s = text;
+    if ((unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB && (unsigned char)s[2] == 0xBF)
+        s += 3; /* UTF-8 byte-order mark */
+    for (int line_no = 1; *s; line_no++) {
+        const char *eol = strchr(s, '\n');
+        size_t len = eol ? (size_t)(eol - s) : strlen(s);
+        const char *next = eol ? eol + 1 : s + len;
+        char line[VALUE_MAX + 128];
+        char where[CDEM_PATH_MAX + 32];
+        snprintf(where, sizeof where, "%s:%d", path, line_no);
+        if (len >= sizeof line)
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: line longer than %zu characters: %.40s...",
+                             where, sizeof line - 1, s);
+        copy_trimmed(line, sizeof line, s, len);
+        s = next;
+        if (line[0] == '\0' || line[0] == '#' || line[0] == ';')
+            continue;
+        if (line[0] == '[') {
+            char *close = strchr(line, ']');
+            char rest[16];
+            if (!close || !clean_value(close + 1, strlen(close + 1), rest, sizeof rest) ||
+                rest[0] != '\0')
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "%s: line is not 'key = value' or '[section]': %s", where, line);
+            copy_trimmed(section, sizeof section, line + 1, (size_t)(close - line - 1));
+            if (!known_section(section))
+                return fail_unknown_section(where, section, err);
+            have_section = 1;
+            continue;
+        }
+        char *eq = strchr(line, '=');
+        char key[64];
+        if (eq)
+            copy_trimmed(key, sizeof key, line, (size_t)(eq - line));
+        if (!eq || key[0] == '\0' || strpbrk(key, " \t"))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s: line is not 'key = value' or '[section]': %s", where, line);
+        char value[VALUE_MAX];
+        if (!clean_value(eq + 1, strlen(eq + 1), value, sizeof value))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s: %s: unterminated quote or text after the closing quote: %s",
+                             where, key, line);
+        if (!have_section) {
+            const cdem_param_def *any = NULL;
+            for (size_t i = 0; i < N_PARAMS && !any; i++)
+                if (strcmp(param_table[i].key, key) == 0)
+                    any = &param_table[i];
+            if (any)
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "%s: %s: key before any [section]; put it under [%s]", where, key,
+                                 any->section);
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s: %s: key before any [section]; start the file with a section "
+                             "such as [assembly]",
+                             where, key);
+        }
+        const cdem_param_def *d = cdem_params_find(section, key);
+        if (!d)
+            return fail_unknown_key(where, section, key, err);
+        size_t idx = (size_t)(d - param_table);
+        if (set_on_line[idx])
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s: [%s] %s: duplicate key (already set on line %d); keep one", where,
+                             section, key, set_on_line[idx]);
+        set_on_line[idx] = line_no;
+        CDEM_TRY(assign_value(&work, d, value, where, err));
+    }
+    *p = work;
+    return CDEM_OK;
+}
+
+cdem_status cdem_params_load(cdem_params *p, const char *path, char **text_out, cdem_error *err) {
+    if (text_out)
+        *text_out = NULL;
+    if (!p || !path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_load: NULL argument");
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot open parameter file: %s", path,
+                         strerror(errno));
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory reading the file", path);
+    }
+    for (;;) {
+        if (len + 1 >= cap) {
+            if (cap > ((size_t)64 << 20)) {
+                free(buf);
+                fclose(f);
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "%s: file larger than 64 MiB; not a parameter file", path);
+            }
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory reading the file", path);
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - 1 - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    int read_error = ferror(f);
+    fclose(f);
+    buf[len] = '\0';
+    if (read_error) {
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: read error", path);
+    }
+    if (memchr(buf, '\0', len)) {
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: contains NUL bytes; not a text parameter file",
+                         path);
+    }
+    cdem_status st = cdem_params_parse_text(p, buf, path, err);
+    if (st != CDEM_OK || !text_out)
+        free(buf);
+    else
+        *text_out = buf;
+    return st;
+}
+
+cdem_status cdem_params_override(cdem_params *p, const char *assignment, cdem_error *err) {
+    if (!p || !assignment)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_override: NULL argument");
+    char where[VALUE_MAX + 16];
+    snprintf(where, sizeof where, "-s %s", assignment);
+    const char *eq = strchr(assignment, '=');
+    char name[128];
+    copy_trimmed(name, sizeof name, assignment,
+                 eq ? (size_t)(eq - assignment) : strlen(assignment));
+    const char *dot = strchr(name, '.');
+    if (!eq || !dot || dot == name || dot[1] == '\0') {
+        /* Help the user: find the section of a bare key. */
+        const char *bare = dot ? dot + 1 : name;
+        for (size_t i = 0; i < N_PARAMS; i++)
+            if (strcmp(param_table[i].key, bare) == 0)
+                return CDEM_FAIL(
+                    err, CDEM_ERR_PARSE, "%s: expected section.key=value, e.g. %s.%s=%s", where,
+                    param_table[i].section, param_table[i].key, eq ? eq + 1 : param_table[i].def);
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "%s: expected section.key=value, e.g. physics.gravity=9.81", where);
+    }
+    char section[64], key[64];
+    copy_trimmed(section, sizeof section, name, (size_t)(dot - name));
+    copy_trimmed(key, sizeof key, dot + 1, strlen(dot + 1));
+    if (!known_section(section))
+        return fail_unknown_section(where, section, err);
+    const cdem_param_def *d = cdem_params_find(section, key);
+    if (!d)
+        return fail_unknown_key(where, section, key, err);
+    char value[VALUE_MAX];
+    copy_trimmed(value, sizeof value, eq + 1, strlen(eq + 1));
+    /* Quotes are optional on the command line; strip one matching pair. */
+    size_t vl = strlen(value);
+    if (vl >= 2 && value[0] == '"' && value[vl - 1] == '"') {
+        memmove(value, value + 1, vl - 2);
+        value[vl - 2] = '\0';
+    }
+    cdem_params work = *p;
+    CDEM_TRY(assign_value(&work, d, value, where, err));
+    *p = work;
+    return CDEM_OK;
+}
+
+/* ---------- formatting and writing ---------- */
+
+void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, char *buf,
+                              size_t n) {
+    if (!buf || n == 0)
+        return;
+    buf[0] = '\0';
+    if (!p || !def)
+        return;
+    const char *field = (const char *)p + def->offset;
+    switch (def->type) {
+    case CDEM_PTYPE_DOUBLE: {
+        double v;
+        memcpy(&v, field, sizeof v);
+        format_double(v, buf, n);
+        break;
+    }
+    case CDEM_PTYPE_INT: {
+        int v;
+        memcpy(&v, field, sizeof v);
+        snprintf(buf, n, "%d", v);
+        break;
+    }
+    case CDEM_PTYPE_LONG: {
+        long v;
+        memcpy(&v, field, sizeof v);
+        snprintf(buf, n, "%ld", v);
+        break;
+    }
+    case CDEM_PTYPE_BOOL: {
+        int v;
+        memcpy(&v, field, sizeof v);
+        snprintf(buf, n, "%s", v ? "on" : "off");
+        break;
+    }
+    case CDEM_PTYPE_ENUM: {
+        int v;
+        memcpy(&v, field, sizeof v);
+        int count = 0;
+        while (def->choices[count])
+            count++;
+        snprintf(buf, n, "%s", v >= 0 && v < count ? def->choices[v] : "?");
+        break;
+    }
+    case CDEM_PTYPE_STRING: {
+        size_t len = strnlen(field, def->size);
+        /* Quote when the plain text would not read back the same. */
+        int quote = len == 0 || is_blank(field[0]) || is_blank(field[len - 1]) ||
+                    memchr(field, '#', len) || memchr(field, ';', len);
+        snprintf(buf, n, quote ? "\"%.*s\"" : "%.*s", (int)len, field);
+        break;
+    }
+    }
+}
+
+void cdem_params_write(const cdem_params *p, FILE *out) {
+    if (!p || !out)
+        return;
+    fprintf(out, "# cdem-c model parameters (complete; see docs/parameters.md)\n"
+                 "# INI format: [section], key = value; '#' or ';' start a comment.\n"
+                 "# Every key is listed; delete a line to use its default.\n");
+    const char *cur = "";
+    for (size_t i = 0; i < N_PARAMS; i++) {
+        const cdem_param_def *d = &param_table[i];
+        if (strcmp(d->section, cur) != 0) {
+            fprintf(out, "\n[%s]\n", d->section);
+            cur = d->section;
+        }
+        char allowed[256], value[VALUE_MAX + 4];
+        describe_allowed(d, allowed, sizeof allowed);
+        cdem_params_format_value(p, d, value, sizeof value);
+        fprintf(out, "# %s (%s%s%s; default %s)\n%s = %s\n", d->help, d->unit,
+                d->unit[0] ? "; " : "", allowed, d->def[0] ? d->def : "empty", d->key, value);
+    }
+}
+
+/* Escapes '|' for a markdown table cell. */
+static void md_cell(FILE *out, const char *text) {
+    for (const char *c = text; *c; c++) {
+        if (*c == '|')
+            fputc('\\', out);
+        fputc(*c, out);
+    }
+}
+
+static const char *type_name(cdem_param_type t) {
+    switch (t) {
+    case CDEM_PTYPE_DOUBLE:
+        return "real";
+    case CDEM_PTYPE_INT:
+    case CDEM_PTYPE_LONG:
+        return "integer";
+    case CDEM_PTYPE_BOOL:
+        return "boolean";
+    case CDEM_PTYPE_ENUM:
+        return "choice";
+    case CDEM_PTYPE_STRING:
+        return "text";
+    }
+    return "?";
+}
+
+void cdem_params_write_markdown(FILE *out) {
+    if (!out)
+        return;
+    fprintf(out, "| section | key | type | default | unit | range / values | meaning |\n"
+                 "|---|---|---|---|---|---|---|\n");
+    for (size_t i = 0; i < N_PARAMS; i++) {
+        const cdem_param_def *d = &param_table[i];
+        char allowed[256];
+        describe_allowed(d, allowed, sizeof allowed);
+        fprintf(out, "| %s | `%s` | %s | ", d->section, d->key, type_name(d->type));
+        if (d->def[0]) {
+            fputc('`', out);
+            md_cell(out, d->def);
+            fputc('`', out);
+        } else {
+            fputs("(empty)", out);
+        }
+        fputs(" | ", out);
+        md_cell(out, d->unit);
+        fputs(" | ", out);
+        md_cell(out, allowed);
+        fputs(" | ", out);
+        md_cell(out, d->help);
+        fputs(" |\n", out);
+    }
+}
+
+/* ---------- validation of combinations ---------- */
+
+/* Accumulates one message per violated rule, separated by newlines. */
+typedef struct {
+    char *buf;  /* destination (err->msg or a scratch buffer) */
+    size_t cap; /* its size */
+    size_t len; /* characters written */
+    int count;  /* rules violated so far */
+} rule_log;
+
+static void rule_add(rule_log *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void rule_add(rule_log *log, const char *fmt, ...) {
+    log->count++;
+    if (log->len + 2 >= log->cap)
+        return;
+    if (log->len > 0)
+        log->buf[log->len++] = '\n';
+    va_list ap;
+    va_start(ap, fmt);
+    int w = vsnprintf(log->buf + log->len, log->cap - log->len, fmt, ap);
+    va_end(ap);
+    if (w > 0)
+        log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
+}
+
+/* Options the biaxial test excludes ({section, key}; all BOOL or ENUM with 0 = off). */
+static const char *const biaxial_excludes[][2] = {
+    {"heterogeneity", "flexural_slip"},    {"heterogeneity", "weak_interval"},
+    {"heterogeneity", "layered_friction"}, {"surface", "erosion"},
+    {"surface", "sedimentation"},
+};
+
+static int is_fault_mode(cdem_mode m) {
+    return m == CDEM_MODE_PLANAR_FAULT || m == CDEM_MODE_LISTRIC_FAULT ||
+           m == CDEM_MODE_IRREGULAR_FAULT;
+}
+
+cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
+    if (!p)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
+    char msg[CDEM_ERROR_MSG_MAX];
+    rule_log log = {msg, sizeof msg, 0, 0};
+    msg[0] = '\0';
+    char v1[64], v2[64];
+
+    /* Values set by code rather than parsed still obey the table. */
+    for (size_t i = 0; i < N_PARAMS; i++) {
+        const cdem_param_def *d = &param_table[i];
+        const char *field = (const char *)p + d->offset;
+        double v = 0.0;
+        int iv = 0, count = 0;
+        long lv = 0;
+        switch (d->type) {
+        case CDEM_PTYPE_DOUBLE:
+            memcpy(&v, field, sizeof v);
+            break;
+        case CDEM_PTYPE_INT:
+            memcpy(&iv, field, sizeof iv);
+            v = iv;
+            break;
+        case CDEM_PTYPE_LONG:
+            memcpy(&lv, field, sizeof lv);
+            v = (double)lv;
+            break;
+        case CDEM_PTYPE_BOOL:
+            memcpy(&iv, field, sizeof iv);
+            if (iv != 0 && iv != 1)
+                rule_add(&log, "[%s] %s = %d: must be 0 or 1 (off/on)", d->section, d->key, iv);
+            continue;
+        case CDEM_PTYPE_ENUM:
+            memcpy(&iv, field, sizeof iv);
+            while (d->choices[count])
+                count++;
+            if (iv < 0 || iv >= count)
+                rule_add(&log, "[%s] %s = %d: not a valid choice", d->section, d->key, iv);
+            continue;
+        case CDEM_PTYPE_STRING:
+            if (!memchr(field, '\0', d->size))
+                rule_add(&log, "[%s] %s: text not terminated within %zu characters", d->section,
+                         d->key, d->size);
+            continue;
+        }
+        if (!in_range(d, v)) {
+            char range[160];
+            describe_range(d, range, sizeof range);
+            format_double(v, v1, sizeof v1);
+            rule_add(&log, "[%s] %s = %s: must be %s", d->section, d->key, v1, range);
+        }
+    }
+    if (log.count > 0) /* ranges first: the cross rules below assume sane values */
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
+
+    if (!(p->equilibration < p->runtime)) {
+        format_double(p->equilibration, v1, sizeof v1);
+        format_double(p->runtime, v2, sizeof v2);
+        rule_add(&log,
+                 "equilibration = %s s must be shorter than runtime = %s s: increase [time] "
+                 "runtime or reduce [time] equilibration",
+                 v1, v2);
+    }
+    if (p->weak_interval != CDEM_WEAK_OFF && p->layered_friction)
+        rule_add(&log,
+                 "weak_interval = %s excludes layered_friction = on: set [heterogeneity] "
+                 "weak_interval = off or layered_friction = off",
+                 weak_words[p->weak_interval]);
+    if (p->layered_friction && p->material != CDEM_MATERIAL_GRANULAR)
+        rule_add(&log,
+                 "layered_friction = on requires material = granular (got material = %s): set "
+                 "[heterogeneity] layered_friction = off or [material] material = granular",
+                 material_words[p->material]);
+    if (p->overburden_pressure > 0) {
+        format_double(p->overburden_pressure, v1, sizeof v1);
+        if (p->mode == CDEM_MODE_REPOSE || p->mode == CDEM_MODE_BIAXIAL)
+            rule_add(&log,
+                     "overburden_pressure = %s N/m cannot be used with mode = %s: set [surface] "
+                     "overburden_pressure = 0 or choose another mode",
+                     v1, mode_words[p->mode]);
+        if (p->erosion)
+            rule_add(&log,
+                     "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
+                     "overburden_pressure = 0 or erosion = off",
+                     v1);
+        if (p->sedimentation)
+            rule_add(&log,
+                     "overburden_pressure = %s N/m excludes sedimentation = on: set [surface] "
+                     "overburden_pressure = 0 or sedimentation = off",
+                     v1);
+    }
+    if (p->mode == CDEM_MODE_BIAXIAL) {
+        if (p->width != 10.0 || p->height != 5.0) {
+            format_double(p->width, v1, sizeof v1);
+            format_double(p->height, v2, sizeof v2);
+            rule_add(&log,
+                     "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
+                     "height = %s): set them in [assembly]",
+                     v1, v2);
+        }
+        for (size_t i = 0; i < sizeof biaxial_excludes / sizeof biaxial_excludes[0]; i++) {
+            const cdem_param_def *d =
+                cdem_params_find(biaxial_excludes[i][0], biaxial_excludes[i][1]);
+            int v;
+            memcpy(&v, (const char *)p + d->offset, sizeof v);
+            if (v) {
+                cdem_params_format_value(p, d, v1, sizeof v1);
+                rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key, v1,
+                         d->section, d->key);
+            }
+        }
+    }
+    if (p->mode == CDEM_MODE_REPOSE) {
+        if (p->erosion)
+            rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
+        if (p->sedimentation)
+            rule_add(
+                &log,
+                "mode = repose excludes sedimentation = on: set [surface] sedimentation = off");
+    }
+    if (p->mode == CDEM_MODE_IRREGULAR_FAULT && p->fault_file[0] == '\0')
+        rule_add(&log, "mode = irregular-fault requires fault_file: set [boundary] fault_file to "
+                       "a text file of x y vertices in m");
+    if (p->mode == CDEM_MODE_VERTICAL_FAULTS &&
+        !(p->vertical_fault_location + p->vertical_fault_spacing < 1.0)) {
+        format_double(p->vertical_fault_location, v1, sizeof v1);
+        format_double(p->vertical_fault_spacing, v2, sizeof v2);
+        rule_add(&log,
+                 "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s + "
+                 "%s must be < 1 (the second fault must lie inside the base): reduce one of them",
+                 v1, v2);
+    }
+    if (p->inversion && !is_fault_mode(p->mode))
+        rule_add(&log,
+                 "inversion = on needs mode = planar-fault, listric-fault or irregular-fault "
+                 "(got mode = %s): set [boundary] inversion = off",
+                 mode_words[p->mode]);
+    if (p->sedimentation) {
+        cdem_model m;
+        cdem_error merr;
+        cdem_error_clear(&merr);
+        if (cdem_model_derive(p, &m, &merr) != CDEM_OK) {
+            rule_add(&log, "%s", merr.msg);
+        } else {
+            double settling = 0.2 * p->equilibration;
+            double between = m.sediment_interval / m.boundary_speed;
+            if (settling > between) {
+                char s_set[32], s_bet[32], s_speed[32], s_di[32], s_eq[32];
+                format_double(settling, s_set, sizeof s_set);
+                snprintf(s_bet, sizeof s_bet, "%.4g", between);
+                snprintf(s_speed, sizeof s_speed, "%.4g", m.boundary_speed);
+                /* smallest display interval / largest equilibration that satisfy the rule */
+                format_safe(settling * m.boundary_speed / 30.0, 1, s_di, sizeof s_di);
+                format_safe(between / 0.2, 0, s_eq, sizeof s_eq);
+                format_double(p->display_interval, v1, sizeof v1);
+                format_double(p->equilibration, v2, sizeof v2);
+                rule_add(&log,
+                         "settling > displacement: the settling time 0.2 x equilibration = 0.2 x "
+                         "%s s = %s s is longer than the time between sediment steps 30 x "
+                         "display_interval / boundary speed = 30 x %s m / %s m/s = %s s: increase "
+                         "[time] display_interval to at least %s m or reduce [time] "
+                         "equilibration to at most %s s",
+                         v2, s_set, v1, s_speed, s_bet, s_di, s_eq);
+            }
+        }
+    }
+    if (log.count > 0)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT, "%s", msg);
+    return CDEM_OK;
+}

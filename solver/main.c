@@ -1,0 +1,308 @@
+/* cdem-run: the command line of the solver.
+ *
+ * Reads a parameter file (or uses the built-in default model), applies -s overrides in
+ * command-line order, validates, prints the model summary and runs the simulation through
+ * cdem_run() (solver/run.h). This is the only place that prints messages and chooses exit
+ * codes: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM; the output
+ * file is still valid and records where it stopped). Messages go to stderr as
+ * "cdem-run: <message>", one line per problem; the summary and the --print-defaults /
+ * --params-markdown texts go to stdout so they can be redirected into files. */
+#include "model.h"
+#include "params.h"
+#include "run.h"
+#include "summary.h"
+
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef CDEM_VERSION
+#define CDEM_VERSION "0.0.0"
+#endif
+
+enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 3 };
+
+/* The one mutable global of the project: a signal handler can only communicate through a
+ * static volatile sig_atomic_t. main passes its address to cdem_run as opt.stop_requested;
+ * the solver polls it between time steps and stops cleanly. */
+static volatile sig_atomic_t stop_requested = 0;
+
+static void on_signal(int sig) {
+    (void)sig;
+    stop_requested = 1;
+}
+
+static const char usage_text[] =
+    "usage: cdem-run [MODEL.ini] [-o OUT.h5] [-s section.key=value]... [-q] [--summary]\n"
+    "                [--dry-run] [--print-defaults] [--params-markdown] [--max-steps N]\n"
+    "                [--version] [-h|--help]\n"
+    "\n"
+    "Simulates a 2-D discrete element model and writes every display increment to an HDF5\n"
+    "file. Without MODEL.ini the built-in default model is used (the paper's Figure 7A:\n"
+    "10 x 5 km, planar normal fault dipping 30 degrees).\n"
+    "\n"
+    "  -o OUT.h5            output file (default: MODEL's base name with .h5 in the current\n"
+    "                       directory, or cdem-default.h5 without a model file)\n"
+    "  -s section.key=value override one parameter (repeatable; applied after the file)\n"
+    "  -q                   quiet: no summary, no progress\n"
+    "  --summary            validate, print the model summary and exit\n"
+    "  --dry-run            as --summary, then say that nothing was simulated\n"
+    "  --print-defaults     print a complete commented parameter file of the effective\n"
+    "                       values (defaults + file + overrides) and exit\n"
+    "  --params-markdown    print the parameter table in markdown (docs/parameters.md)\n"
+    "  --max-steps N        stop after N time steps (tests, benchmarks)\n"
+    "  --version            print the version and exit\n"
+    "  -h, --help           print this help and exit\n"
+    "\n"
+    "Exit status: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM).\n"
+    "Parameters, ranges and rules: docs/parameters.md.\n";
+
+/* Prints a possibly multi-line message with the program prefix on every line. */
+static void print_error(const char *msg) {
+    const char *s = msg;
+    while (*s) {
+        const char *nl = strchr(s, '\n');
+        int len = nl ? (int)(nl - s) : (int)strlen(s);
+        fprintf(stderr, "cdem-run: %.*s\n", len, s);
+        s += len + (nl ? 1 : 0);
+    }
+    if (!msg[0])
+        fprintf(stderr, "cdem-run: unknown error\n");
+}
+
+static int usage_error(const char *fmt, const char *arg) {
+    fprintf(stderr, "cdem-run: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nTry 'cdem-run --help' for more information.\n");
+    return EXIT_USAGE;
+}
+
+typedef struct {
+    const char *model_path;  /* MODEL.ini or NULL for the default model */
+    const char *output_path; /* -o, or NULL for the default name */
+    const char **overrides;  /* -s arguments in order (points into argv) */
+    int n_overrides;         /* number of -s arguments */
+    int quiet;               /* -q */
+    int summary_only;        /* --summary */
+    int dry_run;             /* --dry-run */
+    int print_defaults;      /* --print-defaults */
+    int params_markdown;     /* --params-markdown */
+    int help, version;       /* -h/--help, --version */
+    long max_steps;          /* --max-steps, 0 = no limit */
+} cli_args;
+
+/* Returns EXIT_OK or EXIT_USAGE (message already printed). */
+static int parse_args(int argc, char **argv, cli_args *a) {
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            a->help = 1;
+        } else if (strcmp(arg, "--version") == 0) {
+            a->version = 1;
+        } else if (strcmp(arg, "-q") == 0 || strcmp(arg, "--quiet") == 0) {
+            a->quiet = 1;
+        } else if (strcmp(arg, "--summary") == 0) {
+            a->summary_only = 1;
+        } else if (strcmp(arg, "--dry-run") == 0) {
+            a->dry_run = 1;
+        } else if (strcmp(arg, "--print-defaults") == 0) {
+            a->print_defaults = 1;
+        } else if (strcmp(arg, "--params-markdown") == 0) {
+            a->params_markdown = 1;
+        } else if (strcmp(arg, "-o") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs a file name", arg);
+            a->output_path = argv[++i];
+        } else if (strcmp(arg, "-s") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs section.key=value", arg);
+            a->overrides[a->n_overrides++] = argv[++i];
+        } else if (strncmp(arg, "-s", 2) == 0 && strchr(arg, '=')) {
+            a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
+        } else if (strcmp(arg, "--max-steps") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs a number of time steps", arg);
+            char *end = NULL;
+            long n = strtol(argv[++i], &end, 10);
+            if (end == argv[i] || *end != '\0' || n <= 0)
+                return usage_error("--max-steps %s: expected a whole number > 0", argv[i]);
+            a->max_steps = n;
+        } else if (arg[0] == '-' && arg[1] != '\0') {
+            return usage_error("unknown option %s", arg);
+        } else if (!a->model_path) {
+            a->model_path = arg;
+        } else {
+            return usage_error("more than one model file given (second: %s)", arg);
+        }
+    }
+    return EXIT_OK;
+}
+
+/* "dir/fault.ini" -> "fault.h5" (in the current directory). */
+static char *default_output(const char *model_path) {
+    if (!model_path)
+        return strdup("cdem-default.h5");
+    const char *base = strrchr(model_path, '/');
+    base = base ? base + 1 : model_path;
+    const char *dot = strrchr(base, '.');
+    size_t stem = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    char *out = malloc(stem + 4);
+    if (!out)
+        return NULL;
+    memcpy(out, base, stem);
+    memcpy(out + stem, ".h5", 4);
+    return out;
+}
+
+/* The parameter text stored in the output: the original file when nothing was overridden,
+ * else a complete file of the effective values (so it re-parses to what was run). */
+static char *stored_params_text(const cdem_params *p, const cli_args *a, char *file_text) {
+    if (a->n_overrides == 0 && file_text)
+        return file_text;
+    free(file_text);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return NULL;
+    fprintf(f, "# effective parameters of this run: %s",
+            a->model_path ? a->model_path : "defaults");
+    for (int i = 0; i < a->n_overrides; i++)
+        fprintf(f, " -s %s", a->overrides[i]);
+    fputc('\n', f);
+    cdem_params_write(p, f);
+    fclose(f);
+    return buf;
+}
+
+int main(int argc, char **argv) {
+    cli_args a;
+    memset(&a, 0, sizeof a);
+    a.overrides = calloc((size_t)argc + 1, sizeof *a.overrides);
+    if (!a.overrides) {
+        fprintf(stderr, "cdem-run: out of memory\n");
+        return EXIT_ERROR;
+    }
+    int rc = parse_args(argc, argv, &a);
+    if (rc != EXIT_OK) {
+        free(a.overrides);
+        return rc;
+    }
+    if (a.help) {
+        fputs(usage_text, stdout);
+        free(a.overrides);
+        return EXIT_OK;
+    }
+    if (a.version) {
+        printf("cdem-run %s\n", CDEM_VERSION);
+        free(a.overrides);
+        return EXIT_OK;
+    }
+    if (a.params_markdown) {
+        cdem_params_write_markdown(stdout);
+        free(a.overrides);
+        return EXIT_OK;
+    }
+
+    cdem_error err;
+    cdem_error_clear(&err);
+    cdem_params p;
+    cdem_params_defaults(&p);
+    char *file_text = NULL;
+    char *out_path = NULL;
+    char *summary = NULL;
+    rc = EXIT_ERROR;
+
+    if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK)
+        goto fail;
+    for (int i = 0; i < a.n_overrides; i++)
+        if (cdem_params_override(&p, a.overrides[i], &err) != CDEM_OK)
+            goto fail;
+    if (a.print_defaults) {
+        cdem_params_write(&p, stdout);
+        rc = EXIT_OK;
+        goto done;
+    }
+    if (cdem_params_validate(&p, &err) != CDEM_OK) {
+        fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
+                a.model_path ? a.model_path : "", a.model_path ? ": " : "");
+        goto fail;
+    }
+    cdem_model m;
+    if (cdem_model_derive(&p, &m, &err) != CDEM_OK)
+        goto fail;
+
+    int want_summary = a.summary_only || a.dry_run || !a.quiet;
+    if (want_summary) {
+        long n_int = 0, n_wall = 0;
+        int estimated = 0;
+        cdem_error cerr;
+        cdem_error_clear(&cerr);
+        if (cdem_run_count_elements(&p, &n_int, &n_wall, &cerr) != CDEM_OK) {
+            /* The summary must not fail because the packing could not be generated here;
+             * the run itself reports that properly. */
+            n_int = cdem_model_estimate_elements(&p);
+            n_wall = 0;
+            estimated = 1;
+        }
+        if (cdem_summary_text(&p, &m, n_int, n_wall, estimated, &summary, &err) != CDEM_OK)
+            goto fail;
+        fputs(summary, stdout);
+        fflush(stdout);
+    }
+    if (a.summary_only || a.dry_run) {
+        if (a.dry_run)
+            printf("\ndry run: nothing simulated\n");
+        rc = EXIT_OK;
+        goto done;
+    }
+
+    out_path = a.output_path ? strdup(a.output_path) : default_output(a.model_path);
+    char *params_text = stored_params_text(&p, &a, file_text);
+    file_text = NULL; /* owned by params_text now (or freed) */
+    if (!out_path || !params_text) {
+        free(params_text);
+        fprintf(stderr, "cdem-run: out of memory\n");
+        goto done;
+    }
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    cdem_run_options opt = {
+        .output_path = out_path,
+        .params_text = params_text,
+        .quiet = a.quiet,
+        .progress_is_tty = isatty(STDERR_FILENO),
+        .log = stderr,
+        .stop_requested = &stop_requested,
+        .max_steps = a.max_steps,
+    };
+    cdem_status st = cdem_run(&p, &opt, &err);
+    free(params_text);
+    if (st == CDEM_OK) {
+        rc = EXIT_OK;
+    } else if (st == CDEM_ERR_INTERRUPTED) {
+        print_error(err.msg[0] ? err.msg : "interrupted");
+        rc = EXIT_INTERRUPTED;
+    } else {
+        goto fail;
+    }
+    goto done;
+
+fail:
+    print_error(err.msg);
+    rc = EXIT_ERROR;
+done:
+    free(summary);
+    free(out_path);
+    free(file_text);
+    free(a.overrides);
+    return rc;
+}

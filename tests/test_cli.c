@@ -1,0 +1,228 @@
+/* Tests of the cdem-run command line (solver/main.c), run as a program: --print-defaults
+ * round trip, error messages and exit codes, -s overrides, --summary, usage errors.
+ * The binary is $CDEM_BUILD/cdem-run (default build/); scratch files go to $CDEM_TEST_TMP. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "params.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct {
+    char bin[1024]; /* path of cdem-run */
+    char tmp[1024]; /* private scratch directory */
+} cli_ctx;
+
+static int setup(void **state) {
+    cli_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return -1;
+    const char *b = getenv("CDEM_BUILD");
+    snprintf(c->bin, sizeof c->bin, "%s/cdem-run", b && b[0] ? b : "build");
+    const char *t = getenv("CDEM_TEST_TMP");
+    snprintf(c->tmp, sizeof c->tmp, "%s/test_cli_XXXXXX", t && t[0] ? t : "/tmp");
+    if (!mkdtemp(c->tmp)) {
+        free(c);
+        return -1;
+    }
+    *state = c;
+    return 0;
+}
+
+static int teardown(void **state) {
+    cli_ctx *c = *state;
+    char cmd[2200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
+    int rc = system(cmd);
+    free(c);
+    return rc == 0 ? 0 : -1;
+}
+
+/* Runs cdem-run with args (shell syntax), stdout and stderr to files in tmp; returns the
+ * exit status. */
+static int run(const cli_ctx *c, const char *args) {
+    if (access(c->bin, X_OK) != 0) {
+        print_error("%s is missing: build it first (make build/cdem-run)\n", c->bin);
+        fail();
+    }
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' %s >'%s/out.txt' 2>'%s/err.txt'", c->bin, args, c->tmp, c->tmp);
+    int st = system(cmd);
+    assert_true(WIFEXITED(st));
+    return WEXITSTATUS(st);
+}
+
+static char *slurp(const cli_ctx *c, const char *name) {
+    char path[1100];
+    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char *buf = calloc(1, 1 << 20);
+    assert_non_null(buf);
+    size_t n = fread(buf, 1, (1 << 20) - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static void write_file(const cli_ctx *c, const char *name, const char *text) {
+    char path[1100];
+    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void assert_has(const char *text, const char *needle) {
+    if (!strstr(text, needle)) {
+        print_error("output lacks \"%s\":\n%s\n", needle, text);
+        fail();
+    }
+}
+
+static void test_cli_print_defaults_round_trip(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "--print-defaults"), 0);
+    char path[1100];
+    snprintf(path, sizeof path, "%s/out.txt", c->tmp);
+    cdem_params p, d;
+    cdem_error err;
+    cdem_params_defaults(&d);
+    memset(&p, 0, sizeof p);
+    cdem_status st = cdem_params_load(&p, path, NULL, &err);
+    if (st != CDEM_OK)
+        print_error("%s\n", err.msg);
+    assert_int_equal(st, CDEM_OK);
+    size_t n;
+    const cdem_param_def *t = cdem_params_table(&n);
+    for (size_t i = 0; i < n; i++) {
+        char a[1100], b[1100];
+        cdem_params_format_value(&p, &t[i], a, sizeof a);
+        cdem_params_format_value(&d, &t[i], b, sizeof b);
+        assert_string_equal(a, b);
+    }
+    assert_true(p.gravity == d.gravity && p.element.cohesion == d.element.cohesion);
+}
+
+static void test_cli_override_visible_in_print_defaults(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "-s time.runtime=3500 -s boundary.mode=detachment --print-defaults"),
+                     0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "\nruntime = 3500\n");
+    assert_has(out, "\nmode = detachment\n");
+    free(out);
+    /* overrides apply after the file */
+    write_file(c, "m.ini", "[time]\nruntime = 3000\n[physics]\ngravity = 5\n");
+    char args[1200];
+    snprintf(args, sizeof args, "'%s/m.ini' -s time.runtime=4000 --print-defaults", c->tmp);
+    assert_int_equal(run(c, args), 0);
+    out = slurp(c, "out.txt");
+    assert_has(out, "\nruntime = 4000\n");
+    assert_has(out, "\ngravity = 5\n");
+    free(out);
+}
+
+static void test_cli_bad_key_in_file(void **state) {
+    cli_ctx *c = *state;
+    write_file(c, "bad.ini", "[assembly]\nwidth = 12\nwidht = 13\n");
+    char args[1200];
+    snprintf(args, sizeof args, "'%s/bad.ini' --summary", c->tmp);
+    assert_int_equal(run(c, args), 1);
+    char *err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: ");
+    assert_has(err, "bad.ini:3: [assembly] widht: unknown key; did you mean 'width'?\n");
+    free(err);
+}
+
+static void test_cli_bad_override_and_rules(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "-s time.runtime=abc --summary"), 1);
+    char *err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: -s time.runtime=abc: runtime = abc: not a number");
+    free(err);
+    assert_int_equal(
+        run(c, "-s boundary.mode=biaxial -s assembly.width=20 -s surface.erosion=on --summary"), 1);
+    err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: mode = biaxial requires width = 10");
+    assert_has(err, "\ncdem-run: mode = biaxial excludes erosion");
+    free(err);
+}
+
+static void test_cli_summary_and_dry_run(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "--summary"), 0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "cdem-c model summary");
+    assert_has(out, "282 increments");
+    assert_null(strstr(out, "dry run"));
+    free(out);
+    assert_int_equal(run(c, "--dry-run -q"), 0);
+    out = slurp(c, "out.txt");
+    assert_has(out, "56 increments");
+    assert_has(out, "dry run: nothing simulated");
+    free(out);
+    char args[1200];
+    snprintf(args, sizeof args, "'%s/crlf.ini' --summary",
+             getenv("CDEM_TEST_DATA") ? getenv("CDEM_TEST_DATA") : "tests/data");
+    assert_int_equal(run(c, args), 0);
+    out = slurp(c, "out.txt");
+    assert_has(out, "15 x 3 units = 15000 x 3000 m");
+    assert_has(out, "detachment");
+    free(out);
+}
+
+static void test_cli_usage_errors_and_info(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "--bogus"), 2);
+    char *err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: unknown option --bogus");
+    free(err);
+    assert_int_equal(run(c, "a.ini b.ini"), 2);
+    assert_int_equal(run(c, "--max-steps zero"), 2);
+    assert_int_equal(run(c, "-o"), 2);
+    assert_int_equal(run(c, "--help"), 0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "usage: cdem-run [MODEL.ini]");
+    free(out);
+    assert_int_equal(run(c, "--version"), 0);
+    out = slurp(c, "out.txt");
+    assert_has(out, "cdem-run ");
+    free(out);
+    assert_int_equal(run(c, "/nonexistent/x.ini"), 1);
+    err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: /nonexistent/x.ini: cannot open parameter file");
+    free(err);
+}
+
+static void test_cli_params_markdown(void **state) {
+    cli_ctx *c = *state;
+    assert_int_equal(run(c, "--params-markdown"), 0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "| section | key | type | default | unit | range / values | meaning |\n");
+    assert_has(out, "| physics | `gravity` | real | `9.81` | m/s^2 | 0.5 to 25 |");
+    free(out);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_cli_print_defaults_round_trip, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_override_visible_in_print_defaults, setup,
+                                        teardown),
+        cmocka_unit_test_setup_teardown(test_cli_bad_key_in_file, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_bad_override_and_rules, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_summary_and_dry_run, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_usage_errors_and_info, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_params_markdown, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

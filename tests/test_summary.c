@@ -1,0 +1,199 @@
+/* Tests of common/summary.c: the key lines of the model summary for the default model and
+ * for every boundary mode, with numbers checked against the model (not hard-coded output). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "model.h"
+#include "params.h"
+#include "summary.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static char *summary_of(const cdem_params *p, long n, long nw, int estimated) {
+    cdem_model m;
+    cdem_error err;
+    cdem_error_clear(&err);
+    assert_int_equal(cdem_model_derive(p, &m, &err), CDEM_OK);
+    char *text = NULL;
+    assert_int_equal(cdem_summary_text(p, &m, n, nw, estimated, &text, &err), CDEM_OK);
+    assert_non_null(text);
+    return text;
+}
+
+static void assert_has(const char *text, const char *needle) {
+    if (!strstr(text, needle)) {
+        print_error("summary lacks \"%s\":\n%s\n", needle, text);
+        fail();
+    }
+}
+
+/* Finds "label:" and checks that the rest of its line starts (after padding) with value. */
+static void assert_line(const char *text, const char *label, const char *value) {
+    char key[128];
+    snprintf(key, sizeof key, "  %s:", label);
+    const char *at = strstr(text, key);
+    if (!at) {
+        print_error("summary has no line \"%s\":\n%s\n", label, text);
+        fail();
+    }
+    at += strlen(key);
+    while (*at == ' ')
+        at++;
+    if (strncmp(at, value, strlen(value)) != 0) {
+        const char *eol = strchr(at, '\n');
+        print_error("line \"%s\" is \"%.*s\", expected \"%s...\"\n", label,
+                    (int)(eol ? eol - at : 60), at, value);
+        fail();
+    }
+}
+
+static void test_summary_default_model_key_lines(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    char *t = summary_of(&p, 2121, 200, 0);
+    assert_line(t, "internal elements", "2121\n");
+    assert_line(t, "wall elements", "200\n");
+    assert_line(t, "assembly", "10 x 5 units = 10000 x 5000 m");
+    assert_line(t, "radius 1", "50 m, mass 1.9635e+07 kg/m");
+    assert_line(t, "radius 4", "125 m, mass 1.22718e+08 kg/m");
+    assert_line(t, "normal stiffness Kn", "1544871985 N/m");
+    assert_line(t, "shear stiffness Ks", "1544871985 N/m");
+    assert_line(t, "damping", "84553183 N s/m");
+    assert_line(t, "time step dt", "0.0281844 s");
+    assert_line(t, "gravity", "9.81 m/s^2");
+    assert_line(t, "density", "2500 kg/m^3");
+    assert_line(t, "equilibration", "400 s = 14192 time steps");
+    assert_line(t, "runtime", "2000 s = 70961 time steps");
+    assert_line(t, "boundary speed", "0.70461 m/s");
+    assert_line(t, "total displacement", "1127.38 m");
+    assert_has(t, "  equilibration:               56 increments\n");
+    assert_has(t, "  total:                       282 increments\n");
+    assert_line(t, "mode", "planar-fault");
+    assert_line(t, "fault dip", "30 degrees");
+    assert_line(t, "fault location", "0.5 of the base = 5000 m");
+    assert_line(t, "element-element", "friction 0.25, cohesion 5e+09 N");
+    assert_line(t, "element-wall", "friction 0.25, cohesion 5e+09 N");
+    assert_line(t, "element-fault", "friction 0.25, cohesion 5e+09 N");
+    assert_line(t, "sedimentation", "off");
+    assert_null(strstr(t, "estimated"));
+    /* deterministic: the same parameters give the same text */
+    char *again = summary_of(&p, 2121, 200, 0);
+    assert_string_equal(t, again);
+    free(again);
+    free(t);
+}
+
+static void test_summary_estimated_counts_say_so(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    char *t = summary_of(&p, 2121, 200, 1);
+    assert_line(t, "internal elements", "2121 (estimated");
+    assert_line(t, "wall elements", "200 (estimated)");
+    free(t);
+}
+
+static void test_summary_modes_geometry(void **state) {
+    (void)state;
+    static const struct {
+        const char *overrides[5];
+        const char *label, *value;
+    } cases[] = {
+        {{"boundary.mode=listric-fault", "boundary.kinematics=cd", NULL},
+         "kinematics",
+         "constant displacement (CD, mylar sheet)"},
+        {{"boundary.mode=listric-fault", NULL},
+         "fault dip",
+         "30 degrees at the base, steepening to 90 degrees"},
+        {{"boundary.mode=irregular-fault", "boundary.fault_file=f.txt", NULL},
+         "fault vertices",
+         "f.txt"},
+        {{"boundary.mode=vertical-faults", "boundary.vertical_sense=piston", NULL},
+         "sense",
+         "piston"},
+        {{"boundary.mode=vertical-faults", NULL}, "second fault", "0.65 of the base = 6500 m"},
+        {{"boundary.mode=vertical-faults", NULL}, "block width", "3000 m"},
+        {{"boundary.mode=detachment", "boundary.detachment_walls=both", NULL},
+         "moving walls",
+         "both walls"},
+        {{"boundary.mode=repose", "boundary.repose_walls=both", NULL},
+         "walls removed",
+         "both walls"},
+        {{"boundary.mode=repose", NULL}, "display interval", "5 s ="},
+        {{"boundary.mode=biaxial", "boundary.confining_pressure=2e7", NULL},
+         "confining pressure",
+         "2e+07 N/m (20 MPa in 3-D), ramped from zero at 200 s to full at 400 s"},
+        {{"boundary.mode=biaxial", NULL}, "gravity", "0 m/s^2 (off in the biaxial test)"},
+        {{"boundary.inversion=on", "boundary.inversion_percent=75", NULL},
+         "net displacement",
+         "563.7 m normal"},
+        {{"boundary.inversion=on", NULL}, "net displacement", "0 m"},
+        {{"material.material=bonded", "material.wall_breaking_strain=0.05", NULL},
+         "element-wall",
+         "breaking strain 0.05"},
+        {{"material.first_slip=off", NULL}, "cohesion lost", "when the pair separates"},
+        {{"heterogeneity.weak_interval=lower", "heterogeneity.weak_density_percent=80", NULL},
+         "interval density",
+         "80 % = 2000 kg/m^3"},
+        {{"heterogeneity.weak_interval=upper", "heterogeneity.weak_thickness_percent=20", NULL},
+         "weak/light interval",
+         "upper 20 % of the height = 1000 m"},
+        {{"heterogeneity.layered_friction=on", NULL},
+         "layered friction",
+         "layers 5-8, 13-16, 21-24 friction 0.1"},
+        {{"surface.overburden_pressure=5e6", NULL}, "overburden pressure", "5e+06 N/m"},
+        {{"surface.erosion=on", "surface.erosion_base_level=1.5", NULL},
+         "erosion",
+         "above 1.5 x the assembly height = 7500 m"},
+        {{"surface.sedimentation=on", "surface.sea_level_rise=mid", NULL},
+         "sea-level rise",
+         "mid (factor 0.5"},
+        {{"surface.sedimentation=on", NULL},
+         "sediment interval",
+         "150 m of boundary displacement = 7553 time steps"},
+        {{"surface.sedimentation=on", NULL}, "settling time", "80 s = 2838 time steps"},
+        {{"assembly.unit_scaling=200", NULL},
+         "normal stiffness Kn",
+         "349022201.5 N/m (scaled with the average radius)"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cdem_params p;
+        cdem_error err;
+        cdem_params_defaults(&p);
+        for (size_t j = 0; cases[i].overrides[j]; j++)
+            assert_int_equal(cdem_params_override(&p, cases[i].overrides[j], &err), CDEM_OK);
+        char *t = summary_of(&p, 100, 10, 0);
+        assert_line(t, cases[i].label, cases[i].value);
+        free(t);
+    }
+}
+
+static void test_summary_rejects_null(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_model m;
+    cdem_error err;
+    cdem_params_defaults(&p);
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    char *t = (char *)&p;
+    assert_int_equal(cdem_summary_text(NULL, &m, 1, 1, 0, &t, &err), CDEM_ERR_INVALID);
+    assert_null(t);
+    assert_int_equal(cdem_summary_text(&p, &m, 1, 1, 0, NULL, &err), CDEM_ERR_INVALID);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_summary_default_model_key_lines),
+        cmocka_unit_test(test_summary_estimated_counts_say_so),
+        cmocka_unit_test(test_summary_modes_geometry),
+        cmocka_unit_test(test_summary_rejects_null),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
