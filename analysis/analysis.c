@@ -89,7 +89,7 @@ cdem_status cdem_analysis_open_source(const cdem_analysis_source *src, void *ctx
     if (params)
         a->params = *params;
     else
-        a->params.total_strain_max = 2.0;
+        cdem_params_defaults(&a->params);
     if (!(a->params.total_strain_max > 0.0))
         a->params.total_strain_max = 2.0;
     a->n = src->count(ctx);

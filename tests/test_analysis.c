@@ -71,8 +71,7 @@ static int setup(void **state) {
         f->info[k].has_stress = k > EQUIL;
         f->info[k].n_elements = (int64_t)f->st[k].n;
     }
-    /* cdem_params_defaults lives in params.c (another branch): set the one field used */
-    memset(&f->params, 0, sizeof f->params);
+    cdem_params_defaults(&f->params);
     f->params.total_strain_max = 1.5;
     assert_int_equal(cdem_analysis_open_states(f->st, f->info, NINC, &f->params, &f->a, &err),
                      CDEM_OK);

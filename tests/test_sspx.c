@@ -45,7 +45,7 @@ static void test_sspx_round_trip_total_displacement(void **st) {
         info[k].phase = k <= 2 ? 0 : 1;
     }
     cdem_params p;
-    memset(&p, 0, sizeof p);
+    cdem_params_defaults(&p);
     cdem_analysis *a;
     assert_int_equal(cdem_analysis_open_states(s, info, NINC, &p, &a, &err), CDEM_OK);
     char dir[1024];
