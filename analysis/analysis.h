@@ -17,7 +17,7 @@
 #include "axes.h"
 #include "cdem_error.h"
 #include "h5format.h"
-#include "limits.h"
+#include "colorlimits.h"
 #include "params.h"
 #include "quantity.h"
 #include "state.h"
@@ -75,7 +75,7 @@ cdem_status cdem_analysis_state(cdem_analysis *a, size_t index, const cdem_state
 cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quantity *q,
                                  const cdem_state **s, double **values, cdem_error *err);
 
-/* Colour limits of q for increment index (see limits.h and docs/analysis.md). */
+/* Colour limits of q for increment index (see colorlimits.h and docs/analysis.md). */
 cdem_status cdem_analysis_limits(cdem_analysis *a, size_t index, const cdem_quantity *q,
                                  cdem_limits *lim, cdem_error *err);
 

@@ -7,7 +7,7 @@
 
 #include "assert_near.h"
 
-#include "limits.h"
+#include "colorlimits.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,4 +1,5 @@
-/* limits: colour-bar limits (SPEC section 5) and the percentile they are built from.
+/* colorlimits (module "limits"; not named limits.h so it never shadows <limits.h>): colour-bar
+ * limits (SPEC section 5) and the percentile they are built from.
  *
  * Percentile definition (the one of gsl_stats_quantile_from_sorted_data, used directly): for
  * n finite values sorted ascending, the f-quantile is v[i] + (v[i+1] - v[i]) (h - i) with
@@ -7,8 +8,8 @@
  * stress is clipped to +-CDEM_LIMITS_STRESS_CAP. Strain limits are fixed (see analysis.h).
  * The "only above" mode colours only elements whose |value| > 0.1 x max(|vmin|, |vmax|).
  * Ownership: plain values. Thread safety: pure. Units: those of the quantity. */
-#ifndef CDEM_LIMITS_H
-#define CDEM_LIMITS_H
+#ifndef CDEM_COLORLIMITS_H
+#define CDEM_COLORLIMITS_H
 
 #include "cdem_error.h"
 

@@ -1,6 +1,6 @@
-/* limits: see limits.h. Sorting a copy (qsort) is O(n log n) per call; the analysis context
- * caches the limits that span many increments (stress over all increments). */
-#include "limits.h"
+/* colorlimits: see colorlimits.h. Sorting a copy (qsort) is O(n log n) per call; the analysis
+ * context caches the limits that span many increments (stress over all increments). */
+#include "colorlimits.h"
 
 #include <gsl/gsl_statistics_double.h>
 #include <math.h>
