@@ -434,8 +434,9 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
             if (st == CDEM_OK)
                 st = cdem_analysis_state(a, index, &cur, err);
             if (st == CDEM_OK) {
-                cdem_strain_cum_get(&a->cum, cur, 1, m);
-                /* elements born after the end of equilibration with no pair yet: NaN */
+                /* 0 at the end of equilibration itself; afterwards an element with no
+                 * defined pair (always too few neighbours, or just born) is NaN */
+                cdem_strain_cum_get(&a->cum, cur, index == a->equil, m);
                 for (size_t i = 0; i < n; i++)
                     v[i] = pick_strain(&m[i], q->component);
             }

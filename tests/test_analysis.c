@@ -20,6 +20,7 @@
 #define EQUIL     3
 #define GROWTH_AT 7
 #define DGAMMA    0.01
+#define LONE      99999 /* id of a free element far from all others */
 
 typedef struct {
     cdem_state st[NINC];
@@ -35,6 +36,8 @@ static int setup(void **state) {
     fixture *f = calloc(1, sizeof *f);
     cdem_error err;
     make_packing(&f->st[0], 250, 3600.0, 1600.0, 17);
+    /* a lone free element far from the others: never enough neighbours */
+    cdem_state_append(&f->st[0], LONE, 60000.0, 500.0, 50, 1, 3, 0, 0, NULL, &err);
     f->st[0].next_id = 100000;
     for (int k = 0; k < NINC; k++) {
         if (k > 0)
@@ -114,8 +117,8 @@ static void test_analysis_total_and_incremental_rules(void **state) {
     assert_int_equal(cdem_analysis_values(f->a, 11, Q("total-max-shear"), &s, &v, &err), CDEM_OK);
     size_t pre = 0, growth = 0;
     for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAG_WALL) {
-            assert_true(isnan(v[i]));
+        if ((s->flags[i] & CDEM_FLAG_WALL) || s->id[i] == LONE) {
+            assert_true(isnan(v[i])); /* walls, and the lone element (too few neighbours) */
         } else if (s->flags[i] & CDEM_FLAG_GROWTH) {
             if (isnan(v[i]))
                 continue; /* growth elements too isolated to fit */
@@ -137,12 +140,14 @@ static void test_analysis_total_and_incremental_rules(void **state) {
     /* incremental at 10: against 5, shear 5 * DGAMMA; at 2 (< 5): against 0, zero */
     assert_int_equal(cdem_analysis_values(f->a, 10, Q("incr-max-shear"), &s, &v, &err), CDEM_OK);
     for (size_t i = 0; i < s->n; i++)
-        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH))
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH) &&
+            s->id[i] != LONE)
             assert_near(v[i], shear_of(5 * DGAMMA), 1e-12);
     free(v);
     assert_int_equal(cdem_analysis_values(f->a, 10, Q("incr-rotation"), &s, &v, &err), CDEM_OK);
     for (size_t i = 0; i < s->n; i++)
-        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH))
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH) &&
+            s->id[i] != LONE)
             assert_near(v[i], 5 * DGAMMA / 2, 1e-12); /* top to the right: clockwise */
     free(v);
     assert_int_equal(cdem_analysis_values(f->a, 2, Q("incr-disp-mag"), &s, &v, &err), CDEM_OK);
@@ -168,8 +173,22 @@ static void test_analysis_cumulative_sums_pairs(void **state) {
         size_t k = ks[t];
         assert_int_equal(cdem_analysis_values(f->a, k, Q("cum-max-shear"), &s, &v, &err), CDEM_OK);
         for (size_t i = 0; i < s->n; i++)
-            if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH))
+            if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH) &&
+                s->id[i] != LONE)
                 assert_near(v[i], (double)(k - EQUIL) * shear_of(DGAMMA), 1e-12);
+        free(v);
+    }
+    /* the lone element: 0 at the end of equilibration, NaN afterwards (never zero) */
+    for (int t = 0; t < 2; t++) {
+        size_t k = t == 0 ? EQUIL : 8;
+        assert_int_equal(cdem_analysis_values(f->a, k, Q("cum-e1"), &s, &v, &err), CDEM_OK);
+        for (size_t i = 0; i < s->n; i++)
+            if (s->id[i] == LONE) {
+                if (t == 0)
+                    assert_true(v[i] == 0.0);
+                else
+                    assert_true(isnan(v[i]));
+            }
         free(v);
     }
     /* cumulative differs from total once the path is not coaxial: here they agree to
