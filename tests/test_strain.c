@@ -395,6 +395,35 @@ static void test_strain_stress_principal(void **st) {
     assert_close(p.sigma1, 5e6, 0, "isotropic");
 }
 
+static void test_strain_bad_input_no_crash(void **st) {
+    (void)st;
+    cdem_state ref = {0}, cur = {0};
+    cdem_error err;
+    make_packing(&ref, 150, 3000.0, 1500.0, 2);
+    /* one element absurdly far away, one with a NaN position in cur, one with radius NaN */
+    ref.x[0] = 1e300;
+    ref.radius[2] = NAN;
+    cdem_state_copy(&cur, &ref, &err);
+    const double F[4] = {1.05, 0, 0, 1};
+    deform_affine(&cur, F, 0, 0);
+    cur.x[0] = 1e300;
+    cur.y[1] = NAN;
+    cdem_strain_measures *m = malloc(cur.n * sizeof *m);
+    assert_int_equal(cdem_strain_compute(&ref, &cur, NULL, 0.0, m, &err), CDEM_OK);
+    assert_true(isnan(m[0].e1)); /* alone */
+    assert_true(isnan(m[1].e1)); /* no displacement */
+    size_t ok = 0;
+    for (size_t i = 3; i < cur.n; i++)
+        if (!(cur.flags[i] & CDEM_FLAG_WALL) && isfinite(m[i].e1)) {
+            assert_close(m[i].e1, 0.05, 1e-10, "far-away element ignored");
+            ok++;
+        }
+    assert_true(ok > 100);
+    free(m);
+    cdem_state_free(&ref);
+    cdem_state_free(&cur);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_strain_fit_matches_gsl),
@@ -406,6 +435,7 @@ int main(void) {
         cmocka_unit_test(test_strain_thread_count_invariant),
         cmocka_unit_test(test_strain_cumulative_sums_pairs),
         cmocka_unit_test(test_strain_stress_principal),
+        cmocka_unit_test(test_strain_bad_input_no_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
