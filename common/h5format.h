@@ -10,7 +10,8 @@
  *   /increments/NNNNNN     one group per display increment (6-digit number), attrs: number,
  *                          step, time, phase, net_displacement, axial_strain, sea_level, n;
  *                          datasets: id, x, y, radius, layer, flags, born [, sxx, syy, sxy]
- *   /series/<column>       extendible 1-D datasets sampled during the run
+ *   /series/<column>       extendible 1-D datasets sampled during the run (full list:
+ *                          docs/format.md; it also has source and differential_stress)
  * Every dataset is chunked and compressed (shuffle + deflate). The writer flushes after
  * every increment, so a file whose writer died keeps every increment completed before.
  * Ownership: writer and reader are opaque handles; _close/_free release them.
@@ -118,7 +119,8 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec,
                                           size_t *index, cdem_error *err);
 
-/* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero). */
+/* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
+ * s must be zeroed ({0}) or initialised; on failure it is left empty. */
 cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_state *s,
                                           cdem_increment_info *info, cdem_error *err);
 
@@ -132,6 +134,13 @@ const char *cdem_h5_reader_params_text(const cdem_h5_reader *r);
 const char *cdem_h5_reader_stop_reason(const cdem_h5_reader *r);
 const char *cdem_h5_reader_program_version(const cdem_h5_reader *r);
 long cdem_h5_reader_seed(const cdem_h5_reader *r);
+/* Added after the first interface: the stop diagnosis, the source ("cdem-run", ...), the
+ * creation time (ISO 8601 UTC) and whether the writer never closed the file (it died or
+ * is still running; see docs/format.md, "A writer that dies"). */
+const char *cdem_h5_reader_stop_detail(const cdem_h5_reader *r);
+const char *cdem_h5_reader_source(const cdem_h5_reader *r);
+const char *cdem_h5_reader_created(const cdem_h5_reader *r);
+int cdem_h5_reader_unclosed(const cdem_h5_reader *r);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */
 cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err);

@@ -52,6 +52,10 @@ void cdem_state_free(cdem_state *s) {
 cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) {
     if (capacity <= s->capacity)
         return CDEM_OK;
+    /* Refuse sizes whose byte count would overflow (8-byte arrays, 1.5x growth). */
+    if (capacity > SIZE_MAX / 16)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "cannot hold %zu elements (too many for memory)",
+                         capacity);
     size_t new_cap = s->capacity ? s->capacity : 16;
     while (new_cap < capacity)
         new_cap += new_cap / 2 + 1;
@@ -71,12 +75,19 @@ cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) 
 cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
     if (s->has_stress)
         return CDEM_OK;
-#define ALLOC_ONE(name, type)                                                                      \
-    s->name = calloc(s->capacity ? s->capacity : 1, sizeof(type));                                \
-    if (!s->name)                                                                                  \
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory allocating stress arrays");
+#define ALLOC_ONE(name, type) s->name = calloc(s->capacity ? s->capacity : 1, sizeof(type));
+    /* All three or none: a partial failure frees what it got (a retry must not leak). */
     STRESS_ARRAYS(ALLOC_ONE)
 #undef ALLOC_ONE
+    if (!s->sxx || !s->syy || !s->sxy) {
+#define DROP_ONE(name, type)                                                                       \
+    free(s->name);                                                                                 \
+    s->name = NULL;
+        STRESS_ARRAYS(DROP_ONE)
+#undef DROP_ONE
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                         "out of memory allocating stress arrays for %zu elements", s->capacity);
+    }
     s->has_stress = 1;
     return CDEM_OK;
 }
@@ -84,10 +95,14 @@ cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
 cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, double radius,
                               double mass, int32_t layer, uint32_t flags, int32_t born,
                               size_t *index, cdem_error *err) {
-    CDEM_TRY(cdem_state_reserve(s, s->n + 1, err));
-    size_t i = s->n++;
     if (id < 0)
         id = s->next_id;
+    if (id == INT32_MAX)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "element id %d: ids must stay below %d (the id space is exhausted)",
+                         (int)id, (int)INT32_MAX);
+    CDEM_TRY(cdem_state_reserve(s, s->n + 1, err));
+    size_t i = s->n++;
     if (id >= s->next_id)
         s->next_id = id + 1;
     s->id[i] = id;
@@ -131,6 +146,8 @@ void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_in
 }
 
 cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *err) {
+    if (dst == src)
+        return CDEM_OK;
     cdem_state_free(dst);
     CDEM_TRY(cdem_state_init(dst, src->n, src->has_stress, err));
 #define COPY_ONE(name, type) memcpy(dst->name, src->name, src->n * sizeof(type));
@@ -161,8 +178,18 @@ cdem_status cdem_id_map_build(cdem_id_map *map, const cdem_state *s, cdem_error 
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory building an id map of %zu ids", span);
     for (size_t k = 0; k < span; k++)
         map->index[k] = SIZE_MAX;
-    for (size_t i = 0; i < s->n; i++)
-        map->index[s->id[i] - lo] = i;
+    for (size_t i = 0; i < s->n; i++) {
+        size_t *slot = &map->index[s->id[i] - lo];
+        if (*slot != SIZE_MAX) {
+            size_t first = *slot;
+            free(map->index);
+            memset(map, 0, sizeof *map);
+            return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                             "duplicate element id %d at slots %zu and %zu (ids must be unique)",
+                             (int)s->id[i], first, i);
+        }
+        *slot = i;
+    }
     map->min_id = lo;
     map->max_id = hi;
     return CDEM_OK;
