@@ -92,8 +92,9 @@ static int cmd_info(const options *o) {
     if (cdem_h5_reader_summary(r)[0] &&
         cdem_h5_reader_summary(r)[strlen(cdem_h5_reader_summary(r)) - 1] != '\n')
         printf("\n");
-    printf("\nstop reason: %s\n",
-           cdem_h5_reader_stop_reason(r)[0] ? cdem_h5_reader_stop_reason(r) : "(none recorded)");
+    const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
+    printf("\nstop reason: %s%s%s\n", reason[0] ? reason : "(none recorded)", detail[0] ? ": " : "",
+           detail);
     printf("increments: %zu (end of equilibration: increment %d)\n", cdem_analysis_count(a),
            (int)cdem_analysis_info(a, cdem_analysis_equil_index(a))->number);
     printf("%9s %12s %12s %-13s %14s %9s\n", "increment", "step", "time_s", "phase", "net_displ_m",
