@@ -16,7 +16,7 @@
 #include <string.h>
 
 #define CACHE_SLOTS 4
-#define N_STRESS    6
+#define N_STRESS    7
 #define N_DISP      4 /* x, y, mag, uplift */
 
 typedef struct {
@@ -246,6 +246,8 @@ static double pick_strain(const cdem_strain_measures *m, int comp) {
         return m->max_shear;
     case CDEM_QC_DILATION:
         return m->dilation;
+    case CDEM_QC_ANGLE1:
+        return m->angle1;
     default:
         return m->rotation;
     }
@@ -453,8 +455,8 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         for (size_t i = 0; i < n; i++) {
             cdem_stress_principal p;
             cdem_stress_principal_from(cur->sxx[i], cur->syy[i], cur->sxy[i], &p);
-            const double vals[N_STRESS] = {cur->sxx[i], cur->syy[i], cur->sxy[i],
-                                           p.sigma1,    p.sigma3,    p.max_shear};
+            const double vals[N_STRESS] = {cur->sxx[i], cur->syy[i], cur->sxy[i], p.sigma1,
+                                           p.sigma3,    p.max_shear, p.angle1};
             v[i] = vals[q->component];
         }
         break;
@@ -496,6 +498,10 @@ cdem_status cdem_analysis_limits(cdem_analysis *a, size_t index, const cdem_quan
                          a->n - 1);
     const int sym = q->scale == CDEM_SCALE_SIGNED;
     const double tsm = a->params.total_strain_max;
+    if (strcmp(q->unit, "deg") == 0) { /* directions: the whole half circle */
+        *lim = cdem_limits_fixed(-90.0, 90.0);
+        return CDEM_OK;
+    }
     switch (q->family) {
     case CDEM_QF_INCR_DISP:
         return limits_of(a, index, q, lim, err);

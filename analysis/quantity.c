@@ -29,6 +29,8 @@ static const cdem_quantity quantities[] = {
      CDEM_QC_DILATION, "S1 S3 - 1"},
     {"incr-rotation", "Incremental rotation (+ clockwise)", "rad", CDEM_SCALE_SIGNED, 0,
      CDEM_QF_INCR_STRAIN, CDEM_QC_ROTATION, "(dUx/dY - dUy/dX) / 2"},
+    {"incr-s1-direction", "Incremental S1 direction", "deg", CDEM_SCALE_SIGNED, 0,
+     CDEM_QF_INCR_STRAIN, CDEM_QC_ANGLE1, "direction of S1 in the deformed frame"},
     {"total-e1", "Total extension e1", "", CDEM_SCALE_MAGNITUDE, 0, CDEM_QF_TOTAL_STRAIN,
      CDEM_QC_E1, "S1 - 1"},
     {"total-e3", "Total shortening -e3", "", CDEM_SCALE_MAGNITUDE, 0, CDEM_QF_TOTAL_STRAIN,
@@ -37,6 +39,8 @@ static const cdem_quantity quantities[] = {
      CDEM_QF_TOTAL_STRAIN, CDEM_QC_MAXSHEAR, "(l1 - l3) / (2 sqrt(l1 l3))"},
     {"total-dilation", "Total dilation", "", CDEM_SCALE_SIGNED, 0, CDEM_QF_TOTAL_STRAIN,
      CDEM_QC_DILATION, "S1 S3 - 1"},
+    {"total-s1-direction", "Total S1 direction", "deg", CDEM_SCALE_SIGNED, 0, CDEM_QF_TOTAL_STRAIN,
+     CDEM_QC_ANGLE1, "direction of S1 in the deformed frame"},
     {"cum-e1", "Cumulative extension e1", "", CDEM_SCALE_MAGNITUDE, 0, CDEM_QF_CUM_STRAIN,
      CDEM_QC_E1, "sum of S1 - 1 over successive increments"},
     {"cum-e3", "Cumulative shortening -e3", "", CDEM_SCALE_MAGNITUDE, 0, CDEM_QF_CUM_STRAIN,
@@ -57,6 +61,8 @@ static const cdem_quantity quantities[] = {
      CDEM_QC_SIGMA3, "(sxx + syy)/2 - sqrt(((sxx - syy)/2)^2 + sxy^2)"},
     {"max-shear-stress", "Maximum shear stress (s1 - s3)/2", "N/m", CDEM_SCALE_MAGNITUDE, 1,
      CDEM_QF_STRESS, CDEM_QC_SMAXSHEAR, "(sigma1 - sigma3) / 2"},
+    {"sigma1-direction", "Direction of s1", "deg", CDEM_SCALE_SIGNED, 1, CDEM_QF_STRESS,
+     CDEM_QC_SANGLE, "0.5 atan2(2 sxy, sxx - syy)"},
 };
 
 const cdem_quantity *cdem_quantity_table(size_t *count) {

@@ -5,7 +5,7 @@
  * the shortening -e3 (positive when shortened).
  * Ownership: rows are static const; pointers stay valid for the program's life.
  * Thread safety: read-only. Units: m (displacement), 1 (strain), rad (rotation), N/m (stress,
- * compression positive). */
+ * compression positive), deg (directions, counter-clockwise from +x, in (-90, 90]). */
 #ifndef CDEM_QUANTITY_H
 #define CDEM_QUANTITY_H
 
@@ -39,6 +39,7 @@ enum {
     CDEM_QC_MAXSHEAR, /* strain: maximum shear strain */
     CDEM_QC_DILATION, /* strain: S1 S3 - 1 */
     CDEM_QC_ROTATION, /* strain: infinitesimal rotation, + clockwise */
+    CDEM_QC_ANGLE1,   /* strain: direction of S1 in the deformed frame, deg */
 };
 enum {
     CDEM_QC_SXX = 0,   /* stress: sigma_xx */
@@ -47,6 +48,7 @@ enum {
     CDEM_QC_SIGMA1,    /* stress: sigma1 */
     CDEM_QC_SIGMA3,    /* stress: sigma3 */
     CDEM_QC_SMAXSHEAR, /* stress: (sigma1 - sigma3) / 2 */
+    CDEM_QC_SANGLE,    /* stress: direction of sigma1, deg */
 };
 
 typedef struct {

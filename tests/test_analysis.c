@@ -150,6 +150,14 @@ static void test_analysis_total_and_incremental_rules(void **state) {
             s->id[i] != LONE)
             assert_near(v[i], 5 * DGAMMA / 2, 1e-12); /* top to the right: clockwise */
     free(v);
+    /* S1 direction of simple shear 0.05 (deformed frame): 0.5 atan2(2 g, g^2) */
+    assert_int_equal(cdem_analysis_values(f->a, 10, Q("incr-s1-direction"), &s, &v, &err), CDEM_OK);
+    const double g5 = 5 * DGAMMA, a5 = 0.5 * atan2(2 * g5, g5 * g5) * 180 / M_PI;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->flags[i] & CDEM_FLAG_GROWTH) &&
+            s->id[i] != LONE)
+            assert_near(v[i], a5, 1e-8);
+    free(v);
     assert_int_equal(cdem_analysis_values(f->a, 2, Q("incr-disp-mag"), &s, &v, &err), CDEM_OK);
     for (size_t i = 0; i < s->n; i++)
         assert_near(v[i], 0.0, 0);
@@ -268,6 +276,20 @@ static void test_analysis_stress_and_errors(void **state) {
         else if (s->id[i] == 10)
             assert_near(v[i], 2e6, 0); /* sxx = 10e6 > syy */
     free(v);
+    /* sigma1 direction: sxx = 1e6 id against syy = 2e6, no shear */
+    assert_int_equal(cdem_analysis_values(f->a, 6, Q("sigma1-direction"), &s, &v, &err), CDEM_OK);
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->id[i] == 1)
+            assert_near(v[i], 90.0, 1e-12);
+        else if (s->id[i] == 2)
+            assert_true(isnan(v[i])); /* isotropic: no direction */
+        else if (s->id[i] > 2 && s->id[i] < 1000)
+            assert_near(v[i], 0.0, 1e-12);
+    }
+    free(v);
+    cdem_limits l;
+    assert_int_equal(cdem_analysis_limits(f->a, 6, Q("sigma1-direction"), &l, &err), CDEM_OK);
+    assert_true(l.vmin == -90.0 && l.vmax == 90.0);
     assert_int_equal(cdem_analysis_values(f->a, 2, Q("sxx"), &s, &v, &err), CDEM_ERR_NOTFOUND);
     assert_non_null(strstr(err.msg, "increment 2 stores none"));
     assert_null(v);
