@@ -66,11 +66,14 @@ cdem_status cdem_sspx_export(cdem_analysis *a, size_t first, size_t last, const 
     if (!prefix || strchr(prefix, '/'))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: prefix '%s' must not contain '/'",
                          prefix ? prefix : "(null)");
+    int dirlen = (int)strlen(dir); /* "out/" and "out" name the same directory */
+    while (dirlen > 1 && dir[dirlen - 1] == '/')
+        dirlen--;
     for (size_t k = first; k <= last; k++) {
         const cdem_state *s;
         CDEM_TRY(cdem_analysis_state(a, k, &s, err));
         char path[CDEM_PATH_MAX + 128];
-        int n = snprintf(path, sizeof path, "%s/%s%d.txt", dir, prefix,
+        int n = snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
                          (int)cdem_analysis_info(a, k)->number);
         if (n < 0 || (size_t)n >= sizeof path)
             return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: output path in '%s' is too long", dir);

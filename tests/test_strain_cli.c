@@ -158,7 +158,7 @@ static void test_strain_cli_element_limits_info(void **state) {
 static void test_strain_cli_exports_and_import(void **state) {
     (void)state;
     char cmd[8192], out[65536], path[1200];
-    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments equil-last --prefix mod %s", g_exe,
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments equil-last --prefix mod %s/", g_exe,
              g_run, g_tmp);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     for (int k = 2; k < NINC; k++) {
@@ -176,6 +176,58 @@ static void test_strain_cli_exports_and_import(void **state) {
     /* element 0 starts at (100, 100) and moves 5 + 0.02 y = 7 m per increment; the end of
      * equilibration is increment 1, so at increment 3 it sits at x = 121 with u = 14 m */
     assert_non_null(strstr(out, "\n0,121.000000,100.000000,14\n"));
+}
+
+static void test_strain_cli_export_biaxial(void **state) {
+    (void)state;
+    char path[1200], out_path[1200], cmd[8192], out[8192];
+    snprintf(path, sizeof path, "%s/biax.h5", g_tmp);
+    snprintf(out_path, sizeof out_path, "%s/biax.txt", g_tmp);
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_BIAXIAL;
+    cdem_run_meta meta = {&p, "", "biaxial", "0", "test"};
+    cdem_h5_writer *w;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    cdem_state s = {0};
+    make_packing(&s, 30, 1000.0, 500.0, 1);
+    for (int k = 0; k < 3; k++) {
+        for (int j = 0; j < 4; j++) {
+            cdem_series_sample smp;
+            memset(&smp, 0, sizeof smp);
+            smp.step = 40 * k + 10 * j;
+            smp.axial_strain = 0.001 * (double)smp.step;
+            smp.differential_stress = 1e5 * (double)smp.step;
+            smp.sea_level = NAN;
+            assert_int_equal(cdem_h5_writer_append_series(w, &smp, &err), CDEM_OK);
+        }
+        cdem_increment_info in;
+        memset(&in, 0, sizeof in);
+        in.number = k;
+        in.step = 40 * k;
+        in.sea_level = NAN;
+        assert_int_equal(cdem_h5_writer_write_increment(w, &in, &s, &err), CDEM_OK);
+    }
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    cdem_state_free(&s);
+    snprintf(cmd, sizeof cmd, "%s export-biaxial %s -o %s", g_exe, path, out_path);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    FILE *f = fopen(out_path, "r");
+    assert_non_null(f);
+    char line[256];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, "time_step axial_strain differential_stress"));
+    int rows = 0;
+    long long step;
+    double e, sd;
+    while (fscanf(f, "%lld %lf %lf", &step, &e, &sd) == 3) {
+        assert_true(fabs(e - 0.001 * (double)step) < 1e-12);
+        assert_true(fabs(sd - 1e5 * (double)step) < 1e-3);
+        rows++;
+    }
+    fclose(f);
+    assert_int_equal(rows, 12);
 }
 
 static void test_strain_cli_errors(void **state) {
@@ -216,6 +268,7 @@ int main(void) {
         cmocka_unit_test(test_strain_cli_compute_csv),
         cmocka_unit_test(test_strain_cli_element_limits_info),
         cmocka_unit_test(test_strain_cli_exports_and_import),
+        cmocka_unit_test(test_strain_cli_export_biaxial),
         cmocka_unit_test(test_strain_cli_errors),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
