@@ -223,6 +223,45 @@ static void test_analysis_cumulative_sums_pairs(void **state) {
     free(w);
 }
 
+/* A source over the fixture that counts loads. */
+typedef struct {
+    fixture *f;
+    size_t loads;
+} counting;
+static size_t cnt_count(void *ctx) {
+    (void)ctx;
+    return NINC;
+}
+static cdem_status cnt_info(void *ctx, size_t index, cdem_increment_info *info, cdem_error *err) {
+    (void)err;
+    *info = ((counting *)ctx)->f->info[index];
+    return CDEM_OK;
+}
+static cdem_status cnt_load(void *ctx, size_t index, cdem_state *s, cdem_error *err) {
+    counting *c = ctx;
+    c->loads++;
+    return cdem_state_copy(s, &c->f->st[index], err);
+}
+
+static void test_analysis_cumulative_reuses_pairs(void **state) {
+    fixture *f = *state;
+    counting c = {f, 0};
+    const cdem_analysis_source ops = {cnt_count, cnt_info, cnt_load, NULL, NULL};
+    cdem_analysis *a;
+    cdem_error err;
+    assert_int_equal(cdem_analysis_open_source(&ops, &c, &f->params, &a, &err), CDEM_OK);
+    /* walking every increment forward loads each increment about once (LRU of 4 slots):
+     * pairs are computed once and the running sums reused, never recomputed from the start */
+    for (size_t k = 0; k < NINC; k++) {
+        const cdem_state *s;
+        double *v;
+        assert_int_equal(cdem_analysis_values(a, k, Q("cum-max-shear"), &s, &v, &err), CDEM_OK);
+        free(v);
+    }
+    assert_true(c.loads <= NINC + 2);
+    cdem_analysis_close(a);
+}
+
 static void test_analysis_limits_per_quantity(void **state) {
     fixture *f = *state;
     cdem_error err;
@@ -344,6 +383,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_analysis_total_and_incremental_rules, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_cumulative_sums_pairs, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_analysis_cumulative_reuses_pairs, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_limits_per_quantity, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_stress_and_errors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_vectors_and_axes, setup, teardown),
