@@ -5,7 +5,7 @@
  *      300 pair fits plus the running sums (generation of the states is not timed).
  * Prints seconds for OMP_NUM_THREADS 1 and 2 (best of 3) and a checksum (sum of the finite
  * max. shear values) that the Python script reproduces. */
-#include "bench_common.h"
+#include "bench_strain_states.h"
 #include "strain.h"
 
 #include <omp.h>

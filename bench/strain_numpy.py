@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The script a user would otherwise write: strain from neighbour least-squares fits with
 numpy + scipy cKDTree + batched normal equations (no Python loop over elements).
-Same states as bench/bench_common.h; prints seconds and the same checksum as bench_strain.
+Same states as bench/bench_strain_states.h; prints seconds and the same checksum as bench_strain.
 """
 import sys
 import time

@@ -1,9 +1,9 @@
-/* bench_common: the deterministic test states shared by bench_strain.c and strain_numpy.py
+/* bench_strain_states: the deterministic test states shared by bench_strain.c and strain_numpy.py
  * (the Python script builds the same positions with the same formulas). No RNG: the jitter
  * is a closed-form function of the lattice indices, so both programs see the same packing
  * (to the last few ulps of sin). */
-#ifndef CDEM_BENCH_COMMON_H
-#define CDEM_BENCH_COMMON_H
+#ifndef CDEM_BENCH_STRAIN_STATES_H
+#define CDEM_BENCH_STRAIN_STATES_H
 
 #include "state.h"
 
