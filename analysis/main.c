@@ -5,6 +5,7 @@
  * place that prints and chooses exit codes: 0 success, 1 error ("cdem-strain: <message>" on
  * stderr), 2 usage error. Results go to stdout (or -o FILE) so they can be redirected. */
 #include "analysis.h"
+#include "cmd_render.h"
 #include "biaxial.h"
 #include "cdem2d.h"
 #include "qexport.h"
@@ -362,7 +363,8 @@ static const command commands[] = {
     {"import-cdem2d", cmd_import_cdem2d, "DIR -o OUT.h5",
      "convert a cdem2D simulation folder into a cdem file"},
     {"quantities", cmd_quantities, "", "list every quantity name with unit and colour scale"},
-    /* The coordinator adds the renderer's row here: {"render", cmd_render, ...}. */
+    /* "render" has many options of its own: it is dispatched to cmd_render.c before this
+     * table is searched (see main). */
 };
 
 static void print_help(void) {
@@ -371,6 +373,10 @@ static void print_help(void) {
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         printf("  %-15s %s\n  %-15s   %s\n", commands[i].name, commands[i].help, "",
                commands[i].usage);
+    printf("  %-15s %s\n  %-15s   %s\n", "render",
+           "pictures of increments (PNG, PDF, SVG) and animated GIFs", "",
+           "RUN.h5 [--increment K|last|equil|all] [--color QUANTITY] -o OUT.png|DIR [--gif OUT.gif]"
+           " (cdem-strain render --help for all options)");
     printf("\nQuantities, formulas and rules: docs/analysis.md; text formats: "
            "docs/formats-text.md.\nExit status: 0 success, 1 error, 2 usage error.\n");
 }
@@ -436,6 +442,8 @@ int main(int argc, char **argv) {
         printf("cdem-strain %s\n", CDEM_VERSION);
         return EXIT_OK;
     }
+    if (!strcmp(argv[1], "render"))
+        return cdem_cmd_render(argc - 1, argv + 1);
     options o;
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(argv[1], commands[i].name)) {
