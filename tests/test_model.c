@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-#define REL(a, b, tol) assert_true(fabs((a) - (b)) <= (tol) * fabs(b))
+#define REL(a, b, tol) assert_true(fabs((a) - (b)) <= (tol)*fabs(b))
 
 static cdem_model derive(const cdem_params *p) {
     cdem_model m;

@@ -1,0 +1,226 @@
+/* axes: see axes.h. Nodes are visited row by row; the kept nodes are compacted in that
+ * order, so the output is the same for any thread count. */
+#include "axes.h"
+
+#include "cellgrid.h"
+#include "strain.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cdem_axes_free(cdem_axes *a) {
+    if (!a)
+        return;
+    free(a->x);
+    free(a->y);
+    free(a->angle1);
+    free(a->angle3);
+    free(a->shear_a);
+    free(a->shear_b);
+    free(a->value);
+    memset(a, 0, sizeof *a);
+}
+
+static double wrap(double a) {
+    while (a <= -90.0)
+        a += 180.0;
+    while (a > 90.0)
+        a -= 180.0;
+    return a;
+}
+
+static cdem_status alloc_axes(cdem_axes *a, size_t n, cdem_error *err) {
+    memset(a, 0, sizeof *a);
+    size_t m = n ? n : 1;
+    a->x = malloc(m * sizeof(double));
+    a->y = malloc(m * sizeof(double));
+    a->angle1 = malloc(m * sizeof(double));
+    a->angle3 = malloc(m * sizeof(double));
+    a->shear_a = malloc(m * sizeof(double));
+    a->shear_b = malloc(m * sizeof(double));
+    a->value = malloc(m * sizeof(double));
+    if (!a->x || !a->y || !a->angle1 || !a->angle3 || !a->shear_a || !a->shear_b || !a->value) {
+        cdem_axes_free(a);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "axes: out of memory for %zu grid nodes", n);
+    }
+    return CDEM_OK;
+}
+
+/* Shared driver: stress = 0 for strain axes (ref required), 1 for stress axes. */
+static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double spacing,
+                            int stress, cdem_axes *out, cdem_error *err) {
+    memset(out, 0, sizeof *out);
+    const double rmax = cdem_strain_max_radius(cur);
+    if (!(spacing > 0.0))
+        spacing = 2.0 * rmax;
+    if (!(spacing > 0.0) || !isfinite(spacing) || cur->n == 0)
+        return alloc_axes(out, 0, err);
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (size_t i = 0; i < cur->n; i++) {
+        if (!isfinite(cur->x[i]) || !isfinite(cur->y[i]))
+            continue;
+        xmin = fmin(xmin, cur->x[i]);
+        xmax = fmax(xmax, cur->x[i]);
+        ymin = fmin(ymin, cur->y[i]);
+        ymax = fmax(ymax, cur->y[i]);
+    }
+    if (!(xmax >= xmin))
+        return alloc_axes(out, 0, err);
+    const double span_x = floor((xmax - xmin) / spacing) + 1,
+                 span_y = floor((ymax - ymin) / spacing) + 1;
+    if (span_x * span_y > 4.0 * (double)cur->n + 1e4) /* absurd extent: refuse, never thrash */
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "axes: grid of %.0f x %.0f nodes at spacing %g m is too large", span_x,
+                         span_y, spacing);
+    const size_t nx = (size_t)span_x, ny = (size_t)span_y, nn = nx * ny;
+
+    cdem_id_map ref_map = {0};
+    double *ux = NULL, *uy = NULL;
+    cdem_cellgrid grid = {0};
+    cdem_axes all = {0};
+    unsigned char *keep = NULL;
+    cdem_status st = alloc_axes(&all, nn, err);
+    if (st != CDEM_OK)
+        return st;
+    keep = calloc(nn, 1);
+    ux = malloc(cur->n * sizeof *ux);
+    uy = malloc(cur->n * sizeof *uy);
+    if (!keep || !ux || !uy) {
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "axes: out of memory for %zu grid nodes", nn);
+        goto done;
+    }
+    /* Reference positions of cur's elements (strain axes); NaN when absent. */
+    if (!stress) {
+        st = cdem_id_map_build(&ref_map, ref, err);
+        if (st != CDEM_OK)
+            goto done;
+        for (size_t i = 0; i < cur->n; i++) {
+            size_t r = cdem_id_map_find(&ref_map, cur->id[i]);
+            ux[i] = r == SIZE_MAX ? NAN : ref->x[r];
+            uy[i] = r == SIZE_MAX ? NAN : ref->y[r];
+        }
+    }
+    st = cdem_cellgrid_build(&grid, cur->x, cur->y, cur->n, NULL, spacing, err);
+    if (st != CDEM_OK)
+        goto done;
+    const long nnl = (long)nn;
+#pragma omp parallel for schedule(static)
+    for (long kk = 0; kk < nnl; kk++) {
+        const size_t k = (size_t)kk;
+        const double px = xmin + (double)(k % nx) * spacing, py = ymin + (double)(k / nx) * spacing;
+        size_t ix0, ix1, iy0, iy1;
+        if (!cdem_cellgrid_range(&grid, px, py, spacing, &ix0, &ix1, &iy0, &iy1))
+            continue;
+        double X[64], Y[64], U[64], V[64];
+        size_t m = 0, nearest = SIZE_MAX;
+        double dnear = INFINITY, s_xx = 0, s_yy = 0, s_xy = 0, mx = 0, my = 0;
+        for (size_t cy = iy0; cy <= iy1; cy++)
+            for (size_t cx = ix0; cx <= ix1; cx++) {
+                const size_t c = cy * grid.nx + cx;
+                for (size_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
+                    const size_t j = grid.items[q];
+                    const double dx = cur->x[j] - px, dy = cur->y[j] - py, d2 = dx * dx + dy * dy;
+                    if (d2 > spacing * spacing)
+                        continue;
+                    if (d2 < dnear) {
+                        dnear = d2;
+                        nearest = j;
+                    }
+                    if (cur->flags[j] & CDEM_FLAGS_BOUNDARY)
+                        continue;
+                    if (stress) {
+                        s_xx += cur->sxx[j];
+                        s_yy += cur->syy[j];
+                        s_xy += cur->sxy[j];
+                        m++;
+                    } else if (isfinite(ux[j]) && m < 64) {
+                        X[m] = ux[j];
+                        Y[m] = uy[j];
+                        U[m] = cur->x[j] - ux[j];
+                        V[m] = cur->y[j] - uy[j];
+                        mx += X[m];
+                        my += Y[m];
+                        m++;
+                    }
+                }
+            }
+        if (nearest == SIZE_MAX || (cur->flags[nearest] & CDEM_FLAGS_BOUNDARY) ||
+            dnear > rmax * rmax || m == 0)
+            continue;
+        double a1, val;
+        if (stress) {
+            cdem_stress_principal p;
+            cdem_stress_principal_from(s_xx / (double)m, s_yy / (double)m, s_xy / (double)m, &p);
+            a1 = p.angle1;
+            val = p.max_shear;
+        } else {
+            mx /= (double)m;
+            my /= (double)m;
+            for (size_t q = 0; q < m; q++) {
+                X[q] -= mx;
+                Y[q] -= my;
+            }
+            double g[4];
+            if (!cdem_strain_fit(m, X, Y, U, V, g, NULL))
+                continue;
+            cdem_strain_measures sm;
+            cdem_strain_measures_from_gradient(g, &sm);
+            a1 = sm.angle1;
+            val = sm.max_shear;
+        }
+        if (!isfinite(a1))
+            continue;
+        keep[k] = 1;
+        all.x[k] = px;
+        all.y[k] = py;
+        all.angle1[k] = a1;
+        all.angle3[k] = wrap(a1 + 90.0);
+        all.shear_a[k] = wrap(a1 + 45.0);
+        all.shear_b[k] = wrap(a1 - 45.0);
+        all.value[k] = val;
+    }
+    size_t kept = 0;
+    for (size_t k = 0; k < nn; k++)
+        kept += keep[k];
+    st = alloc_axes(out, kept, err);
+    if (st != CDEM_OK)
+        goto done;
+    out->spacing = spacing;
+    for (size_t k = 0; k < nn; k++) {
+        if (!keep[k])
+            continue;
+        size_t j = out->n++;
+        out->x[j] = all.x[k];
+        out->y[j] = all.y[k];
+        out->angle1[j] = all.angle1[k];
+        out->angle3[j] = all.angle3[k];
+        out->shear_a[j] = all.shear_a[k];
+        out->shear_b[j] = all.shear_b[k];
+        out->value[j] = all.value[k];
+    }
+done:
+    cdem_axes_free(&all);
+    free(keep);
+    free(ux);
+    free(uy);
+    cdem_cellgrid_free(&grid);
+    cdem_id_map_free(&ref_map);
+    return st;
+}
+
+cdem_status cdem_axes_strain(const cdem_state *ref, const cdem_state *cur, double spacing,
+                             cdem_axes *out, cdem_error *err) {
+    return axes_run(ref, cur, spacing, 0, out, err);
+}
+
+cdem_status cdem_axes_stress(const cdem_state *cur, double spacing, cdem_axes *out,
+                             cdem_error *err) {
+    if (!cur->has_stress) {
+        memset(out, 0, sizeof *out);
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "stress axes: this increment stores no stress (run with "
+                         "physics.calculate_stress = true)");
+    }
+    return axes_run(NULL, cur, spacing, 1, out, err);
+}

@@ -1,0 +1,452 @@
+/* cmd_render: see cmd_render.h. One increment, all increments (prefix + number files) or
+ * an animated GIF. Every frame of a series uses one fixed view box (the union of the first
+ * and last increments' boxes) so pictures and animation frames line up. */
+#include "cmd_render.h"
+
+#include "analysis.h"
+#include "gif.h"
+#include "render.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+typedef struct {
+    const char *path;       /* run file */
+    const char *increment;  /* "K", "last", "first", "equil" or "all" */
+    const char *quantity;   /* colour-by quantity name, or NULL for layer colours */
+    const char *output;     /* file (single), directory (all), or NULL */
+    const char *gif;        /* animated GIF path, or NULL */
+    const char *prefix;     /* file-name prefix for --increment all */
+    const char *format;     /* extension for --increment all: png, pdf, svg */
+    int vectors;            /* 0 none, 1 incremental, 2 total */
+    int axes;               /* -1 none, else cdem_axes_kind */
+    int axes_shear;         /* 1: draw maximum-shear directions instead of principal */
+    int above_tenth;        /* 1: colour only values above 0.1 x the maximum */
+    int zoom_given;         /* 1: zoom box given */
+    double zoom[4];         /* xmin, xmax, ymin, ymax in m */
+    cdem_render_options ro; /* drawing options */
+    cdem_gif_options go;    /* GIF options */
+} render_args;
+
+static int fail(const cdem_error *err) {
+    fprintf(stderr, "cdem-strain render: %s\n", err->msg);
+    return 1;
+}
+
+static int usage(const char *what) {
+    fprintf(
+        stderr,
+        "cdem-strain render: %s\n"
+        "usage: cdem-strain render RUN.h5 [--increment K|last|first|equil|all]\n"
+        "         [--color QUANTITY] [--vectors incr|total] [--axes "
+        "incr-strain|total-strain|stress]\n"
+        "         [--shear-axes] [--above-tenth-max] [--no-fill] [--no-colours] [--no-scale-bar]\n"
+        "         [--no-colour-bar] [--no-label] [--width N] [--height N] [--zoom "
+        "XMIN,XMAX,YMIN,YMAX]\n"
+        "         [--highlight FIRST-LAST] [--color-walls #RRGGBB] [--color-layers "
+        "#RRGGBB,#RRGGBB]\n"
+        "         [-o OUT.png|.pdf|.svg | -o DIR with --increment all [--prefix P] [--format "
+        "png|pdf|svg]]\n"
+        "         [--gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]]\n",
+        what);
+    return 2;
+}
+
+static int parse_double(const char *text, double *out) {
+    char *end;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (errno || end == text || *end || !isfinite(v))
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static int parse_int(const char *text, int *out) {
+    char *end;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (errno || end == text || *end || v < -2147483647L || v > 2147483647L)
+        return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static int parse_args(int argc, char **argv, render_args *a) {
+    memset(a, 0, sizeof *a);
+    a->increment = "last";
+    a->prefix = "cdem";
+    a->format = "png";
+    a->axes = -1;
+    cdem_render_options_default(&a->ro);
+    cdem_gif_options_default(&a->go);
+    cdem_error err;
+    cdem_error_clear(&err);
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED_VALUE()                                                                               \
+    do {                                                                                           \
+        if (!next) {                                                                               \
+            char m_[128];                                                                          \
+            snprintf(m_, sizeof m_, "%s needs a value", arg);                                      \
+            return usage(m_);                                                                      \
+        }                                                                                          \
+        i++;                                                                                       \
+    } while (0)
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+            usage("help");
+            return 3; /* help shown: exit 0 after the caller sees 3 */
+        } else if (!strcmp(arg, "--increment") || !strcmp(arg, "--increments")) {
+            NEED_VALUE();
+            a->increment = next;
+        } else if (!strcmp(arg, "--color") || !strcmp(arg, "--colour")) {
+            NEED_VALUE();
+            a->quantity = next;
+        } else if (!strcmp(arg, "-o") || !strcmp(arg, "--output")) {
+            NEED_VALUE();
+            a->output = next;
+        } else if (!strcmp(arg, "--gif")) {
+            NEED_VALUE();
+            a->gif = next;
+        } else if (!strcmp(arg, "--prefix")) {
+            NEED_VALUE();
+            a->prefix = next;
+        } else if (!strcmp(arg, "--format")) {
+            NEED_VALUE();
+            if (strcmp(next, "png") && strcmp(next, "pdf") && strcmp(next, "svg"))
+                return usage("--format must be png, pdf or svg");
+            a->format = next;
+        } else if (!strcmp(arg, "--vectors")) {
+            NEED_VALUE();
+            if (!strcmp(next, "incr"))
+                a->vectors = 1;
+            else if (!strcmp(next, "total"))
+                a->vectors = 2;
+            else
+                return usage("--vectors must be incr or total");
+        } else if (!strcmp(arg, "--axes")) {
+            NEED_VALUE();
+            if (!strcmp(next, "incr-strain"))
+                a->axes = CDEM_AXES_INCR_STRAIN;
+            else if (!strcmp(next, "total-strain"))
+                a->axes = CDEM_AXES_TOTAL_STRAIN;
+            else if (!strcmp(next, "stress"))
+                a->axes = CDEM_AXES_STRESS;
+            else
+                return usage("--axes must be incr-strain, total-strain or stress");
+        } else if (!strcmp(arg, "--shear-axes")) {
+            a->axes_shear = 1;
+        } else if (!strcmp(arg, "--above-tenth-max")) {
+            a->above_tenth = 1;
+        } else if (!strcmp(arg, "--no-fill")) {
+            a->ro.show_fill = 0;
+        } else if (!strcmp(arg, "--no-colours") || !strcmp(arg, "--no-colors")) {
+            a->ro.show_colours = 0;
+        } else if (!strcmp(arg, "--no-scale-bar")) {
+            a->ro.show_scale_bar = 0;
+        } else if (!strcmp(arg, "--no-colour-bar") || !strcmp(arg, "--no-color-bar")) {
+            a->ro.show_colour_bar = 0;
+        } else if (!strcmp(arg, "--no-label")) {
+            a->ro.show_label = 0;
+        } else if (!strcmp(arg, "--width")) {
+            NEED_VALUE();
+            if (!parse_int(next, &a->ro.width) || a->ro.width < 16 ||
+                a->ro.width > CDEM_RENDER_MAX_SIZE)
+                return usage("--width must be a whole number from 16 to 20000");
+        } else if (!strcmp(arg, "--height")) {
+            NEED_VALUE();
+            if (!parse_int(next, &a->ro.height) || a->ro.height < 16 ||
+                a->ro.height > CDEM_RENDER_MAX_SIZE)
+                return usage("--height must be a whole number from 16 to 20000");
+        } else if (!strcmp(arg, "--zoom")) {
+            NEED_VALUE();
+            char buf[256];
+            snprintf(buf, sizeof buf, "%s", next);
+            char *save = NULL, *tok = strtok_r(buf, ",", &save);
+            int k = 0;
+            while (tok && k < 4 && parse_double(tok, &a->zoom[k])) {
+                k++;
+                tok = strtok_r(NULL, ",", &save);
+            }
+            if (k != 4 || tok || a->zoom[0] >= a->zoom[1] || a->zoom[2] >= a->zoom[3])
+                return usage("--zoom must be XMIN,XMAX,YMIN,YMAX in metres with XMIN < XMAX "
+                             "and YMIN < YMAX");
+            a->zoom_given = 1;
+        } else if (!strcmp(arg, "--highlight")) {
+            NEED_VALUE();
+            if (sscanf(next, "%d-%d", &a->ro.highlight_first, &a->ro.highlight_last) != 2 ||
+                a->ro.highlight_first < 1 || a->ro.highlight_last < a->ro.highlight_first)
+                return usage("--highlight must be FIRST-LAST layers, e.g. 5-8");
+        } else if (!strcmp(arg, "--color-walls") || !strcmp(arg, "--colour-walls")) {
+            NEED_VALUE();
+            if (cdem_render_parse_colour(next, &a->ro.wall, &err) != CDEM_OK)
+                return usage(err.msg);
+        } else if (!strcmp(arg, "--color-layers") || !strcmp(arg, "--colour-layers")) {
+            NEED_VALUE();
+            char buf[64];
+            snprintf(buf, sizeof buf, "%s", next);
+            char *comma = strchr(buf, ',');
+            if (!comma)
+                return usage("--color-layers needs two colours: #RRGGBB,#RRGGBB");
+            *comma = '\0';
+            if (cdem_render_parse_colour(buf, &a->ro.pregrowth[0], &err) != CDEM_OK ||
+                cdem_render_parse_colour(comma + 1, &a->ro.pregrowth[1], &err) != CDEM_OK)
+                return usage(err.msg);
+        } else if (!strcmp(arg, "--backward")) {
+            a->go.order = CDEM_GIF_BACKWARD;
+        } else if (!strcmp(arg, "--odd")) {
+            a->go.selection = CDEM_GIF_ODD;
+        } else if (!strcmp(arg, "--gif-scale")) {
+            NEED_VALUE();
+            if (!parse_double(next, &a->go.scale) || a->go.scale < 0.05 || a->go.scale > 1)
+                return usage("--gif-scale must be between 0.05 and 1");
+        } else if (!strcmp(arg, "--delay")) {
+            NEED_VALUE();
+            if (!parse_int(next, &a->go.delay_cs) || a->go.delay_cs < 1 || a->go.delay_cs > 65535)
+                return usage("--delay must be 1 to 65535 hundredths of a second");
+        } else if (arg[0] == '-' && arg[1]) {
+            char m[160];
+            snprintf(m, sizeof m, "unknown option '%s'", arg);
+            return usage(m);
+        } else if (!a->path) {
+            a->path = arg;
+        } else {
+            char m[160];
+            snprintf(m, sizeof m, "unexpected argument '%s'", arg);
+            return usage(m);
+        }
+#undef NEED_VALUE
+    }
+    if (!a->path)
+        return usage("no run file given");
+    if (!a->output && !a->gif)
+        return usage("give -o OUTPUT (a picture, or a directory with --increment all) or --gif");
+    return 0;
+}
+
+/* Everything one picture needs, owned here and released by scene_free. */
+typedef struct {
+    cdem_render_scene sc;
+    double *values, *ux, *uy;
+    cdem_axes axes;
+    double *axis_angle;
+    char label[256];
+    char title[160];
+} scene_data;
+
+static void scene_free(scene_data *d) {
+    free(d->values);
+    free(d->ux);
+    free(d->uy);
+    free(d->axis_angle);
+    cdem_axes_free(&d->axes);
+    memset(d, 0, sizeof *d);
+}
+
+static void make_label(const cdem_analysis *an, size_t index, char *buf, size_t n) {
+    const cdem_increment_info *info = cdem_analysis_info(an, index);
+    const cdem_params *p = cdem_analysis_params(an);
+    if (p->mode == CDEM_MODE_BIAXIAL)
+        snprintf(buf, n, "Increment %d   Axial strain %.4f", (int)info->number, info->axial_strain);
+    else if (p->mode == CDEM_MODE_REPOSE)
+        snprintf(buf, n, "Increment %d   Time %.0f s", (int)info->number, info->time);
+    else
+        snprintf(buf, n, "Increment %d   Net displacement %.1f m", (int)info->number,
+                 info->net_displacement);
+}
+
+static cdem_status build_scene(cdem_analysis *an, size_t index, const render_args *a,
+                               const cdem_quantity *q, scene_data *d, cdem_error *err) {
+    memset(d, 0, sizeof *d);
+    const cdem_state *s = NULL;
+    CDEM_TRY(cdem_analysis_state(an, index, &s, err));
+    d->sc.state = s;
+    if (q) {
+        cdem_limits lim;
+        CDEM_TRY(cdem_analysis_values(an, index, q, &s, &d->values, err));
+        CDEM_TRY(cdem_analysis_limits(an, index, q, &lim, err));
+        d->sc.state = s;
+        d->sc.values = d->values;
+        d->sc.vmin = lim.vmin;
+        d->sc.vmax = lim.vmax;
+        d->sc.kind = (cdem_colormap_kind)q->scale;
+        snprintf(d->title, sizeof d->title, "%s", q->label);
+        d->sc.quantity = d->title;
+        d->sc.unit = q->unit;
+        d->sc.above_tenth_max = a->above_tenth;
+    }
+    if (a->vectors) {
+        const cdem_state *vs = NULL;
+        CDEM_TRY(cdem_analysis_vectors(an, index, a->vectors == 2, &vs, &d->ux, &d->uy, err));
+        if (vs != d->sc.state)
+            return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                             "%s: increment %zu: vectors and values refer to different states",
+                             a->path, index);
+        d->sc.ux = d->ux;
+        d->sc.uy = d->uy;
+        d->sc.vector_scale = a->vectors == 1 ? 5.0 : 1.0;
+    }
+    if (a->axes >= 0) {
+        CDEM_TRY(cdem_analysis_axes(an, index, (cdem_axes_kind)a->axes, &d->axes, err));
+        d->axis_angle = malloc((d->axes.n ? d->axes.n : 1) * sizeof *d->axis_angle);
+        if (!d->axis_angle)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for %zu axes", d->axes.n);
+        const double *deg = a->axes_shear ? d->axes.shear_a : d->axes.angle1;
+        for (size_t i = 0; i < d->axes.n; i++)
+            d->axis_angle[i] = deg[i] * M_PI / 180.0;
+        d->sc.axis_x = d->axes.x;
+        d->sc.axis_y = d->axes.y;
+        d->sc.axis_angle = d->axis_angle;
+        d->sc.n_axes = d->axes.n;
+        d->sc.axis_perpendicular = 1;
+    }
+    make_label(an, index, d->label, sizeof d->label);
+    d->sc.label = d->label;
+    return CDEM_OK;
+}
+
+/* The view box shared by every picture of a series: first and last increments together. */
+static cdem_status series_box(cdem_analysis *an, double margin, double box[4], cdem_error *err) {
+    size_t n = cdem_analysis_count(an);
+    const cdem_state *s = NULL;
+    double b0[4], b1[4];
+    CDEM_TRY(cdem_analysis_state(an, 0, &s, err));
+    cdem_render_fit_box(s, margin, b0);
+    CDEM_TRY(cdem_analysis_state(an, n - 1, &s, err));
+    cdem_render_fit_box(s, margin, b1);
+    box[0] = fmin(b0[0], b1[0]);
+    box[1] = fmax(b0[1], b1[1]);
+    box[2] = fmin(b0[2], b1[2]);
+    box[3] = fmax(b0[3], b1[3]);
+    return CDEM_OK;
+}
+
+static void set_zoom(cdem_render_options *o, const double box[4]) {
+    o->has_zoom = 1;
+    o->zoom_xmin = box[0];
+    o->zoom_xmax = box[1];
+    o->zoom_ymin = box[2];
+    o->zoom_ymax = box[3];
+}
+
+static cdem_status render_one(cdem_analysis *an, size_t index, const render_args *a,
+                              const cdem_quantity *q, const cdem_render_options *o,
+                              const char *path, cdem_error *err) {
+    scene_data d;
+    cdem_status st = build_scene(an, index, a, q, &d, err);
+    if (st == CDEM_OK)
+        st = cdem_render_to_file(path, &d.sc, o, err);
+    scene_free(&d);
+    return st;
+}
+
+typedef struct {
+    cdem_analysis *an;
+    const render_args *a;
+    const cdem_quantity *q;
+    const cdem_render_options *o;
+} gif_ctx;
+
+static cdem_status gif_frame(void *user, size_t index, uint8_t *rgba, int width, int height,
+                             cdem_error *err) {
+    const gif_ctx *g = user;
+    scene_data d;
+    cdem_status st = build_scene(g->an, index, g->a, g->q, &d, err);
+    if (st == CDEM_OK)
+        st = cdem_render_to_rgba(rgba, width, height, &d.sc, g->o, err);
+    scene_free(&d);
+    return st;
+}
+
+static int run_render(const render_args *a) {
+    cdem_error err;
+    cdem_error_clear(&err);
+    cdem_analysis *an = NULL;
+    const cdem_quantity *q = NULL;
+    if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
+        return fail(&err);
+    if (cdem_analysis_open(a->path, &an, &err) != CDEM_OK)
+        return fail(&err);
+    int rc = 0;
+    size_t n = cdem_analysis_count(an);
+    cdem_render_options o = a->ro;
+    o.growth1_layers = cdem_analysis_params(an)->growth_sequence1_layers;
+    if (n == 0) {
+        CDEM_FAIL(&err, CDEM_ERR_NOTFOUND, "%s: the file has no increments", a->path);
+        rc = fail(&err);
+        goto done;
+    }
+    int series = a->gif || !strcmp(a->increment, "all");
+    if (a->zoom_given) {
+        set_zoom(&o, a->zoom);
+    } else if (series) {
+        double box[4];
+        if (series_box(an, o.margin, box, &err) != CDEM_OK) {
+            rc = fail(&err);
+            goto done;
+        }
+        set_zoom(&o, box);
+    }
+    if (a->gif) {
+        /* Frame size from the first frame's layout, kept for every frame. */
+        scene_data d;
+        int height = o.height;
+        if (build_scene(an, 0, a, q, &d, &err) != CDEM_OK ||
+            (!height && cdem_render_auto_height(&d.sc, &o, &height, &err) != CDEM_OK)) {
+            scene_free(&d);
+            rc = fail(&err);
+            goto done;
+        }
+        scene_free(&d);
+        gif_ctx g = {an, a, q, &o};
+        if (cdem_gif_write(a->gif, n, o.width, height, gif_frame, &g, &a->go, &err) != CDEM_OK) {
+            rc = fail(&err);
+            goto done;
+        }
+        printf("%s: %zu increments\n", a->gif, cdem_gif_frame_order(n, &a->go, NULL));
+    }
+    if (!a->output)
+        goto done;
+    if (!strcmp(a->increment, "all")) {
+        if (mkdir(a->output, 0777) != 0 && errno != EEXIST) {
+            CDEM_FAIL(&err, CDEM_ERR_IO, "%s: cannot create the output directory: %s", a->output,
+                      strerror(errno));
+            rc = fail(&err);
+            goto done;
+        }
+        for (size_t i = 0; i < n && rc == 0; i++) {
+            char path[4096];
+            snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+                     (int)cdem_analysis_info(an, i)->number, a->format);
+            if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK)
+                rc = fail(&err);
+        }
+        if (rc == 0)
+            printf("%s: %zu pictures\n", a->output, n);
+    } else {
+        size_t index;
+        if (cdem_analysis_find(an, a->increment, &index, &err) != CDEM_OK ||
+            render_one(an, index, a, q, &o, a->output, &err) != CDEM_OK)
+            rc = fail(&err);
+        else
+            printf("%s\n", a->output);
+    }
+done:
+    cdem_analysis_close(an);
+    return rc;
+}
+
+int cdem_cmd_render(int argc, char **argv) {
+    render_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc == 3)
+        return 0;
+    if (rc != 0)
+        return rc;
+    return run_render(&a);
+}

@@ -1,0 +1,12 @@
+/* cmd_render: the `cdem-strain render` subcommand: turns command-line options into a
+ * cdem_render_scene/options pair per increment (values, limits, vectors, axes and the
+ * label from the analysis context) and writes one picture, one picture per increment, or
+ * an animated GIF. Kept apart from main.c because its options are many and its own.
+ * Ownership: nothing outlives the call. Thread safety: one call at a time per process. */
+#ifndef CDEM_CMD_RENDER_H
+#define CDEM_CMD_RENDER_H
+
+/* argv[0] is "render"; returns the process exit code (0 ok, 1 error, 2 usage). */
+int cdem_cmd_render(int argc, char **argv);
+
+#endif
