@@ -7,7 +7,7 @@ BUILD=${1:-build}
 OUT=${CDEM_DEMO_OUT:-out}
 mkdir -p "$OUT"
 "$BUILD/cdem-run" -o "$OUT/default.h5"
-"$BUILD/cdem-strain" info "$OUT/default.h5" | head -n 3
+"$BUILD/cdem-strain" info "$OUT/default.h5" | grep -E "^(stop reason|increments):"
 "$BUILD/cdem-strain" compute "$OUT/default.h5" --increment last --quantity total-max-shear \
     -o "$OUT/default-total-max-shear.csv"
 "$BUILD/cdem-strain" render "$OUT/default.h5" --increment last -o "$OUT/default-layers.png"
