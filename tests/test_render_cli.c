@@ -1,0 +1,202 @@
+/* test_render_cli: `cdem-strain render` end to end on a short real run made by cdem-run
+ * ($CDEM_BUILD, default build/): one picture per format, all increments as prefix+number
+ * files, an animated GIF with one frame per increment (and the odd-frame selection), and
+ * the usage and error messages. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <gif_lib.h>
+
+#include <dirent.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static char g_tmp[1024], g_run[1100], g_strain[1100], g_bin[1024];
+static int g_increments; /* increments in the run, from `cdem-strain info` */
+
+static int run(const char *cmd, char *out, size_t n) {
+    char full[8192];
+    snprintf(full, sizeof full, "%s 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    if (!p)
+        return -1;
+    size_t got = fread(out, 1, n - 1, p);
+    out[got] = '\0';
+    while (fread(full, 1, sizeof full, p) > 0) {
+    }
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int setup(void **state) {
+    (void)state;
+    const char *t = getenv("CDEM_TEST_TMP");
+    snprintf(g_tmp, sizeof g_tmp, "%s/render_cli_%d", t ? t : "/tmp", (int)getpid());
+    const char *b = getenv("CDEM_BUILD");
+    char *abs = realpath(b ? b : "build", NULL); /* tests cd elsewhere */
+    if (!abs)
+        return -1;
+    snprintf(g_bin, sizeof g_bin, "%s", abs);
+    free(abs);
+    snprintf(g_strain, sizeof g_strain, "%s/cdem-strain", g_bin);
+    snprintf(g_run, sizeof g_run, "%s/run.h5", g_tmp);
+    char cmd[4096], out[8192];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", g_tmp);
+    if (system(cmd) != 0)
+        return -1;
+    /* A 10 x 2.5 unit planar normal fault, 200 s equilibration and 100 s of faulting. */
+    snprintf(cmd, sizeof cmd,
+             "'%s/cdem-run' -q -s assembly.height=2.5 -s time.equilibration=200 "
+             "-s time.runtime=300 -s time.display_interval=20 -o '%s'",
+             g_bin, g_run);
+    if (run(cmd, out, sizeof out) != 0) {
+        fprintf(stderr, "cdem-run failed: %s\n", out);
+        return -1;
+    }
+    snprintf(cmd, sizeof cmd, "'%s' info '%s'", g_strain, g_run);
+    if (run(cmd, out, sizeof out) != 0)
+        return -1;
+    const char *line = strstr(out, "increments: ");
+    if (!line || sscanf(line, "increments: %d", &g_increments) != 1)
+        return -1;
+    return 0;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    char cmd[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void read_head(const char *path, char *buf, size_t n) {
+    memset(buf, 0, n);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    size_t got = fread(buf, 1, n - 1, f);
+    fclose(f);
+    assert_true(got > 0);
+}
+
+static void test_render_cli_formats(void **state) {
+    (void)state;
+    assert_true(g_increments >= 10);
+    static const struct {
+        const char *ext;
+        const char *magic;
+    } cases[] = {{"png", "\x89PNG"}, {"pdf", "%PDF-"}, {"svg", "<svg"}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char cmd[4096], out[4096], path[1200], head[512];
+        snprintf(path, sizeof path, "%s/shear.%s", g_tmp, cases[i].ext);
+        snprintf(cmd, sizeof cmd,
+                 "'%s' render '%s' --increment last --color total-max-shear --vectors total "
+                 "--axes total-strain --width 600 -o '%s'",
+                 g_strain, g_run, path);
+        assert_int_equal(run(cmd, out, sizeof out), 0);
+        read_head(path, head, sizeof head);
+        assert_non_null(strstr(head, cases[i].magic));
+    }
+    /* The PNG is as wide as asked: width is big-endian at byte 16 of the IHDR chunk. */
+    char path[1200];
+    unsigned char ihdr[24];
+    snprintf(path, sizeof path, "%s/shear.png", g_tmp);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
+    fclose(f);
+    unsigned width =
+        (unsigned)ihdr[16] << 24 | (unsigned)ihdr[17] << 16 | (unsigned)ihdr[18] << 8 | ihdr[19];
+    assert_int_equal(width, 600);
+}
+
+static void test_render_cli_all_increments(void **state) {
+    (void)state;
+    char cmd[4096], out[4096], dir[1200];
+    snprintf(dir, sizeof dir, "%s/frames", g_tmp);
+    snprintf(cmd, sizeof cmd,
+             "'%s' render '%s' --increment all --color incr-max-shear --width 200 --prefix inc "
+             "-o '%s'",
+             g_strain, g_run, dir);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int count = 0, has_first = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        if (!strncmp(e->d_name, "inc", 3) && strstr(e->d_name, ".png"))
+            count++;
+        if (!strcmp(e->d_name, "inc0.png"))
+            has_first = 1;
+    }
+    closedir(d);
+    assert_int_equal(count, g_increments);
+    assert_true(has_first);
+}
+
+static int gif_frames(const char *path) {
+    int error = 0;
+    GifFileType *g = DGifOpenFileName(path, &error);
+    assert_non_null(g);
+    assert_int_equal(DGifSlurp(g), GIF_OK);
+    int n = g->ImageCount;
+    DGifCloseFile(g, &error);
+    return n;
+}
+
+static void test_render_cli_gif(void **state) {
+    (void)state;
+    char cmd[4096], out[4096], path[1200];
+    snprintf(path, sizeof path, "%s/movie.gif", g_tmp);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --width 240 --gif '%s'", g_strain, g_run, path);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(gif_frames(path), g_increments);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --width 240 --odd --backward --gif '%s'", g_strain,
+             g_run, path);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(gif_frames(path), g_increments / 2);
+}
+
+static void test_render_cli_errors(void **state) {
+    (void)state;
+    static const struct {
+        const char *args; /* after "render RUN" */
+        int code;
+        const char *message;
+    } cases[] = {
+        {"--color total-max-shaer -o x.png", 1, "did you mean 'total-max-shear'"},
+        {"--increment 99999 -o x.png", 1, "99999"},
+        {"", 2, "give -o OUTPUT"},
+        {"--zoom 1,2,3 -o x.png", 2, "--zoom must be XMIN,XMAX,YMIN,YMAX"},
+        {"--width 5 -o x.png", 2, "--width must be"},
+        {"--vectors sideways -o x.png", 2, "--vectors must be incr or total"},
+        {"--bogus -o x.png", 2, "unknown option '--bogus'"},
+        {"-o x.tiff", 1, ".png"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char cmd[4096], out[8192];
+        snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render '%s' %s", g_tmp, g_strain, g_run,
+                 cases[i].args);
+        int rc = run(cmd, out, sizeof out);
+        if (rc != cases[i].code || !strstr(out, cases[i].message))
+            fail_msg("case %zu (%s): exit %d, output: %s", i, cases[i].args, rc, out);
+    }
+    char cmd[4096], out[4096];
+    snprintf(cmd, sizeof cmd, "'%s' render '%s/missing.h5' -o '%s/x.png'", g_strain, g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "missing.h5"));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_render_cli_formats),
+        cmocka_unit_test(test_render_cli_all_increments),
+        cmocka_unit_test(test_render_cli_gif),
+        cmocka_unit_test(test_render_cli_errors),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
