@@ -10,9 +10,13 @@
 #include <cmocka.h>
 
 #include "contact.h"
+#include "h5format.h"
 #include "integrate.h"
+#include "run.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define KN  1.0e9
@@ -374,6 +378,89 @@ static void test_heterogeneity_erosion_removes_above(void **st) {
     cdem_state_free(&s);
 }
 
+/* End to end: a small reverse-fault model with an upper light interval, flexural slip and
+ * erosion at the initial top runs (no refusal); increment 0 flags exactly the upper interval,
+ * every increment carries the flags, and no free element of a deformation increment is
+ * above the level. (Masses are not in the file; test_heterogeneity_weak_mass covers them.) */
+static void test_heterogeneity_run_end_to_end(void **st) {
+    (void)st;
+    char path[1024];
+    const char *dir = getenv("CDEM_TEST_TMP");
+    snprintf(path, sizeof path, "%s/test_heterogeneity_run.h5", dir && *dir ? dir : "/tmp");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.width = 10.0;
+    p.height = 2.5;
+    p.equilibration = 100.0;
+    p.runtime = 250.0;
+    p.fault_sense = CDEM_SENSE_REVERSE;
+    p.fault_dip = 60.0;
+    p.flexural_slip = 1;
+    p.weak_interval = CDEM_WEAK_UPPER;
+    p.weak_thickness_percent = 40.0;
+    p.weak_strength_percent = 50.0;
+    p.weak_density_percent = 80.0;
+    p.erosion = 1;
+    p.erosion_base_level = 1.0;
+    cdem_error err;
+    cdem_model m;
+    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    cdem_run_options o;
+    memset(&o, 0, sizeof o);
+    o.output_path = path;
+    o.quiet = 1;
+    if (cdem_run(&p, &o, &err) != CDEM_OK)
+        fail_msg("cdem_run: %s", err.msg);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "completed");
+    const size_t ninc = cdem_h5_reader_increment_count(r);
+    size_t ie = 0;
+    assert_int_equal(cdem_h5_reader_find_increment(r, "equil", &ie, &err), CDEM_OK);
+    cdem_state s;
+    memset(&s, 0, sizeof s);
+    cdem_increment_info info;
+    double level = INFINITY;
+    long weak0 = -1;
+    size_t n_equil = 0, n_last = 0;
+    for (size_t k = 0; k < ninc; k++) {
+        assert_int_equal(cdem_h5_reader_load_increment(r, k, &s, &info, &err), CDEM_OK);
+        long weak = 0;
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < s.n; i++) {
+            if (s.flags[i] & CDEM_FLAGS_BOUNDARY)
+                continue;
+            lo = fmin(lo, s.y[i]);
+            hi = fmax(hi, s.y[i]);
+            weak += (s.flags[i] & CDEM_FLAG_WEAK) != 0;
+            if (k > ie)
+                assert_true(s.y[i] <= level);
+        }
+        if (k == 0) {
+            /* membership from the initial heights: the upper 40 % of the centre span */
+            for (size_t i = 0; i < s.n; i++) {
+                const int in =
+                    !(s.flags[i] & CDEM_FLAGS_BOUNDARY) && s.y[i] >= hi - 0.40 * (hi - lo);
+                assert_int_equal((s.flags[i] & CDEM_FLAG_WEAK) != 0, in);
+            }
+            weak0 = weak;
+        }
+        /* the flag is kept for life; only erosion (of the top, weak here) lowers the count */
+        assert_true(weak > 0 && weak <= weak0);
+        if (k == ie) {
+            level = lo + 1.0 * (hi - lo); /* docs/solver.md 7.4 */
+            n_equil = s.n;
+        }
+        n_last = s.n;
+        cdem_state_free(&s);
+    }
+    assert_true(isfinite(level));
+    assert_true(n_last < n_equil); /* the uplifted hanging wall was eroded */
+    cdem_h5_reader_close(r);
+    remove(path);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_heterogeneity_flexural_slip),
@@ -383,6 +470,7 @@ int main(void) {
         cmocka_unit_test(test_heterogeneity_layered_friction),
         cmocka_unit_test(test_heterogeneity_overburden_surface),
         cmocka_unit_test(test_heterogeneity_erosion_removes_above),
+        cmocka_unit_test(test_heterogeneity_run_end_to_end),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
