@@ -234,19 +234,26 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
 
     heading(f, "Heterogeneity");
     line(f, "flexural slip", "%s",
-         p->flexural_slip ? "on (no strength between pre-growth layers)" : "off");
+         p->flexural_slip ? "on (no strength between pre-growth layers, from the end of "
+                            "equilibration)"
+                          : "off");
     if (p->weak_interval == CDEM_WEAK_OFF) {
         line(f, "weak/light interval", "off");
     } else {
-        line(f, "weak/light interval", "%s %g %% of the height = %.6g m",
+        line(f, "weak/light interval",
+             "%s %g %% of the height = %.6g m (of the initial span of element centres; "
+             "fixed at assembly, flagged weak)",
              p->weak_interval == CDEM_WEAK_LOWER ? "lower" : "upper", p->weak_thickness_percent,
              p->weak_thickness_percent / 100.0 * m->height_m);
+        line(f, "mixed pairs", "a pair with one weak element uses the weak values");
         line(f, "interval strength", "%g %% of the material values", p->weak_strength_percent);
         line(f, "interval density", "%g %% = %g kg/m^3", p->weak_density_percent,
              p->weak_density_percent / 100.0 * p->density);
     }
     if (p->layered_friction)
-        line(f, "layered friction", "layers 5-8, 13-16, 21-24 friction %g",
+        line(f, "layered friction",
+             "layers 5-8, 13-16, 21-24 friction %g (a pair with either element in such a "
+             "layer)",
              p->layered_friction_value);
     else
         line(f, "layered friction", "off");
@@ -254,12 +261,19 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
 
     heading(f, "Surface processes");
     if (p->overburden_pressure > 0)
-        line(f, "overburden pressure", "%g N/m", p->overburden_pressure);
+        line(f, "overburden pressure",
+             "%g N/m on the top surface: %g N on the highest element of each %g m column "
+             "(2 x the largest radius), found again at every neighbour-list rebuild",
+             p->overburden_pressure, p->overburden_pressure * 2.0 * m->max_radius,
+             2.0 * m->max_radius);
     else
         line(f, "overburden pressure", "off");
     if (p->erosion)
-        line(f, "erosion", "above %g x the assembly height = %.6g m", p->erosion_base_level,
-             p->erosion_base_level * m->height_m);
+        line(f, "erosion",
+             "above %g x the assembly height = %.6g m (exactly: the level x the span of "
+             "element centres at the end of equilibration, above the lowest centre); "
+             "elements above it removed before each deformation increment",
+             p->erosion_base_level, p->erosion_base_level * m->height_m);
     else
         line(f, "erosion", "off");
     if (p->sedimentation) {

@@ -2,12 +2,19 @@
  * header so the force loop in integrate.c can inline it. */
 #include "contact.h"
 
+#include "model.h"
 #include "state.h"
 
-static const char *const class_names[CDEM_CLASS_COUNT] = {"element", "wall", "fault"};
+static const char *const class_names[CDEM_CLASS_TOTAL] = {"element",
+                                                          "wall",
+                                                          "fault",
+                                                          "element (weak)",
+                                                          "element (layered)",
+                                                          "element (layered, weak)",
+                                                          "element (flexural slip)"};
 
 const char *cdem_contact_class_name(int cls) {
-    if (cls < 0 || cls >= CDEM_CLASS_COUNT)
+    if (cls < 0 || cls >= CDEM_CLASS_TOTAL)
         return "none";
     return class_names[cls];
 }
@@ -48,6 +55,8 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
     law->kn = kn;
     law->ks = ks;
     law->max_breaking_strain = 0.0;
+    law->flexural_slip = p->flexural_slip ? 1 : 0;
+    law->layered_friction = p->layered_friction ? 1 : 0;
     if (p->material != CDEM_MATERIAL_GRANULAR && p->material != CDEM_MATERIAL_BONDED)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "contact law: material.model = %d: must be granular or bonded",
@@ -65,5 +74,93 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
                 law->max_breaking_strain = mats[c]->breaking_strain;
         }
     }
+    /* heterogeneity classes (element-element refinements) */
+    const double ws = p->weak_interval != CDEM_WEAK_OFF ? p->weak_strength_percent / 100.0 : 1.0;
+    if (!isfinite(ws) || ws < 0.0 || ws > 1.0)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "contact law: heterogeneity.weak_strength_percent = %g: must be 0..100",
+                         p->weak_strength_percent);
+    const double lf = p->layered_friction ? p->layered_friction_value : p->element.friction;
+    CDEM_TRY(check_value("heterogeneity", "layered_friction_value", lf, 0, err));
+    const cdem_contact_material *e = &p->element;
+    law->friction[CDEM_CLASS_WEAK] = e->friction * ws;
+    law->cohesion[CDEM_CLASS_WEAK] = e->cohesion * ws;
+    law->breaking_strain[CDEM_CLASS_WEAK] = e->breaking_strain * ws;
+    law->friction[CDEM_CLASS_LAYERED] = lf;
+    law->cohesion[CDEM_CLASS_LAYERED] = e->cohesion;
+    law->breaking_strain[CDEM_CLASS_LAYERED] = e->breaking_strain;
+    law->friction[CDEM_CLASS_LAYERED_WEAK] = lf * ws;
+    law->cohesion[CDEM_CLASS_LAYERED_WEAK] = e->cohesion * ws;
+    law->breaking_strain[CDEM_CLASS_LAYERED_WEAK] = e->breaking_strain * ws;
+    law->friction[CDEM_CLASS_SLIP] = 0.0;
+    law->cohesion[CDEM_CLASS_SLIP] = 0.0;
+    law->breaking_strain[CDEM_CLASS_SLIP] = 0.0;
+    return CDEM_OK;
+}
+
+int cdem_contact_layered_layer(int32_t layer) {
+    return layer >= 1 && layer <= CDEM_PREGROWTH_LAYERS && ((layer - 1) / 4) % 2 == 1;
+}
+
+int cdem_contact_refine(const cdem_contact_law *law, int cls, int32_t layer_i, uint32_t flags_i,
+                        int32_t layer_j, uint32_t flags_j) {
+    if (cls != CDEM_CLASS_ELEMENT)
+        return cls;
+    if (law->flexural_slip && layer_i != layer_j && layer_i >= 1 &&
+        layer_i <= CDEM_PREGROWTH_LAYERS && layer_j >= 1 && layer_j <= CDEM_PREGROWTH_LAYERS)
+        return CDEM_CLASS_SLIP;
+    const int weak = ((flags_i | flags_j) & CDEM_FLAG_WEAK) != 0;
+    const int layered = law->layered_friction && (cdem_contact_layered_layer(layer_i) ||
+                                                  cdem_contact_layered_layer(layer_j));
+    static const int table[2][2] = {{CDEM_CLASS_ELEMENT, CDEM_CLASS_WEAK},
+                                    {CDEM_CLASS_LAYERED, CDEM_CLASS_LAYERED_WEAK}};
+    return table[layered][weak];
+}
+
+cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *marked,
+                                     cdem_error *err) {
+    if (marked)
+        *marked = 0;
+    if (!p || !s)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_contact_assign_weak: NULL argument");
+    if (p->weak_interval == CDEM_WEAK_OFF)
+        return CDEM_OK;
+    if (p->weak_interval != CDEM_WEAK_LOWER && p->weak_interval != CDEM_WEAK_UPPER)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "heterogeneity.weak_interval = %d: must be off, lower or upper",
+                         (int)p->weak_interval);
+    if (!(p->weak_thickness_percent >= 0.0 && p->weak_thickness_percent <= 100.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "heterogeneity.weak_thickness_percent = %g: must be 0..100",
+                         p->weak_thickness_percent);
+    if (!(p->weak_density_percent > 0.0 && p->weak_density_percent <= 100.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "heterogeneity.weak_density_percent = %g: must be > 0 and <= 100",
+                         p->weak_density_percent);
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        lo = fmin(lo, s->y[i]);
+        hi = fmax(hi, s->y[i]);
+    }
+    if (!(hi >= lo))
+        return CDEM_OK; /* no free elements */
+    const double th = p->weak_thickness_percent / 100.0 * (hi - lo);
+    const double fd = p->weak_density_percent / 100.0;
+    long count = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & (CDEM_FLAGS_BOUNDARY | CDEM_FLAG_WEAK))
+            continue;
+        const int in =
+            p->weak_interval == CDEM_WEAK_LOWER ? s->y[i] <= lo + th : s->y[i] >= hi - th;
+        if (!in || th <= 0.0)
+            continue;
+        s->flags[i] |= CDEM_FLAG_WEAK;
+        s->mass[i] *= fd;
+        count++;
+    }
+    if (marked)
+        *marked = count;
     return CDEM_OK;
 }

@@ -12,12 +12,16 @@
  * minus it). Normal force on i = Kn (r - R) n (negative along n = repulsion when r < R).
  * Tangential: Xs += ((vj - vi) . t) dt; force on i = +Ks Xs t (the spring drags i along j).
  * The scalar Xs lives in the contact frame, so it rotates with the pair automatically.
- * Units: m, m/s, s, N (per metre of thickness). */
+ * Heterogeneity (SPEC 3, manual Set-up 9-11): element-element pairs are refined at each list
+ * rebuild into material classes (weak, layered, layered+weak, flexural slip) by
+ * cdem_contact_refine from the two elements' layers and CDEM_FLAG_WEAK; the hot loop only
+ * indexes the per-class arrays. Units: m, m/s, s, N (per metre of thickness). */
 #ifndef CDEM_CONTACT_H
 #define CDEM_CONTACT_H
 
 #include "cdem_error.h"
 #include "params.h"
+#include "state.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -27,7 +31,13 @@ enum {
     CDEM_CLASS_ELEMENT = 0, /* element-element: params.element */
     CDEM_CLASS_WALL = 1,    /* element-wall (either flagged CDEM_FLAG_WALL): params.wall */
     CDEM_CLASS_FAULT = 2,   /* element-fault (either flagged CDEM_FLAG_FAULT): params.fault */
-    CDEM_CLASS_COUNT = 3
+    CDEM_CLASS_COUNT = 3,   /* number of base classes (element, wall, fault) */
+    /* element-element refinements (heterogeneity), chosen by cdem_contact_refine */
+    CDEM_CLASS_WEAK = 3,         /* either element weak: element values x weak_strength_percent */
+    CDEM_CLASS_LAYERED = 4,      /* either element in layers 5-8/13-16/21-24: layered friction */
+    CDEM_CLASS_LAYERED_WEAK = 5, /* both rules: layered friction x weak_strength_percent */
+    CDEM_CLASS_SLIP = 6,         /* flexural slip: different pre-growth layers, no strength */
+    CDEM_CLASS_TOTAL = 7         /* length of the per-class arrays */
 };
 
 /* Pair history flags (uint8 per pair). */
@@ -42,10 +52,12 @@ typedef struct {
     int first_slip;                    /* 1: cohesion lost at the first slip; 0: at separation */
     double kn;                         /* N/m, normal spring stiffness, > 0 */
     double ks;                         /* N/m, shear spring stiffness, >= 0 */
-    double friction[CDEM_CLASS_COUNT]; /* Coulomb coefficient mu per class, >= 0 */
-    double cohesion[CDEM_CLASS_COUNT]; /* C0 per class, N, >= 0 */
-    double breaking_strain[CDEM_CLASS_COUNT]; /* r0 per class (bonded), > 0 */
+    double friction[CDEM_CLASS_TOTAL]; /* Coulomb coefficient mu per class, >= 0 */
+    double cohesion[CDEM_CLASS_TOTAL]; /* C0 per class, N, >= 0 */
+    double breaking_strain[CDEM_CLASS_TOTAL]; /* r0 per class (bonded), > 0 (0 for SLIP) */
     double max_breaking_strain; /* largest r0 of the classes when bonded, else 0 (cut-off) */
+    int flexural_slip;          /* 0/1: pairs of different pre-growth layers use CDEM_CLASS_SLIP */
+    int layered_friction;       /* 0/1: layers 5-8, 13-16, 21-24 use CDEM_CLASS_LAYERED */
 } cdem_contact_law;
 
 /* Fills the law from the material parameters and the model constants kn, ks. Fails with
@@ -60,6 +72,27 @@ const char *cdem_contact_class_name(int cls);
  * element. Returns -1 when the pair never interacts (both boundary elements, or either a
  * display-only footwall element). */
 int cdem_contact_class(uint32_t flags_i, uint32_t flags_j);
+
+/* Refines a base class (cdem_contact_class) of a pair from its elements' layers and flags.
+ * Only CDEM_CLASS_ELEMENT is refined (walls and faults keep their own materials). Rules,
+ * in order: flexural slip on and both layers in 1..24 and different -> SLIP (no strength,
+ * no bond); else weak = either element has CDEM_FLAG_WEAK, layered = layered friction on
+ * and either layer in 5-8, 13-16 or 21-24 -> ELEMENT, WEAK, LAYERED or LAYERED_WEAK. */
+int cdem_contact_refine(const cdem_contact_law *law, int cls, int32_t layer_i, uint32_t flags_i,
+                        int32_t layer_j, uint32_t flags_j);
+
+/* 1 when pre-growth layer L (1..24) is one of the layered-friction layers 5-8, 13-16,
+ * 21-24; 0 otherwise (growth layers 25.. and walls 0 never are). */
+int cdem_contact_layered_layer(int32_t layer);
+
+/* Weak/light interval at assembly time (before equilibration, so the equilibrated state
+ * carries the density): among free elements, those whose centre lies in the lowest
+ * (CDEM_WEAK_LOWER) or highest (CDEM_WEAK_UPPER) weak_thickness_percent of the span of
+ * free-element centres get CDEM_FLAG_WEAK and mass x weak_density_percent/100. Does
+ * nothing when weak_interval is off. *marked (may be NULL) receives the count. Fails with
+ * CDEM_ERR_RANGE naming the key when a percentage is outside 0..100. */
+cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *marked,
+                                     cdem_error *err);
 
 /* Evaluates one pair. dx, dy = xj - xi; R = ri + rj; dvx, dvy = vj - vi (mid-step velocities,
  * so dv * dt is the relative displacement of the step). Updates *xs and *hist; writes the

@@ -39,6 +39,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     it->damping = m->damping;
     it->gravity = m->gravity;
     it->max_radius = m->max_radius > 0.0 ? m->max_radius : m->radius[CDEM_NUM_RADII - 1];
+    it->column_width = 2.0 * it->max_radius;
     CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
     CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
                                  RESORT_EVERY, err));
@@ -51,6 +52,7 @@ void cdem_integrator_free(cdem_integrator *it) {
     cdem_neighbour_free(&it->nb);
     free(it->keep);
     free(it->removed_ids);
+    free(it->col_top);
     memset(it, 0, sizeof *it);
 }
 
@@ -60,6 +62,36 @@ void cdem_integrator_enable_escape(cdem_integrator *it) {
 
 static int is_free(uint32_t flags) {
     return !(flags & CDEM_FLAGS_BOUNDARY);
+}
+
+static cdem_status reserve_keep(cdem_integrator *it, size_t n, cdem_error *err) {
+    if (n <= it->keepcap)
+        return CDEM_OK;
+    size_t c = n + n / 2 + 16;
+    unsigned char *k = realloc(it->keep, c);
+    if (!k)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+    it->keep = k;
+    it->keepcap = c;
+    return CDEM_OK;
+}
+
+/* Copies the ids of the elements with keep[i] == 0 (nrem of them) to removed_ids. */
+static cdem_status collect_removed(cdem_integrator *it, const cdem_state *s, size_t nrem,
+                                   cdem_error *err) {
+    if (nrem > it->removed_cap) {
+        size_t c = nrem + it->removed_cap + 16;
+        int32_t *q = realloc(it->removed_ids, c * sizeof *q);
+        if (!q)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu ids)", c);
+        it->removed_ids = q;
+        it->removed_cap = c;
+    }
+    size_t k = 0;
+    for (size_t i = 0; i < s->n && k < nrem; i++)
+        if (!it->keep[i])
+            it->removed_ids[k++] = s->id[i];
+    return CDEM_OK;
 }
 
 /* Marks escaping free elements in it->keep; returns how many. */
@@ -81,14 +113,7 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
     it->escape_xmin = xmin;
     it->escape_xmax = xmax;
     it->escape_ymin = ymin;
-    if (s->n > it->keepcap) {
-        size_t c = s->n + s->n / 2 + 16;
-        unsigned char *k = realloc(it->keep, c);
-        if (!k)
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
-        it->keep = k;
-        it->keepcap = c;
-    }
+    CDEM_TRY(reserve_keep(it, s->n, err));
     size_t nrem = 0;
     for (size_t i = 0; i < s->n; i++) {
         int out = 0;
@@ -99,20 +124,8 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
         it->keep[i] = (unsigned char)!out;
         nrem += (size_t)out;
     }
-    if (nrem > it->removed_cap) {
-        size_t c = nrem + it->removed_cap + 16;
-        int32_t *q = realloc(it->removed_ids, c * sizeof *q);
-        if (!q)
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu ids)", c);
-        it->removed_ids = q;
-        it->removed_cap = c;
-    }
-    size_t k = 0;
-    for (size_t i = 0; i < s->n; i++)
-        if (!it->keep[i])
-            it->removed_ids[k++] = s->id[i];
     *count = nrem;
-    return CDEM_OK;
+    return collect_removed(it, s, nrem, err);
 }
 
 static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
@@ -120,7 +133,92 @@ static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) 
     CDEM_TRY(find_escapes(it, s, &nrem, err));
     it->n_removed_last = nrem;
     it->n_removed += (long)nrem;
-    return cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err);
+    CDEM_TRY(cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err));
+    cdem_integrator_classify(it, s);
+    if (it->overburden_force > 0.0)
+        CDEM_TRY(cdem_integrator_find_surface(it, s, err));
+    return CDEM_OK;
+}
+
+void cdem_integrator_classify(cdem_integrator *it, const cdem_state *s) {
+    const cdem_contact_law *law = &it->law;
+    if (!law->flexural_slip && !law->layered_friction) {
+        /* only the weak flag can refine: skip the pass when no element carries it */
+        int any = 0;
+        for (size_t i = 0; i < s->n && !any; i++)
+            any = (s->flags[i] & CDEM_FLAG_WEAK) != 0;
+        if (!any)
+            return;
+    }
+    cdem_neighbour *nb = &it->nb;
+    for (size_t p = 0; p < nb->np; p++) {
+        const int32_t i = nb->pi[p], j = nb->pj[p];
+        const int base = nb->cls[p] >= CDEM_CLASS_COUNT ? CDEM_CLASS_ELEMENT : nb->cls[p];
+        nb->cls[p] = (uint8_t)cdem_contact_refine(law, base, s->layer[i], s->flags[i], s->layer[j],
+                                                  s->flags[j]);
+    }
+}
+
+cdem_status cdem_integrator_set_overburden(cdem_integrator *it, double pressure, cdem_error *err) {
+    if (!isfinite(pressure) || pressure < 0.0)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "integrator: surface.overburden_pressure = %g N/m: must be a finite "
+                         "number >= 0",
+                         pressure);
+    it->overburden_pressure = pressure;
+    it->overburden_force = pressure * it->column_width;
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_find_surface(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    double xmin = INFINITY, xmax = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        s->flags[i] &= ~(uint32_t)CDEM_FLAG_SURFACE;
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        xmin = fmin(xmin, s->x[i]);
+        xmax = fmax(xmax, s->x[i]);
+    }
+    it->n_surface = 0;
+    if (!isfinite(xmin) || !(it->column_width > 0.0))
+        return CDEM_OK;
+    const double w = it->column_width;
+    const double span = (xmax - xmin) / w;
+    if (!(span < 1e8))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "integrator: free elements span %g m = %g columns of %g m: too many "
+                         "for the surface search",
+                         xmax - xmin, span, w);
+    const size_t ncol = (size_t)span + 1;
+    if (ncol > it->colcap) {
+        size_t c = ncol + ncol / 2 + 16;
+        int32_t *q = realloc(it->col_top, c * sizeof *q);
+        if (!q)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu columns)", c);
+        it->col_top = q;
+        it->colcap = c;
+    }
+    for (size_t c = 0; c < ncol; c++)
+        it->col_top[c] = -1;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        size_t c = (size_t)((s->x[i] - xmin) / w);
+        if (c >= ncol)
+            c = ncol - 1;
+        const int32_t b = it->col_top[c];
+        if (b < 0 || s->y[i] > s->y[b])
+            it->col_top[c] = (int32_t)i;
+    }
+    long count = 0;
+    for (size_t c = 0; c < ncol; c++) {
+        if (it->col_top[c] < 0)
+            continue;
+        s->flags[it->col_top[c]] |= CDEM_FLAG_SURFACE;
+        count++;
+    }
+    it->n_surface = count;
+    return CDEM_OK;
 }
 
 static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, cdem_error *err) {
@@ -171,10 +269,11 @@ static inline void pair_force(const cdem_contact_law *law, long p, const double 
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
  * kick (when kick), and the total force stored in fx, fy. */
 static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
-                                  double *restrict vxw, double *restrict vyw, double *restrict fx,
-                                  double *restrict fy, double hdt, double c, double g, int kick) {
+                                  const uint32_t *restrict flags, double *restrict vxw,
+                                  double *restrict vyw, double *restrict fx, double *restrict fy,
+                                  double hdt, double c, double g, double ob, int kick) {
     const double m = mass[i];
-    sy -= m * g;
+    sy -= m * g + ((flags[i] & CDEM_FLAG_SURFACE) ? ob : 0.0);
     if (kick) {
         /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
         const double inv = 1.0 / (m + c * hdt);
@@ -207,7 +306,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     const uint32_t *restrict flags = s->flags;
     double *restrict fx = s->fx, *restrict fy = s->fy;
     double *restrict vxw = s->vx, *restrict vyw = s->vy;
-    const double hdt = 0.5 * dt, c = it->damping, g = it->gravity;
+    const double hdt = 0.5 * dt, c = it->damping, g = it->gravity, ob = it->overburden_force;
     const int threaded = (np > it->par_min || n > it->par_min) && omp_get_max_threads() > 1;
 
     if (!threaded) {
@@ -223,7 +322,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         }
         for (long i = 0; i < n; i++)
             if (!(flags[i] & CDEM_FLAGS_BOUNDARY))
-                finish_element(i, fx[i], fy[i], mass, vxw, vyw, fx, fy, hdt, c, g, kick);
+                finish_element(i, fx[i], fy[i], mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick);
         return;
     }
 
@@ -258,7 +357,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
             fy[i] = sy;
             continue;
         }
-        finish_element(i, sx, sy, mass, vxw, vyw, fx, fy, hdt, c, g, kick);
+        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick);
     }
 }
 
@@ -312,13 +411,45 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     return CDEM_OK;
 }
 
+cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double ymax, long *count,
+                                  cdem_error *err) {
+    if (count)
+        *count = 0;
+    it->n_removed_last = 0;
+    CDEM_TRY(reserve_keep(it, s->n, err));
+    size_t nrem = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        const int out = !(s->flags[i] & CDEM_FLAGS_BOUNDARY) && s->y[i] > ymax;
+        it->keep[i] = (unsigned char)!out;
+        nrem += (size_t)out;
+    }
+    if (nrem == 0)
+        return CDEM_OK;
+    CDEM_TRY(collect_removed(it, s, nrem, err));
+    it->n_removed_last = nrem;
+    it->n_removed += (long)nrem;
+    CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
+    cdem_integrator_classify(it, s);
+    if (it->overburden_force > 0.0)
+        CDEM_TRY(cdem_integrator_find_surface(it, s, err));
+    /* forces of the remaining elements without the removed ones: no tangential increment
+     * (dt = 0) and no kick, as in prime */
+    const double dt = it->dt;
+    it->dt = 0.0;
+    forces_and_kick(it, s, 0);
+    it->dt = dt;
+    if (count)
+        *count = (long)nrem;
+    return CDEM_OK;
+}
+
 long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s) {
     (void)s;
     const uint8_t flag =
         it->law.model == CDEM_MATERIAL_BONDED ? CDEM_PAIR_BONDED : CDEM_PAIR_COHESIVE;
     long count = 0;
     for (size_t p = 0; p < it->nb.np; p++) {
-        if (it->nb.hist[p] & CDEM_PAIR_TOUCH) {
+        if ((it->nb.hist[p] & CDEM_PAIR_TOUCH) && it->nb.cls[p] != CDEM_CLASS_SLIP) {
             it->nb.hist[p] |= flag;
             count++;
         }

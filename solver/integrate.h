@@ -12,6 +12,10 @@
  * count. The integrator owns the neighbour list and contact histories; it never owns the
  * state. Escaping elements (cdem_integrator_enable_escape) are removed at list rebuilds.
  * Nothing allocates in a step except at list rebuilds (geometric growth).
+ * Heterogeneity: after each list rebuild the element-element pair classes are refined from
+ * layers and flags (cdem_contact_refine). Overburden: at each rebuild the highest free
+ * element of each column (width 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a
+ * constant force -p x column width in y until the next rebuild.
  * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
@@ -48,6 +52,14 @@ typedef struct {
     int32_t *removed_ids;  /* ids removed at the last rebuild (n_removed_last of them) */
     size_t n_removed_last; /* count at the last rebuild */
     size_t removed_cap;    /* capacity of removed_ids */
+
+    /* overburden (enabled when overburden_force > 0) */
+    double overburden_pressure; /* N/m, vertical pressure on the top surface, >= 0 */
+    double column_width;        /* m, surface-search column width = 2 x max_radius, > 0 */
+    double overburden_force;    /* N, force on each surface element = pressure x column_width */
+    long n_surface;             /* surface elements flagged at the last rebuild */
+    int32_t *col_top;           /* per-column scratch: index of the highest element (colcap) */
+    size_t colcap;              /* capacity of col_top */
 } cdem_integrator;
 
 /* Sets up the stepper from the model constants (dt, damping, gravity, kn, ks, max radius)
@@ -70,8 +82,30 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
 cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
                                  cdem_error *err);
 
+/* Enables the overburden: pressure in N/m (>= 0, finite) on the top surface. Surface
+ * elements are found again at every list rebuild. Fails with CDEM_ERR_RANGE naming
+ * surface.overburden_pressure when the value is negative or not finite. */
+cdem_status cdem_integrator_set_overburden(cdem_integrator *it, double pressure, cdem_error *err);
+
+/* Flags the surface elements now (clears CDEM_FLAG_SURFACE elsewhere): in columns of width
+ * column_width from the leftmost free element, the free element with the highest centre.
+ * Called at every rebuild when the overburden is on; public for tests and views. */
+cdem_status cdem_integrator_find_surface(cdem_integrator *it, cdem_state *s, cdem_error *err);
+
+/* Re-derives the material class of every pair from the current layers and flags (call
+ * after layers change, e.g. at the end of equilibration). */
+void cdem_integrator_classify(cdem_integrator *it, const cdem_state *s);
+
+/* Erosion: removes every free element whose centre is above ymax (m) through the same
+ * path as escaping elements (ids in removed_ids, count in n_removed_last and *count),
+ * rebuilds the list and recomputes the forces of the current positions (no tangential
+ * increment, velocities unchanged). */
+cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double ymax, long *count,
+                                  cdem_error *err);
+
 /* End of equilibration (and of each settling): every touching pair becomes cohesive
- * (granular) or bonded (bonded model). Returns the number of pairs so marked. */
+ * (granular) or bonded (bonded model), except flexural-slip pairs (CDEM_CLASS_SLIP). Returns the
+ * number of pairs so marked. */
 long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s);
 
 /* Counts touching pairs and intact bonds / cohesive contacts. */

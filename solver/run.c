@@ -44,6 +44,8 @@ typedef struct {
     long last_written_step;      /* step of the last increment written (-1: none) */
     double base_tol_y;           /* m, wall elements with y below this are the base */
     long removed;                /* escaped elements removed */
+    long eroded;                 /* elements removed by erosion, whole run */
+    double erosion_y;            /* m, erosion level (INFINITY until the end of equilibration) */
     double t_start, t_last_log;  /* s, monotonic clock (progress display only) */
     long last_log_step;          /* step of the last progress output */
     int tty_line_open;           /* 1 when a progress line is drawn without newline */
@@ -138,7 +140,44 @@ static void assign_layers(cdem_state *s) {
     }
 }
 
+/* Erosion before an increment of the deformation phase: every free element whose centre is
+ * above erosion_y is removed (integrator removal path), the count logged. */
+static cdem_status erode(run_ctx *r, cdem_error *err) {
+    if (!r->p->erosion || !isfinite(r->erosion_y) || r->step <= r->m.equil_steps)
+        return CDEM_OK;
+    long count = 0;
+    CDEM_TRY(cdem_integrator_erode(&r->it, &r->s, r->erosion_y, &count, err));
+    r->eroded += count;
+    if (logging(r) && count > 0) {
+        end_progress_line(r);
+        fprintf(r->opt->log,
+                "cdem-run: erosion removed %ld elements above y = %.6g m before increment %d at "
+                "step %ld (%ld eroded so far)\n",
+                count, r->erosion_y, r->next_inc, r->step, r->eroded);
+    }
+    return CDEM_OK;
+}
+
+/* End of equilibration: the erosion level is erosion_base_level x the height of the
+ * equilibrated assembly, measured from the lowest free-element centre to the highest one
+ * (the span of the 24 layers): y = lo + level (hi - lo). */
+static void set_erosion_level(run_ctx *r) {
+    r->erosion_y = INFINITY;
+    if (!r->p->erosion)
+        return;
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < r->s.n; i++) {
+        if (r->s.flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        lo = fmin(lo, r->s.y[i]);
+        hi = fmax(hi, r->s.y[i]);
+    }
+    if (hi >= lo)
+        r->erosion_y = lo + r->p->erosion_base_level * (hi - lo);
+}
+
 static cdem_status write_increment(run_ctx *r, cdem_error *err) {
+    CDEM_TRY(erode(r, err));
     if (r->p->calculate_stress)
         CDEM_TRY(cdem_stress_compute(&r->it.nb, &r->s, err));
     cdem_increment_info inf;
@@ -198,11 +237,6 @@ static cdem_status check_supported(const cdem_params *p, cdem_error *err) {
         const char *what;
     } const rows[] = {
         {p->sedimentation != 0, "surface.sedimentation = on"},
-        {p->erosion != 0, "surface.erosion = on"},
-        {p->overburden_pressure != 0.0, "surface.overburden_pressure > 0"},
-        {p->flexural_slip != 0, "heterogeneity.flexural_slip = on"},
-        {p->weak_interval != CDEM_WEAK_OFF, "heterogeneity.weak_interval (lower/upper)"},
-        {p->layered_friction != 0, "heterogeneity.layered_friction = on"},
     };
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++)
         if (rows[i].on)
@@ -259,6 +293,11 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_model_derive(p, &r->m, err));
     CDEM_TRY(cdem_state_init(&r->s, 1024, p->calculate_stress, err));
     CDEM_TRY(cdem_assembly_build(p, &r->m, &r->s, &r->info, err));
+    long n_weak = 0;
+    CDEM_TRY(cdem_contact_assign_weak(p, &r->s, &n_weak, err));
+    if (logging(r) && p->weak_interval != CDEM_WEAK_OFF)
+        fprintf(opt->log, "cdem-run: weak/light interval: %ld elements flagged weak\n", n_weak);
+    r->erosion_y = INFINITY;
     double ywall = INFINITY;
     for (size_t i = 0; i < r->s.n; i++)
         if (r->s.flags[i] & CDEM_FLAG_WALL)
@@ -267,6 +306,7 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     cdem_integrator_enable_escape(&r->it);
+    CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(make_summary(r, err));
     const cdem_run_meta meta = {
         .params = p,
@@ -303,6 +343,8 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
         log_removed(r);
         if (step == equil) {
             assign_layers(&r->s);
+            cdem_integrator_classify(&r->it, &r->s);
+            set_erosion_level(r);
             long made = cdem_integrator_make_cohesive(&r->it, &r->s);
             if (logging(r) && !opt->progress_is_tty)
                 fprintf(opt->log, "cdem-run: end of equilibration at step %ld: %ld %s created\n",
@@ -341,8 +383,9 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     if (r->last_written_step != r->step)
         CDEM_TRY(write_increment(r, err));
     char detail[256];
-    snprintf(detail, sizeof detail, "%ld steps, %d increments, %ld escaping elements removed",
-             r->step, r->next_inc - 1, r->removed);
+    snprintf(detail, sizeof detail,
+             "%ld steps, %d increments, %ld escaping elements removed, %ld eroded", r->step,
+             r->next_inc - 1, r->removed, r->eroded);
     return cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err);
 }
 
