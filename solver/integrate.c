@@ -62,6 +62,37 @@ static int is_free(uint32_t flags) {
     return !(flags & CDEM_FLAGS_BOUNDARY);
 }
 
+/* Grows the keep scratch to n entries. */
+static cdem_status ensure_keep(cdem_integrator *it, size_t n, cdem_error *err) {
+    if (n <= it->keepcap)
+        return CDEM_OK;
+    size_t c = n + n / 2 + 16;
+    unsigned char *k = realloc(it->keep, c);
+    if (!k)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+    it->keep = k;
+    it->keepcap = c;
+    return CDEM_OK;
+}
+
+/* Copies the ids of the nrem elements with keep[i] == 0 into removed_ids. */
+static cdem_status record_removed(cdem_integrator *it, const cdem_state *s, size_t nrem,
+                                  cdem_error *err) {
+    if (nrem > it->removed_cap) {
+        size_t c = nrem + it->removed_cap + 16;
+        int32_t *q = realloc(it->removed_ids, c * sizeof *q);
+        if (!q)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu ids)", c);
+        it->removed_ids = q;
+        it->removed_cap = c;
+    }
+    size_t k = 0;
+    for (size_t i = 0; i < s->n && k < nrem; i++)
+        if (!it->keep[i])
+            it->removed_ids[k++] = s->id[i];
+    return CDEM_OK;
+}
+
 /* Marks escaping free elements in it->keep; returns how many. */
 static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t *count,
                                 cdem_error *err) {
@@ -81,14 +112,7 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
     it->escape_xmin = xmin;
     it->escape_xmax = xmax;
     it->escape_ymin = ymin;
-    if (s->n > it->keepcap) {
-        size_t c = s->n + s->n / 2 + 16;
-        unsigned char *k = realloc(it->keep, c);
-        if (!k)
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
-        it->keep = k;
-        it->keepcap = c;
-    }
+    CDEM_TRY(ensure_keep(it, s->n, err));
     size_t nrem = 0;
     for (size_t i = 0; i < s->n; i++) {
         int out = 0;
@@ -99,18 +123,7 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
         it->keep[i] = (unsigned char)!out;
         nrem += (size_t)out;
     }
-    if (nrem > it->removed_cap) {
-        size_t c = nrem + it->removed_cap + 16;
-        int32_t *q = realloc(it->removed_ids, c * sizeof *q);
-        if (!q)
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu ids)", c);
-        it->removed_ids = q;
-        it->removed_cap = c;
-    }
-    size_t k = 0;
-    for (size_t i = 0; i < s->n; i++)
-        if (!it->keep[i])
-            it->removed_ids[k++] = s->id[i];
+    CDEM_TRY(record_removed(it, s, nrem, err));
     *count = nrem;
     return CDEM_OK;
 }
@@ -309,6 +322,40 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(rebuild(it, s, err));
     }
     forces_and_kick(it, s, 1);
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_begin_deformation(cdem_integrator *it, cdem_state *s, cdem_bc *bc,
+                                              size_t *n_removed, cdem_error *err) {
+    *n_removed = 0;
+    it->n_removed_last = 0;
+    if (!bc)
+        return CDEM_OK;
+    if (it->nb.n_builds == 0)
+        CDEM_TRY(cdem_integrator_prime(it, s, err));
+    CDEM_TRY(ensure_keep(it, s->n, err));
+    memset(it->keep, 1, s->n);
+    size_t nrem = 0;
+    CDEM_TRY(cdem_bc_begin_deformation(bc, s, it->keep, &nrem, err));
+    if (nrem == 0)
+        return CDEM_OK;
+    size_t check = 0;
+    for (size_t i = 0; i < s->n; i++)
+        check += it->keep[i] == 0;
+    if (check != nrem)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "boundary mode %s: begin_deformation reported %zu elements to remove "
+                         "but marked %zu",
+                         bc->ops->name, nrem, check);
+    CDEM_TRY(record_removed(it, s, nrem, err));
+    it->n_removed_last = nrem;
+    CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
+    /* forces of the new configuration, without a tangential increment (as in prime) */
+    const double dt = it->dt;
+    it->dt = 0.0;
+    forces_and_kick(it, s, 0);
+    it->dt = dt;
+    *n_removed = nrem;
     return CDEM_OK;
 }
 
