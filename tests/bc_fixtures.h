@@ -20,16 +20,16 @@
 #define RW    50.0
 #define DPS   (CDEM_BOUNDARY_ACCEL * DT * DT) /* m, displacement per deformation step */
 
-static double fx_rnd(uint64_t *s) {
+__attribute__((unused)) static double fx_rnd(uint64_t *s) {
     *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
     return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
 }
 
-static double fx_mass(double r) {
+__attribute__((unused)) static double fx_mass(double r) {
     return RHO * M_PI * r * r;
 }
 
-static cdem_model fx_model(long def_steps) {
+__attribute__((unused)) static cdem_model fx_model(long def_steps) {
     cdem_model m;
     memset(&m, 0, sizeof m);
     const double r[4] = {50.0, 75.0, 100.0, 125.0};
@@ -53,7 +53,7 @@ static cdem_model fx_model(long def_steps) {
     return m;
 }
 
-static cdem_params fx_params(cdem_mode mode) {
+__attribute__((unused)) static cdem_params fx_params(cdem_mode mode) {
     cdem_params p;
     memset(&p, 0, sizeof p);
     p.material = CDEM_MATERIAL_GRANULAR;
@@ -72,7 +72,7 @@ static cdem_params fx_params(cdem_mode mode) {
 
 /* Base (y = 0, x = 0 .. WIDTH), lateral walls at x = 0 and WIDTH (y = 100 .. 1500), and 4
  * rows of free elements above the base. */
-static void fx_assembly(cdem_state *s) {
+__attribute__((unused)) static void fx_assembly(cdem_state *s) {
     cdem_error err;
     assert_int_equal(cdem_state_init(s, 256, 0, &err), CDEM_OK);
     for (double x = 0.0; x <= WIDTH + 1e-9; x += 2.0 * RW)
@@ -98,7 +98,7 @@ static void fx_assembly(cdem_state *s) {
 }
 
 /* Index of element id in s, or SIZE_MAX. */
-static size_t fx_find(const cdem_state *s, int32_t id) {
+__attribute__((unused)) static size_t fx_find(const cdem_state *s, int32_t id) {
     for (size_t i = 0; i < s->n; i++)
         if (s->id[i] == id)
             return i;
@@ -106,8 +106,8 @@ static size_t fx_find(const cdem_state *s, int32_t id) {
 }
 
 /* Displacement of element id between s0 and s. */
-static void fx_displacement(const cdem_state *s0, const cdem_state *s, int32_t id, double *dx,
-                            double *dy) {
+__attribute__((unused)) static void fx_displacement(const cdem_state *s0, const cdem_state *s,
+                                                    int32_t id, double *dx, double *dy) {
     const size_t a = fx_find(s0, id), b = fx_find(s, id);
     assert_true(a != SIZE_MAX && b != SIZE_MAX);
     *dx = s->x[b] - s0->x[a];
@@ -123,7 +123,7 @@ typedef struct {
 } fx_result;
 
 /* Initialises mode p on the fixture assembly and runs k deformation steps. */
-static void fx_run(cdem_params p, long k, fx_result *out) {
+__attribute__((unused)) static void fx_run(cdem_params p, long k, fx_result *out) {
     cdem_model m = fx_model(k);
     cdem_error err;
     cdem_bc bc;
@@ -149,13 +149,13 @@ static void fx_run(cdem_params p, long k, fx_result *out) {
     cdem_bc_free(&bc);
 }
 
-static void fx_result_free(fx_result *r) {
+__attribute__((unused)) static void fx_result_free(fx_result *r) {
     cdem_state_free(&r->s0);
     cdem_state_free(&r->s);
 }
 
 /* The view text of an initialised mode (malloc'd). */
-static char *fx_view(const cdem_bc *bc) {
+__attribute__((unused)) static char *fx_view(const cdem_bc *bc) {
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
