@@ -1,20 +1,16 @@
-/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one
- * static const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode ->
- * ops, so the solver never switches on mode names. Checklist for a mode (see
- * bc_planar_fault.c, the template):
- *   name            the parameter-file word of the mode
- *   state_size      bytes of the mode's private context (calloc'd by cdem_bc_init)
- *   init            after the assembly is built: add/flag the mode's boundary elements
- *                   (CDEM_FLAG_WALL / FAULT / MOVING), record its geometry
- *   apply           deformation step k (1-based): move the prescribed elements by this step's
- *                   boundary increment du (sign/sense decided by the mode, e.g. inversion) and
- *                   set their velocity to the boundary velocity; walls never move otherwise
- *   net_displacement  m, net displacement of the moving boundary so far (report)
- *   view            one-paragraph description of the effective settings
- *   free            releases what init allocated inside the context (NULL slot: nothing)
- *   begin_deformation  optional (NULL: nothing), once before deformation step 1: may clear
- *                   keep[i] of elements to remove (e.g. repose drops its walls); the solver
- *                   removes them through the escape path (histories of the rest kept)
+/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one static
+ * const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode -> ops, so
+ * the solver never switches on mode names. Checklist for a mode (bc_planar_fault.c is the
+ * template): name (parameter-file word); state_size (bytes of the private context, calloc'd
+ * by cdem_bc_init); init (after the assembly is built: add/flag the mode's boundary elements
+ * CDEM_FLAG_WALL / FAULT / MOVING, record its geometry); apply (deformation step k, 1-based:
+ * move the prescribed elements by this step's boundary increment du, sense decided by the
+ * mode, and set their velocity to the boundary velocity; walls never move otherwise);
+ * net_displacement (m, of the moving boundary so far); view (one paragraph of the effective
+ * settings); free (releases what init allocated in the context; NULL: nothing);
+ * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
+ * of elements to remove, e.g. repose drops its walls; the solver removes them through the
+ * escape path, histories of the rest kept).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
