@@ -43,10 +43,25 @@ static void check_removal(cdem_walls_choice walls) {
     cdem_bc bc;
     cdem_integrator it;
     fx_assembly(&s);
+    /* two elements against each lateral wall (slightly overlapping it: touching during the
+     * two equilibration steps below) */
+    for (int k = 0; k < 2; k++) {
+        const double r = 80.0, y = 1000.0 + 200.0 * k;
+        assert_int_equal(
+            cdem_state_append(&s, -1, WIDTH - RW - r + 3.0, y, r, fx_mass(r), 1, 0, 0, NULL, &err),
+            CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(&s, -1, RW + r - 3.0, y, r, fx_mass(r), 1, 0, 0, NULL, &err),
+            CDEM_OK);
+    }
+    for (int k = 1; k <= 3; k++) /* three resting on the base (slightly overlapping it) */
+        assert_int_equal(cdem_state_append(&s, -1, 1000.0 * k, RW + 80.0 - 3.0, 80.0, fx_mass(80.0),
+                                           1, 0, 0, NULL, &err),
+                         CDEM_OK);
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
     cdem_integrator_enable_escape(&it);
-    for (long j = 1; j <= 50; j++) /* equilibration: walls still */
+    for (long j = 1; j <= 2; j++) /* equilibration: walls still */
         assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
     const size_t n0 = s.n;
     assert_int_equal(count_lateral(&s, WIDTH), 15);
@@ -57,8 +72,27 @@ static void check_removal(cdem_walls_choice walls) {
     for (size_t i = 0; i < s.n; i++)
         if ((s.flags[i] & CDEM_FLAG_WALL) && s.y[i] > 0.0 && s.x[i] == WIDTH)
             right_ids[nr++] = s.id[i];
+    /* cohesive contacts at the end of equilibration: those with a removed wall must go, the
+     * others must survive the removal (histories follow the elements) */
+    const long made = cdem_integrator_make_cohesive(&it, &s);
+    long with_removed = 0;
+    for (size_t q = 0; q < it.nb.np; q++) {
+        if (!(it.nb.hist[q] & CDEM_PAIR_COHESIVE))
+            continue;
+        const size_t a = (size_t)it.nb.pi[q], b = (size_t)it.nb.pj[q];
+        const int ra = (s.flags[a] & CDEM_FLAG_WALL) && s.y[a] > 0.0 &&
+                       (s.x[a] == WIDTH || (walls == CDEM_WALLS_BOTH && s.x[a] == 0.0));
+        const int rb = (s.flags[b] & CDEM_FLAG_WALL) && s.y[b] > 0.0 &&
+                       (s.x[b] == WIDTH || (walls == CDEM_WALLS_BOTH && s.x[b] == 0.0));
+        with_removed += ra || rb;
+    }
+    assert_int_equal(with_removed, walls == CDEM_WALLS_BOTH ? 4 : 2);
+    assert_true(made >= with_removed + 3); /* the three on the base */
     size_t nrem = 0;
     assert_int_equal(cdem_integrator_begin_deformation(&it, &s, &bc, &nrem, &err), CDEM_OK);
+    long contacts = 0, cohesive = 0;
+    cdem_integrator_count(&it, &contacts, &cohesive);
+    assert_int_equal(cohesive, made - with_removed);
     const size_t expect = walls == CDEM_WALLS_BOTH ? 30 : 15;
     assert_int_equal(nrem, expect);
     assert_int_equal(it.n_removed_last, expect);
