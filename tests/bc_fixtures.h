@@ -7,10 +7,14 @@
 #define CDEM_TESTS_BC_FIXTURES_H
 
 #include "bc.h"
+#include "h5format.h"
 #include "integrate.h"
+#include "run.h"
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define KN    1.544871985e9
@@ -163,6 +167,36 @@ __attribute__((unused)) static char *fx_view(const cdem_bc *bc) {
     cdem_bc_view(bc, f);
     fclose(f);
     return buf;
+}
+
+/* Runs a small default-based model of mode p (10 x 2.5 units, 60 s equilibration) through
+ * cdem_run, stopped `def_steps` deformation steps after equilibration; returns the info of
+ * the last increment written and the model. */
+__attribute__((unused)) static void fx_cdem_run(cdem_params p, const char *name, long def_steps,
+                                                cdem_increment_info *last, cdem_model *m) {
+    char path[1024];
+    const char *dir = getenv("CDEM_TEST_TMP");
+    snprintf(path, sizeof path, "%s/%s.h5", dir && *dir ? dir : "/tmp", name);
+    p.width = 10.0;
+    p.height = 2.5;
+    p.equilibration = 60.0;
+    p.runtime = 100.0;
+    cdem_error err;
+    assert_int_equal(cdem_model_derive(&p, m, &err), CDEM_OK);
+    cdem_run_options o;
+    memset(&o, 0, sizeof o);
+    o.output_path = path;
+    o.quiet = 1;
+    o.max_steps = m->equil_steps + def_steps;
+    if (cdem_run(&p, &o, &err) != CDEM_OK)
+        fail_msg("cdem_run: %s", err.msg);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    const size_t n = cdem_h5_reader_increment_count(r);
+    assert_true(n > 1);
+    assert_int_equal(cdem_h5_reader_increment_info(r, n - 1, last, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
+    cdem_h5_reader_close(r);
 }
 
 #endif

@@ -105,12 +105,30 @@ static void test_bc_detachment_errors_and_view(void **st) {
     cdem_state_free(&s);
 }
 
+/* Both wall choices run through cdem_run on a small default model; the file reports the
+ * total shortening (twice the wall displacement for "both"). */
+static void test_bc_detachment_cdem_run(void **st) {
+    (void)st;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_DETACHMENT;
+    for (int k = 0; k < 2; k++) {
+        p.detachment_walls = k == 0 ? CDEM_WALLS_RIGHT : CDEM_WALLS_BOTH;
+        cdem_increment_info last;
+        cdem_model m;
+        fx_cdem_run(p, "test_bc_detachment_run", 300, &last, &m);
+        assert_int_equal(last.step, m.equil_steps + 300);
+        assert_float_equal(last.net_displacement, (k + 1) * 300.0 * m.displacement_per_step, 1e-9);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bc_detachment_right_wall),
         cmocka_unit_test(test_bc_detachment_both_walls),
         cmocka_unit_test(test_bc_detachment_base_contacts_are_wall_class),
         cmocka_unit_test(test_bc_detachment_errors_and_view),
+        cmocka_unit_test(test_bc_detachment_cdem_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -106,11 +106,30 @@ static void test_bc_vertical_errors_and_view(void **st) {
     cdem_state_free(&s);
 }
 
+/* Both senses run through cdem_run on a small default model; the file reports the net
+ * displacement of the block. */
+static void test_bc_vertical_cdem_run(void **st) {
+    (void)st;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_VERTICAL_FAULTS;
+    for (int k = 0; k < 2; k++) {
+        p.vertical_sense = k == 0 ? CDEM_VERT_CALDERA : CDEM_VERT_PISTON;
+        cdem_increment_info last;
+        cdem_model m;
+        fx_cdem_run(p, "test_bc_vertical_run", 300, &last, &m);
+        assert_int_equal(last.step, m.equil_steps + 300);
+        assert_int_equal(last.phase, CDEM_PHASE_DEFORMATION);
+        assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bc_vertical_caldera_kinematics),
         cmocka_unit_test(test_bc_vertical_piston_kinematics),
         cmocka_unit_test(test_bc_vertical_errors_and_view),
+        cmocka_unit_test(test_bc_vertical_cdem_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
