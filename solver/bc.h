@@ -1,17 +1,16 @@
-/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one
- * static const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode ->
- * ops, so the solver never switches on mode names. Checklist for a mode (see
- * bc_planar_fault.c, the template):
- *   name            the parameter-file word of the mode
- *   state_size      bytes of the mode's private context (calloc'd by cdem_bc_init)
- *   init            after the assembly is built: add/flag the mode's boundary elements
- *                   (CDEM_FLAG_WALL / FAULT / MOVING), record its geometry
- *   apply           deformation step k (1-based): move the prescribed elements by this step's
- *                   boundary increment du (sign/sense decided by the mode, e.g. inversion) and
- *                   set their velocity to the boundary velocity; walls never move otherwise
- *   net_displacement  m, net displacement of the moving boundary so far (report)
- *   view            one-paragraph description of the effective settings
- *   free            releases what init allocated inside the context (NULL slot: nothing)
+/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one static
+ * const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode -> ops, so
+ * the solver never switches on mode names. Checklist for a mode (bc_planar_fault.c is the
+ * template): name (parameter-file word); state_size (bytes of the private context, calloc'd
+ * by cdem_bc_init); init (after the assembly is built: add/flag the mode's boundary elements
+ * CDEM_FLAG_WALL / FAULT / MOVING, record its geometry); apply (deformation step k, 1-based:
+ * move the prescribed elements by this step's boundary increment du, sense decided by the
+ * mode, and set their velocity to the boundary velocity; walls never move otherwise);
+ * net_displacement (m, of the moving boundary so far); view (one paragraph of the effective
+ * settings); free (releases what init allocated in the context; NULL: nothing);
+ * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
+ * of elements to remove, e.g. repose drops its walls; the solver removes them through the
+ * escape path, histories of the rest kept).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
@@ -32,6 +31,9 @@ typedef struct {
     double (*net_displacement)(const void *ctx);
     void (*view)(const void *ctx, FILE *out);
     void (*free)(void *ctx); /* may be NULL when the context owns no memory */
+    /* may be NULL; keep has s->n entries, all 1 on entry; *n_remove = number cleared */
+    cdem_status (*begin_deformation)(void *ctx, const cdem_state *s, unsigned char *keep,
+                                     size_t *n_remove, cdem_error *err);
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
@@ -53,11 +55,36 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
 cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
                           cdem_error *err);
 double cdem_bc_net_displacement(const cdem_bc *bc);
+/* Runs the mode's begin_deformation hook (none: *n_remove = 0, keep untouched). */
+cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,
+                                      size_t *n_remove, cdem_error *err);
 void cdem_bc_view(const cdem_bc *bc, FILE *out);
 /* Releases the context; bc may be NULL or never initialised. */
 void cdem_bc_free(cdem_bc *bc);
 
+/* The wall geometry every mode starts from: the base is the lowest row of wall elements
+ * (y <= y_base + tol); the other wall elements are the lateral walls, left of x_mid
+ * (left wall) or right of it (right wall). */
+typedef struct {
+    double y_base;       /* m, height of the base centres */
+    double tol;          /* m, half the smallest radius: base-row tolerance in y */
+    double r_base;       /* m, smallest radius of the base elements, > 0 */
+    double x_mid;        /* m, midpoint of the extreme wall x positions */
+    double x_min, x_max; /* m, extreme wall centres in x (the base ends) */
+} cdem_bc_walls;
+
+/* Finds the walls of s; CDEM_ERR_INVALID naming `mode` when s has no wall element. */
+cdem_status cdem_bc_find_walls(const cdem_state *s, const cdem_model *m, const char *mode,
+                               cdem_bc_walls *w, cdem_error *err);
+/* 1 when element i (a wall element) belongs to the base row. */
+static inline int cdem_bc_is_base(const cdem_bc_walls *w, const cdem_state *s, size_t i) {
+    return s->y[i] <= w->y_base + w->tol;
+}
+
 /* The modes implemented so far (one per bc_<name>.c). */
 extern const cdem_bc_ops *const cdem_bc_planar_fault;
+extern const cdem_bc_ops *const cdem_bc_vertical_faults;
+extern const cdem_bc_ops *const cdem_bc_detachment;
+extern const cdem_bc_ops *const cdem_bc_repose;
 
 #endif

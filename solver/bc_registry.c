@@ -2,6 +2,7 @@
  * one new bc_<name>.c plus one row here; modes without a row fail with a clear message. */
 #include "bc.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,14 +16,14 @@ static const bc_row registry[] = {
     {CDEM_MODE_PLANAR_FAULT, "planar-fault", &cdem_bc_planar_fault},
     {CDEM_MODE_LISTRIC_FAULT, "listric-fault", NULL},     /* later issue */
     {CDEM_MODE_IRREGULAR_FAULT, "irregular-fault", NULL}, /* later issue */
-    {CDEM_MODE_VERTICAL_FAULTS, "vertical-faults", NULL}, /* later issue */
-    {CDEM_MODE_DETACHMENT, "detachment", NULL},           /* later issue */
-    {CDEM_MODE_REPOSE, "repose", NULL},                   /* later issue */
-    {CDEM_MODE_BIAXIAL, "biaxial", NULL},                 /* later issue */
+    {CDEM_MODE_VERTICAL_FAULTS, "vertical-faults", &cdem_bc_vertical_faults},
+    {CDEM_MODE_DETACHMENT, "detachment", &cdem_bc_detachment},
+    {CDEM_MODE_REPOSE, "repose", &cdem_bc_repose},
+    {CDEM_MODE_BIAXIAL, "biaxial", NULL}, /* later issue */
 };
 
 const char *cdem_bc_implemented(void) {
-    return "planar-fault";
+    return "planar-fault, vertical-faults, detachment, repose";
 }
 
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err) {
@@ -69,6 +70,17 @@ double cdem_bc_net_displacement(const cdem_bc *bc) {
     return (bc && bc->ops) ? bc->ops->net_displacement(bc->ctx) : 0.0;
 }
 
+cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,
+                                      size_t *n_remove, cdem_error *err) {
+    *n_remove = 0;
+    if (!bc || !bc->ops)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_bc_begin_deformation: boundary mode not initialised");
+    if (!bc->ops->begin_deformation)
+        return CDEM_OK;
+    return bc->ops->begin_deformation(bc->ctx, s, keep, n_remove, err);
+}
+
 void cdem_bc_view(const cdem_bc *bc, FILE *out) {
     if (bc && bc->ops)
         bc->ops->view(bc->ctx, out);
@@ -82,4 +94,35 @@ void cdem_bc_free(cdem_bc *bc) {
     free(bc->ctx);
     bc->ctx = NULL;
     bc->ops = NULL;
+}
+
+cdem_status cdem_bc_find_walls(const cdem_state *s, const cdem_model *m, const char *mode,
+                               cdem_bc_walls *w, cdem_error *err) {
+    memset(w, 0, sizeof *w);
+    double ymin = INFINITY, xmin = INFINITY, xmax = -INFINITY;
+    for (size_t i = 0; i < s->n; i++)
+        if (s->flags[i] & CDEM_FLAG_WALL) {
+            ymin = fmin(ymin, s->y[i]);
+            xmin = fmin(xmin, s->x[i]);
+            xmax = fmax(xmax, s->x[i]);
+        }
+    if (!isfinite(ymin))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: the assembly has no wall elements (CDEM_FLAG_WALL), so there is "
+                         "no base",
+                         mode);
+    w->y_base = ymin;
+    w->tol = 0.5 * m->radius[0];
+    w->x_min = xmin;
+    w->x_max = xmax;
+    w->x_mid = 0.5 * (xmin + xmax);
+    double rb = INFINITY;
+    for (size_t i = 0; i < s->n; i++)
+        if ((s->flags[i] & CDEM_FLAG_WALL) && cdem_bc_is_base(w, s, i))
+            rb = fmin(rb, s->radius[i]);
+    if (!(rb > 0.0 && isfinite(rb)))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: base element radius = %g m: must be > 0", mode,
+                         rb);
+    w->r_base = rb;
+    return CDEM_OK;
 }

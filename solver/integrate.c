@@ -411,6 +411,24 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     return CDEM_OK;
 }
 
+/* Removes the elements marked 0 in it->keep (nrem of them) through the path escaping
+ * elements take: ids to removed_ids, state compacted with histories kept, pair classes and
+ * surface re-derived, and the forces of the new configuration evaluated without a
+ * tangential increment or a kick (as in prime). */
+static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem, cdem_error *err) {
+    CDEM_TRY(collect_removed(it, s, nrem, err));
+    it->n_removed_last = nrem;
+    CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
+    cdem_integrator_classify(it, s);
+    if (it->overburden_force > 0.0)
+        CDEM_TRY(cdem_integrator_find_surface(it, s, err));
+    const double dt = it->dt;
+    it->dt = 0.0;
+    forces_and_kick(it, s, 0);
+    it->dt = dt;
+    return CDEM_OK;
+}
+
 cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double ymax, long *count,
                                   cdem_error *err) {
     if (count)
@@ -425,21 +443,37 @@ cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double yma
     }
     if (nrem == 0)
         return CDEM_OK;
-    CDEM_TRY(collect_removed(it, s, nrem, err));
-    it->n_removed_last = nrem;
+    CDEM_TRY(remove_marked(it, s, nrem, err));
     it->n_removed += (long)nrem;
-    CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
-    cdem_integrator_classify(it, s);
-    if (it->overburden_force > 0.0)
-        CDEM_TRY(cdem_integrator_find_surface(it, s, err));
-    /* forces of the remaining elements without the removed ones: no tangential increment
-     * (dt = 0) and no kick, as in prime */
-    const double dt = it->dt;
-    it->dt = 0.0;
-    forces_and_kick(it, s, 0);
-    it->dt = dt;
     if (count)
         *count = (long)nrem;
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_begin_deformation(cdem_integrator *it, cdem_state *s, cdem_bc *bc,
+                                              size_t *n_removed, cdem_error *err) {
+    *n_removed = 0;
+    it->n_removed_last = 0;
+    if (!bc)
+        return CDEM_OK;
+    if (it->nb.n_builds == 0)
+        CDEM_TRY(cdem_integrator_prime(it, s, err));
+    CDEM_TRY(reserve_keep(it, s->n, err));
+    memset(it->keep, 1, s->n);
+    size_t nrem = 0;
+    CDEM_TRY(cdem_bc_begin_deformation(bc, s, it->keep, &nrem, err));
+    if (nrem == 0)
+        return CDEM_OK;
+    size_t check = 0;
+    for (size_t i = 0; i < s->n; i++)
+        check += it->keep[i] == 0;
+    if (check != nrem)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "boundary mode %s: begin_deformation reported %zu elements to remove "
+                         "but marked %zu",
+                         bc->ops->name, nrem, check);
+    CDEM_TRY(remove_marked(it, s, nrem, err));
+    *n_removed = nrem;
     return CDEM_OK;
 }
 

@@ -103,6 +103,14 @@ void cdem_integrator_classify(cdem_integrator *it, const cdem_state *s);
 cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double ymax, long *count,
                                   cdem_error *err);
 
+/* Start of deformation, once before deformation step 1: runs the mode's begin_deformation
+ * hook and removes the elements it marks (any kind, walls included) through the same path as
+ * escaping elements: state compacted, histories of the remaining pairs kept, forces
+ * re-evaluated; their ids are in removed_ids / n_removed_last (not counted in n_removed,
+ * which counts escapes). bc NULL: nothing. *n_removed = number removed. */
+cdem_status cdem_integrator_begin_deformation(cdem_integrator *it, cdem_state *s, cdem_bc *bc,
+                                              size_t *n_removed, cdem_error *err);
+
 /* End of equilibration (and of each settling): every touching pair becomes cohesive
  * (granular) or bonded (bonded model), except flexural-slip pairs (CDEM_CLASS_SLIP). Returns the
  * number of pairs so marked. */

@@ -1,12 +1,13 @@
 /* run: see run.h. The run loop of cdem-run:
  *   derive the model -> build the assembly -> boundary mode init (adds its elements) ->
  *   writer -> increment 0 -> equilibration (walls still) -> at its last step: 24 layers,
- *   initial cohesion/bonds, increment n_equil -> deformation (mode apply every step) ->
- *   increments on the model schedule, time-series samples every series_interval steps.
- * Stop request: the current step finishes, a final increment is written, the stop reason
- * "interrupted" is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop
- * reason "numerical-failure" with the diagnosis, file closed (every increment written so
- * far stays readable), CDEM_ERR_NUMERIC returned. opt->max_steps > 0 ends the run early
+ *   initial cohesion/bonds, increment n_equil -> start of deformation (the mode's optional
+ *   begin_deformation hook, e.g. repose removes its walls) -> deformation (mode apply every step)
+ * -> increments on the model schedule, time-series samples every series_interval steps. Stop
+ * request: the current step finishes, a final increment is written, the stop reason "interrupted"
+ * is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop reason
+ * "numerical-failure" with the diagnosis, file closed (every increment written so far stays
+ * readable), CDEM_ERR_NUMERIC returned. opt->max_steps > 0 ends the run early
  * ("stopped-early", CDEM_OK). Progress goes to opt->log only (never stdout); the wall clock
  * is read only for the progress display, never for results. */
 #include "run.h"
@@ -333,6 +334,18 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     while (r->step < total) {
         const long step = r->step + 1;
         const int deforming = step > equil;
+        if (step == equil + 1) {
+            /* the mode's start-of-deformation event (e.g. repose removes its walls) */
+            size_t nrem = 0;
+            CDEM_TRY(cdem_integrator_begin_deformation(&r->it, &r->s, &r->bc, &nrem, err));
+            if (nrem > 0 && logging(r)) {
+                end_progress_line(r);
+                fprintf(opt->log,
+                        "cdem-run: start of deformation: %zu boundary elements removed by the %s "
+                        "mode, %zu elements left\n",
+                        nrem, r->bc.ops->name, r->s.n);
+            }
+        }
         /* wall forces are summed only on the steps whose sample reports them */
         r->it.boundary_forces = (step % interval == 0);
         cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL,

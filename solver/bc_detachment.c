@@ -1,0 +1,110 @@
+/* bc_detachment: shortening over a fixed, frictional base (a detachment).
+ *
+ * detachment_walls = right: the right lateral wall moves left (-x) by the step's boundary
+ * increment du; = both: the left wall moves right and the right wall moves left, each by
+ * du (each at the boundary speed). The base (lowest row of wall elements) never moves; its
+ * contacts with elements are wall-class contacts (material.wall_*), like every wall
+ * contact. The moving walls slide over the base (boundary-boundary pairs never interact).
+ * Net displacement (docs/solver.md): the total shortening of the model, i.e. the right
+ * wall's displacement for "right" and the sum of both walls' displacements (2 k du) for
+ * "both", as in version 2.6 of the original program. */
+#include "bc.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct {
+    int walls;    /* cdem_walls_choice: right or both */
+    double x_mid; /* m, walls left of this are the left wall */
+    double net;   /* m, total shortening so far (sum over the moving walls), >= 0 */
+    long n_left;  /* moving left-wall elements (0 for "right") */
+    long n_right; /* moving right-wall elements */
+} detach_ctx;
+
+static cdem_status detach_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
+                               cdem_error *err) {
+    detach_ctx *c = vctx;
+    if (p->detachment_walls != CDEM_WALLS_RIGHT && p->detachment_walls != CDEM_WALLS_BOTH)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "detachment: boundary.detachment_walls = %d: must be right or both",
+                         (int)p->detachment_walls);
+    cdem_bc_walls w;
+    CDEM_TRY(cdem_bc_find_walls(s, m, "detachment", &w, err));
+    c->walls = p->detachment_walls;
+    c->x_mid = w.x_mid;
+    for (size_t i = 0; i < s->n; i++) {
+        s->flags[i] &= ~(uint32_t)CDEM_FLAG_MOVING;
+        if (!(s->flags[i] & CDEM_FLAG_WALL) || cdem_bc_is_base(&w, s, i))
+            continue;
+        if (s->x[i] > w.x_mid) {
+            s->flags[i] |= CDEM_FLAG_MOVING;
+            c->n_right++;
+        } else if (c->walls == CDEM_WALLS_BOTH) {
+            s->flags[i] |= CDEM_FLAG_MOVING;
+            c->n_left++;
+        }
+    }
+    if (c->n_right == 0)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "detachment: the assembly has no right lateral wall (wall elements "
+                         "above the base right of x = %g m) to move",
+                         w.x_mid);
+    return CDEM_OK;
+}
+
+static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, double dt,
+                                cdem_error *err) {
+    (void)k;
+    detach_ctx *c = vctx;
+    if (!(dt > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "detachment: dt = %g s: must be > 0", dt);
+    const double xm = c->x_mid, v = du / dt;
+    const long n = (long)s->n;
+    double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
+    const uint32_t *restrict fl = s->flags;
+#pragma omp parallel for schedule(static) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        if (fl[i] & CDEM_FLAG_MOVING) {
+            /* the right wall moves left, the left wall right: both inward */
+            const double sgn = x[i] > xm ? -1.0 : 1.0;
+            x[i] += sgn * du;
+            vxa[i] = sgn * v;
+            vya[i] = 0.0;
+        }
+    }
+    c->net += (c->walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * du;
+    return CDEM_OK;
+}
+
+static double detach_net(const void *vctx) {
+    return ((const detach_ctx *)vctx)->net;
+}
+
+static void detach_view(const void *vctx, FILE *out) {
+    const detach_ctx *c = vctx;
+    if (c->walls == CDEM_WALLS_BOTH)
+        fprintf(out,
+                "Boundary mode: detachment, both lateral walls move inward over the fixed base "
+                "at the boundary speed each (%ld left + %ld right wall elements); net "
+                "displacement = total shortening (sum of both walls).\n",
+                c->n_left, c->n_right);
+    else
+        fprintf(out,
+                "Boundary mode: detachment, the right wall (%ld elements) moves left over the "
+                "fixed base at the boundary speed; net displacement = the wall's "
+                "displacement.\n",
+                c->n_right);
+}
+
+static const cdem_bc_ops detach_ops = {
+    .name = "detachment",             /* name */
+    .state_size = sizeof(detach_ctx), /* state_size */
+    .init = detach_init,              /* init */
+    .apply = detach_apply,            /* apply */
+    .net_displacement = detach_net,   /* net_displacement */
+    .view = detach_view,              /* view */
+    .free = NULL,                     /* free: the context owns no memory */
+    .begin_deformation = NULL,        /* nothing to remove */
+};
+
+const cdem_bc_ops *const cdem_bc_detachment = &detach_ops;

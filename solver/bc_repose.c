@@ -1,0 +1,99 @@
+/* bc_repose: angle-of-repose collapse. During equilibration the assembly rests between
+ * both lateral walls; at the start of deformation (the begin_deformation hook, once before
+ * deformation step 1) the right wall (repose_walls = right) or both lateral walls (both)
+ * are removed from the state, through the solver's escape-removal path, so contact
+ * histories of the remaining pairs are kept. Nothing moves afterwards: the material
+ * collapses under gravity; elements that run off the ends of the base are removed by the
+ * escape rule. Net displacement is always 0; the display interval is in seconds
+ * (common/model.c). */
+#include "bc.h"
+
+#include <string.h>
+
+typedef struct {
+    int walls;      /* cdem_walls_choice: right or both */
+    double x_mid;   /* m, walls left of this are the left wall */
+    double y_base;  /* m, height of the base centres */
+    double tol;     /* m, base-row tolerance in y */
+    long n_walls;   /* lateral wall elements marked for removal at init */
+    long n_removed; /* lateral wall elements removed by begin_deformation */
+} repose_ctx;
+
+static int is_removed_wall(const repose_ctx *c, const cdem_state *s, size_t i) {
+    if (!(s->flags[i] & CDEM_FLAG_WALL) || s->y[i] <= c->y_base + c->tol)
+        return 0; /* not a wall, or the base */
+    return s->x[i] > c->x_mid || c->walls == CDEM_WALLS_BOTH;
+}
+
+static cdem_status repose_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
+                               cdem_error *err) {
+    repose_ctx *c = vctx;
+    if (p->repose_walls != CDEM_WALLS_RIGHT && p->repose_walls != CDEM_WALLS_BOTH)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "repose: boundary.repose_walls = %d: must be right or both",
+                         (int)p->repose_walls);
+    cdem_bc_walls w;
+    CDEM_TRY(cdem_bc_find_walls(s, m, "repose", &w, err));
+    c->walls = p->repose_walls;
+    c->x_mid = w.x_mid;
+    c->y_base = w.y_base;
+    c->tol = w.tol;
+    for (size_t i = 0; i < s->n; i++) {
+        s->flags[i] &= ~(uint32_t)CDEM_FLAG_MOVING;
+        c->n_walls += is_removed_wall(c, s, i);
+    }
+    return CDEM_OK;
+}
+
+static cdem_status repose_apply(void *vctx, cdem_state *s, long k, double du, double dt,
+                                cdem_error *err) {
+    (void)vctx;
+    (void)s;
+    (void)k;
+    (void)du;
+    (void)dt;
+    (void)err;
+    return CDEM_OK; /* no boundary moves */
+}
+
+static cdem_status repose_begin(void *vctx, const cdem_state *s, unsigned char *keep,
+                                size_t *n_remove, cdem_error *err) {
+    (void)err;
+    repose_ctx *c = vctx;
+    size_t n = 0;
+    for (size_t i = 0; i < s->n; i++)
+        if (is_removed_wall(c, s, i)) {
+            keep[i] = 0;
+            n++;
+        }
+    c->n_removed += (long)n;
+    *n_remove = n;
+    return CDEM_OK;
+}
+
+static double repose_net(const void *vctx) {
+    (void)vctx;
+    return 0.0;
+}
+
+static void repose_view(const void *vctx, FILE *out) {
+    const repose_ctx *c = vctx;
+    fprintf(out,
+            "Boundary mode: repose collapse, %s (%ld wall elements) removed at the start of "
+            "deformation; no boundary moves afterwards; net displacement 0; display interval "
+            "in seconds.\n",
+            c->walls == CDEM_WALLS_BOTH ? "both lateral walls" : "the right wall", c->n_walls);
+}
+
+static const cdem_bc_ops repose_ops = {
+    .name = "repose",                  /* name */
+    .state_size = sizeof(repose_ctx),  /* state_size */
+    .init = repose_init,               /* init */
+    .apply = repose_apply,             /* apply */
+    .net_displacement = repose_net,    /* net_displacement */
+    .view = repose_view,               /* view */
+    .free = NULL,                      /* free: the context owns no memory */
+    .begin_deformation = repose_begin, /* removes the walls */
+};
+
+const cdem_bc_ops *const cdem_bc_repose = &repose_ops;
