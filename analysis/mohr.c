@@ -92,6 +92,7 @@ cdem_status cdem_mohr_read_table(const char *path, double **sigma3, double **q, 
         char *c = strchr(line, '#');
         if (c)
             *c = 0;
+        line[strcspn(line, "\r\n")] = 0;
         char *p = line;
         while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
             p++;
