@@ -476,11 +476,15 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
     }
     cairo_t *cr = cairo_create(surf);
     cdem_status st = cdem_render_draw(cr, o.width, h, &sc, &o, err);
-    if (st == CDEM_OK) { /* the fitted line over the slope, extended by one column each side */
-        double x0 = res->x_first - res->column_width, x1 = res->x_last + res->column_width;
+    for (int side = 0; side < 2 && st == CDEM_OK; side++) {
+        /* each fitted flank's line, extended by one column at both ends */
+        const cdem_repose_flank *f = &res->flank[side];
+        if (f->n < 2)
+            continue;
+        double x0 = f->x_first - res->column_width, x1 = f->x_last + res->column_width;
         double d0x, d0y, d1x, d1y;
-        cdem_render_layout_to_device(&lay, x0, res->intercept + res->slope * x0, &d0x, &d0y);
-        cdem_render_layout_to_device(&lay, x1, res->intercept + res->slope * x1, &d1x, &d1y);
+        cdem_render_layout_to_device(&lay, x0, f->intercept + f->slope * x0, &d0x, &d0y);
+        cdem_render_layout_to_device(&lay, x1, f->intercept + f->slope * x1, &d1x, &d1y);
         cairo_set_source_rgb(cr, 0, 0, 0);
         cairo_set_line_width(cr, fmax(2.0, o.width / 400.0));
         cairo_move_to(cr, d0x, d0y);
@@ -524,10 +528,17 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
         st = cdem_h5_reader_load_increment(r, idx, &s, &info, &err);
     if (st == CDEM_OK)
         st = cdem_repose_measure(&s, &res, &err);
-    if (st == CDEM_OK)
-        printf("angle of repose = %.2f deg (increment %d, %zu surface elements fitted on the "
-               "slope, columns %.4g m wide, rms misfit %.4g m)\n",
-               res.angle_deg, (int)info.number, res.n_fitted, res.column_width, res.residual_rms);
+    if (st == CDEM_OK) {
+        printf("angle of repose = %.2f deg (increment %d, %zu surface elements fitted, columns "
+               "%.4g m wide)\n",
+               res.angle_deg, (int)info.number, res.n_fitted, res.column_width);
+        for (int side = 0; side < 2; side++)
+            if (res.flank[side].n >= 2)
+                printf("  %s flank: %.2f deg, %zu elements, x %.4g .. %.4g m, rms misfit %.4g m\n",
+                       side ? "right" : "left", res.flank[side].angle_deg, res.flank[side].n,
+                       res.flank[side].x_first, res.flank[side].x_last,
+                       res.flank[side].residual_rms);
+    }
     if (st == CDEM_OK && a.out)
         st = repose_figure(&a, &s, (int)info.number, &res, &err);
     cdem_state_free(&s);
