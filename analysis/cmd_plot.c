@@ -526,6 +526,11 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
         cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &idx, &err);
     if (st == CDEM_OK)
         st = cdem_h5_reader_load_increment(r, idx, &s, &info, &err);
+    cdem_params prm;
+    if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &err) == CDEM_OK &&
+        prm.mode != CDEM_MODE_REPOSE)
+        fprintf(stderr, "cdem-strain repose: note: %s is a '%s' run, not a repose-collapse run\n",
+                a.files[0], cdem_mode_name(prm.mode));
     if (st == CDEM_OK)
         st = cdem_repose_measure(&s, &res, &err);
     if (st == CDEM_OK) {
