@@ -228,9 +228,13 @@ static void draw_legend(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout 
         set_rgba(cr, &c);
         cairo_set_line_width(cr, fmax(1.0, fs / 7.0));
         if (s->line || !s->markers) {
+            double lw = fmax(1.0, fs / 7.0), d[2] = {4 * lw, 3 * lw};
+            if (s->dashed)
+                cairo_set_dash(cr, d, 2, 0);
             cairo_move_to(cr, bx + 0.5 * fs, cy);
             cairo_line_to(cr, bx + 2.5 * fs, cy);
             cairo_stroke(cr);
+            cairo_set_dash(cr, NULL, 0, 0);
         }
         if (s->markers) {
             cairo_arc(cr, bx + 1.5 * fs, cy, 0.25 * fs, 0, 2 * M_PI);

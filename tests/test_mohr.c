@@ -16,7 +16,12 @@
 
 #include "assert_near.h"
 #include "cmd_plot.h"
+#include "h5format.h"
 #include "mohr.h"
+#include "params.h"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 static const double deg = 3.14159265358979323846 / 180.0;
 
@@ -154,12 +159,80 @@ const char *__lsan_default_suppressions(void) {
     return "leak:libfontconfig.so\n";
 }
 
+/* A synthetic biaxial run: stress rises linearly to the peak q at 2 % strain, then
+ * softens to 0.7 q. */
+static void write_biaxial_run(const char *path, double sigma3, double q, cdem_mode mode) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = mode;
+    p.confining_pressure = sigma3;
+    cdem_run_meta meta = {&p, "", "biaxial test", "0", "test"};
+    cdem_h5_writer *w;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    for (int k = 0; k <= 40; k++) {
+        double e = 0.001 * k;
+        double sd = e <= 0.02 ? q * e / 0.02 : q * (1.0 - 0.3 * (e - 0.02) / 0.02);
+        cdem_series_sample smp = {
+            .step = k, .time = k, .axial_strain = e, .differential_stress = sd, .sea_level = NAN};
+        assert_int_equal(cdem_h5_writer_append_series(w, &smp, &err), CDEM_OK);
+    }
+    cdem_state s = {0};
+    assert_int_equal(cdem_state_init(&s, 4, 0, &err), CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, 0.0, 50.0, 1.0, 1, 0, 0, NULL, &err), CDEM_OK);
+    cdem_increment_info info = {.number = 0, .sea_level = NAN, .n_elements = 1};
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    cdem_state_free(&s);
+}
+
+static void test_mohr_command_on_runs(void **state) {
+    (void)state;
+    const double C = 4e6, phi = 34 * deg;
+    char runs[3][512], png[512], out[512];
+    for (int i = 0; i < 3; i++) {
+        snprintf(runs[i], sizeof runs[i], "%s/mohr_run%d.h5", tmp_dir(), i);
+        write_biaxial_run(runs[i], 5e6 * i, peak_q(5e6 * i, C, phi), CDEM_MODE_BIAXIAL);
+    }
+    snprintf(png, sizeof png, "%s/mohr_runs.png", tmp_dir());
+    snprintf(out, sizeof out, "%s/mohr_stdout.txt", tmp_dir());
+    char *argv[] = {"mohr", runs[0], runs[1], runs[2], "-o", png};
+    fflush(stdout);
+    int saved = dup(1), fd = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(saved >= 0 && fd >= 0);
+    dup2(fd, 1);
+    int rc = cdem_cmd_plot_mohr(6, argv);
+    fflush(stdout);
+    dup2(saved, 1);
+    close(fd);
+    close(saved);
+    assert_int_equal(rc, 0);
+    char text[2048] = "";
+    FILE *f = fopen(out, "r");
+    assert_non_null(f);
+    size_t got = fread(text, 1, sizeof text - 1, f);
+    text[got] = 0;
+    fclose(f);
+    assert_non_null(strstr(text, "cohesion = 4 +- "));
+    assert_non_null(strstr(text, "friction angle = 34.00 +- "));
+    assert_non_null(strstr(text, "sigma3 = 10 MPa"));
+    cairo_surface_t *img = cairo_image_surface_create_from_png(png);
+    assert_int_equal(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+    assert_int_equal(cairo_image_surface_get_width(img), 1400);
+    cairo_surface_destroy(img);
+    /* a run of another mode is refused by name */
+    write_biaxial_run(runs[2], 1e7, 2e7, CDEM_MODE_PLANAR_FAULT);
+    char *argv2[] = {"mohr", runs[0], runs[2]};
+    assert_int_equal(cdem_cmd_plot_mohr(3, argv2), 1);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mohr_exact_circles_recover_c_and_phi),
         cmocka_unit_test(test_mohr_noisy_uncertainties_cover_truth),
         cmocka_unit_test(test_mohr_bad_input_messages),
         cmocka_unit_test(test_mohr_table_and_command),
+        cmocka_unit_test(test_mohr_command_on_runs),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     cairo_debug_reset_static_data(); /* drop cairo's font caches before LeakSanitizer looks */
