@@ -111,7 +111,11 @@ static int usage(const char *cmd, const char *what, const char *synopsis) {
 }
 
 static int fail(const char *cmd, const cdem_error *err) {
-    fprintf(stderr, "cdem-strain %s: %s\n", cmd, err->msg[0] ? err->msg : "unknown error");
+    const char *m = err->msg[0] ? err->msg : "unknown error";
+    size_t len = strlen(cmd);
+    if (!strncmp(m, cmd, len) && m[len] == ':' && m[len + 1] == ' ')
+        m += len + 2; /* "mohr: ..." from the library: the command already names it */
+    fprintf(stderr, "cdem-strain %s: %s\n", cmd, m);
     return 1;
 }
 
@@ -515,6 +519,9 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
     if (a.n_files != 1)
         return usage(a.cmd, "need exactly one run file (RUN.h5)", repose_synopsis);
     cdem_error err;
+    cdem_render_format fmt;
+    if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
+        return fail(a.cmd, &err);
     cdem_h5_reader *r;
     if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
         return fail(a.cmd, &err);

@@ -13,13 +13,13 @@
 
 cdem_status cdem_mohr_fit_envelope(const double *sigma3, const double *q, size_t n,
                                    cdem_mohr_fit *fit, cdem_error *err) {
-    if (!sigma3 || !q || !fit)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "mohr: NULL argument");
     if (n < 2)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "mohr: %zu test(s) given; the envelope needs at least 2 confining "
                          "pressures",
                          n);
+    if (!sigma3 || !q || !fit)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "mohr: NULL argument");
     for (size_t i = 0; i < n; i++) {
         if (!isfinite(sigma3[i]) || sigma3[i] < 0)
             return CDEM_FAIL(err, CDEM_ERR_RANGE,

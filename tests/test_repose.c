@@ -16,6 +16,7 @@
 #include "cmd_plot.h"
 #include "h5format.h"
 #include "params.h"
+#include "render.h"
 #include "repose.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
@@ -125,6 +126,24 @@ static void test_repose_command_prints_and_draws(void **state) {
     cairo_surface_t *img = cairo_image_surface_create_from_png(png);
     assert_int_equal(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
     assert_int_equal(cairo_image_surface_get_width(img), 800);
+    /* the fitted line is drawn in black where the renderer's layout maps it */
+    cdem_render_options o;
+    cdem_render_options_default(&o);
+    o.width = 800;
+    cdem_render_scene sc = {.state = &s, .label = "label"};
+    int h;
+    assert_int_equal(cdem_render_auto_height(&sc, &o, &h, &err), CDEM_OK);
+    assert_int_equal(cairo_image_surface_get_height(img), h);
+    cdem_render_layout lay;
+    assert_int_equal(cdem_render_layout_compute(&sc, &o, 800, h, &lay, &err), CDEM_OK);
+    const cdem_repose_flank *f = &r.flank[1];
+    double xm = 0.5 * (f->x_first + f->x_last), dx, dy;
+    cdem_render_layout_to_device(&lay, xm, f->intercept + f->slope * xm, &dx, &dy);
+    const unsigned char *d = cairo_image_surface_get_data(img);
+    uint32_t px =
+        ((const uint32_t *)(const void *)(d + (size_t)(int)dy *
+                                                  cairo_image_surface_get_stride(img)))[(int)dx];
+    assert_true(((px >> 16) & 255) < 90 && ((px >> 8) & 255) < 90 && (px & 255) < 90);
     cairo_surface_destroy(img);
     char *argv2[] = {"repose", h5, "--increment", "99"};
     assert_int_equal(cdem_cmd_plot_repose(4, argv2), 1);
