@@ -103,6 +103,8 @@ typedef struct {
     const char *data;             /* --data FILE (mohr) */
     const char *increment;        /* --increment K (repose) */
     int width, height;            /* --width, --height; 0 = default */
+    int fix_x, fix_y;             /* 1: --xrange / --yrange given */
+    double range[4];              /* xmin, xmax, ymin, ymax of --xrange, --yrange */
 } plot_args;
 
 static int usage(const char *cmd, const char *what, const char *synopsis) {
@@ -129,11 +131,27 @@ static int parse_size(const char *text, int *out) {
     return 1;
 }
 
+/* Parses "MIN,MAX" (finite, MIN < MAX) into r[0], r[1]. */
+static int parse_range(const char *text, double r[2]) {
+    char *end, *end2;
+    errno = 0;
+    double a = strtod(text, &end);
+    if (end == text || *end != ',')
+        return 0;
+    double b = strtod(end + 1, &end2);
+    if (errno || end2 == end + 1 || *end2 || !isfinite(a) || !isfinite(b) || !(a < b))
+        return 0;
+    r[0] = a;
+    r[1] = b;
+    return 1;
+}
+
 /* Returns 0 on success, else the usage exit code (message printed). */
 static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis) {
     const char *cmd = a->cmd;
-    static const char *const names[] = {"--y",    "--x",         "-o",      "--output",
-                                        "--data", "--increment", "--width", "--height"};
+    static const char *const names[] = {"--y",      "--x",         "-o",      "--output",
+                                        "--data",   "--increment", "--width", "--height",
+                                        "--xrange", "--yrange"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
@@ -171,6 +189,15 @@ static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis)
                 break;
             case 5:
                 a->increment = val;
+                break;
+            case 8:
+            case 9:
+                if (!parse_range(val, a->range + 2 * (f - 8))) {
+                    snprintf(msg, sizeof msg, "%s '%.60s': need MIN,MAX with MIN < MAX", names[f],
+                             val);
+                    return usage(cmd, msg, synopsis);
+                }
+                *(f == 8 ? &a->fix_x : &a->fix_y) = 1;
                 break;
             default:
                 if (!parse_size(val, f == 6 ? &a->width : &a->height)) {
@@ -213,7 +240,7 @@ static cdem_status read_series(const char *path, cdem_series_sample **smp, size_
 /* ---------------------------------------------------------------- plot-series */
 static const char series_synopsis[] =
     "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT.png|.pdf|.svg "
-    "[--width N] [--height N]";
+    "[--xrange MIN,MAX] [--yrange MIN,MAX] [--width N] [--height N]";
 
 int cdem_cmd_plot_series(int argc, char **argv) {
     plot_args a = {.cmd = "plot-series"};
@@ -262,7 +289,13 @@ int cdem_cmd_plot_series(int argc, char **argv) {
                        .xlabel = xlabel,
                        .ylabel = ylabel,
                        .series = ser,
-                       .n_series = a.n_files};
+                       .n_series = a.n_files,
+                       .fix_x = a.fix_x,
+                       .xmin = a.range[0],
+                       .xmax = a.range[1],
+                       .fix_y = a.fix_y,
+                       .ymin = a.range[2],
+                       .ymax = a.range[3]};
         st = cdem_plot_to_file(a.out, &p, 1, a.width ? a.width : 1000, a.height ? a.height : 600,
                                &err);
     }

@@ -181,6 +181,22 @@ static void test_plot_series_command_draws_the_line(void **state) {
     cdem_plot_to_device(&lay, lay.xtick0 + 0.5 * lay.xstep, lay.ymax - 0.5 * lay.ystep, &dx, &dy);
     assert_int_equal(pixel(img, dx, dy) & 0xffffff, 0xffffff);
     cairo_surface_destroy(img);
+    /* a fixed y range: the same point lands where the fixed-range layout says */
+    char *argv5[] = {"plot-series", h5,        "--y", "kinetic_energy", "-o", png, "--yrange",
+                     "0,40",        "--width", "800", "--height",       "500"};
+    assert_int_equal(cdem_cmd_plot_series(12, argv5), 0);
+    img = cairo_image_surface_create_from_png(png);
+    assert_int_equal(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+    p.fix_y = 1;
+    p.ymin = 0;
+    p.ymax = 40;
+    assert_int_equal(cdem_plot_layout_compute(&p, 0, 0, 800, 500, &lay, &err), CDEM_OK);
+    cdem_plot_to_device(&lay, 60.0, 36.0, &dx, &dy);
+    on = pixel(img, dx, dy);
+    assert_true((on & 255) > ((on >> 16) & 255) + 60);
+    cairo_surface_destroy(img);
+    char *argv6[] = {"plot-series", h5, "--y", "contacts", "-o", png, "--yrange", "5,1"};
+    assert_int_equal(cdem_cmd_plot_series(8, argv6), 2);
     /* several runs, vector output, unknown column */
     char pdf[512];
     snprintf(pdf, sizeof pdf, "%s/plot_series.pdf", tmp_dir());
