@@ -6,6 +6,7 @@
  * stderr), 2 usage error. Results go to stdout (or -o FILE) so they can be redirected. */
 #include "analysis.h"
 #include "cmd_render.h"
+#include "cmd_plot.h"
 #include "biaxial.h"
 #include "cdem2d.h"
 #include "qexport.h"
@@ -377,6 +378,12 @@ static void print_help(void) {
            "pictures of increments (PNG, PDF, SVG) and animated GIFs", "",
            "RUN.h5 [--increment K|last|equil|all] [--color QUANTITY] -o OUT.png|DIR [--gif OUT.gif]"
            " (cdem-strain render --help for all options)");
+    printf("  %-15s %s\n  %-15s   %s\n", "plot-series", "line plot of time-series columns", "",
+           "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT.png");
+    printf("  %-15s %s\n  %-15s   %s\n", "mohr", "Mohr-Coulomb fit of biaxial tests", "",
+           "RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT.png]");
+    printf("  %-15s %s\n  %-15s   %s\n", "repose", "angle of repose of the free surface", "",
+           "RUN.h5 [--increment K] [-o OUT.png]");
     printf("\nQuantities, formulas and rules: docs/analysis.md; text formats: "
            "docs/formats-text.md.\nExit status: 0 success, 1 error, 2 usage error.\n");
 }
@@ -444,6 +451,12 @@ int main(int argc, char **argv) {
     }
     if (!strcmp(argv[1], "render"))
         return cdem_cmd_render(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "plot-series"))
+        return cdem_cmd_plot_series(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "mohr"))
+        return cdem_cmd_plot_mohr(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "repose"))
+        return cdem_cmd_plot_repose(argc - 1, argv + 1);
     options o;
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(argv[1], commands[i].name)) {
