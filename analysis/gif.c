@@ -10,6 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 static const uint8_t gif_greys[3] = {51, 153, 204};
 #define GIF_CUBE 252
@@ -147,8 +150,20 @@ cdem_status cdem_gif_open(cdem_gif **out, const char *path, int width, int heigh
     }
     strcpy(g->path, path);
     int code = 0;
-    g->file = EGifOpenFileName(path, false, &code);
+    /* Open the file ourselves: giflib's EGifOpenFileName creates it mode 0600, but a movie
+     * is an ordinary output file (0666 less the umask, like every other file we write). */
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
+    if (fd < 0) {
+        cdem_status st = CDEM_FAIL(err, CDEM_ERR_IO, "gif '%s': cannot create the file: %s",
+                                   path, strerror(errno));
+        free(g->path);
+        g->path = NULL; /* nothing was created: do not delete anything */
+        cdem_gif_free(g);
+        return st;
+    }
+    g->file = EGifOpenFileHandle(fd, &code);
     if (!g->file) {
+        close(fd);
         cdem_status st = gif_fail(err, "opening the file", path, code);
         free(g->path);
         g->path = NULL; /* nothing was created: do not delete anything */
