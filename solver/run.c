@@ -3,7 +3,9 @@
  *   writer -> increment 0 -> equilibration (walls still) -> at its last step: 24 layers,
  *   initial cohesion/bonds, increment n_equil -> start of deformation (the mode's optional
  *   begin_deformation hook, e.g. repose removes its walls) -> deformation (mode apply every step)
- * -> increments on the model schedule, time-series samples every series_interval steps. Stop
+ * -> increments on the model schedule, time-series samples every series_interval steps;
+ * with sedimentation, deposits every sediment_steps then settling_steps with the mode's motion
+ * paused (phase "settling"; the mode's step counter k_def skips them; docs/solver.md 8). Stop
  * request: the current step finishes, a final increment is written, the stop reason "interrupted"
  * is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop reason
  * "numerical-failure" with the diagnosis, file closed (every increment written so far stays
