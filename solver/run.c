@@ -255,9 +255,13 @@ static cdem_status make_summary(run_ctx *r, cdem_error *err) {
     cdem_bc_view(&r->bc, f);
     fprintf(f,
             "Solver: velocity Verlet, dt %.6g s, Verlet-list skin %.4g m, %s contacts; "
-            "cohesion/bonds created for touching pairs at the end of equilibration.\n",
+            "cohesion/bonds created for touching pairs at the end of equilibration%s.\n",
             r->m.dt, r->it.nb.skin,
-            r->p->material == CDEM_MATERIAL_BONDED ? "bonded" : "frictional-cohesive");
+            r->p->material == CDEM_MATERIAL_BONDED ? "bonded" : "frictional-cohesive",
+            r->p->sedimentation ? " and for the pairs of each sediment deposit at the end of its "
+                                  "settling (settling steps count in the runtime; boundaries "
+                                  "still)"
+                                : "");
     fclose(f);
     free(text);
     r->summary = buf;
