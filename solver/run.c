@@ -3,7 +3,9 @@
  *   writer -> increment 0 -> equilibration (walls still) -> at its last step: 24 layers,
  *   initial cohesion/bonds, increment n_equil -> start of deformation (the mode's optional
  *   begin_deformation hook, e.g. repose removes its walls) -> deformation (mode apply every step)
- * -> increments on the model schedule, time-series samples every series_interval steps. Stop
+ * -> increments on the model schedule, time-series samples every series_interval steps;
+ * with sedimentation, deposits every sediment_steps then settling_steps with the mode's motion
+ * paused (phase "settling"; the mode's step counter k_def skips them; docs/solver.md 8). Stop
  * request: the current step finishes, a final increment is written, the stop reason "interrupted"
  * is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop reason
  * "numerical-failure" with the diagnosis, file closed (every increment written so far stays
@@ -17,6 +19,7 @@
 #include "h5format.h"
 #include "integrate.h"
 #include "model.h"
+#include "sediment.h"
 #include "stress.h"
 #include "summary.h"
 
@@ -50,6 +53,8 @@ typedef struct {
     double t_start, t_last_log;  /* s, monotonic clock (progress display only) */
     long last_log_step;          /* step of the last progress output */
     int tty_line_open;           /* 1 when a progress line is drawn without newline */
+    cdem_sediment sed;           /* syn-tectonic sedimentation (disabled when off) */
+    long k_def;                  /* deformation steps applied by the mode (settling excluded) */
 } run_ctx;
 
 static double now_s(void) {
@@ -76,7 +81,9 @@ static const char *phase_name(int phase) {
 }
 
 static int phase_of(const run_ctx *r, long step) {
-    return step <= r->m.equil_steps ? CDEM_PHASE_EQUILIBRATION : CDEM_PHASE_DEFORMATION;
+    if (step <= r->m.equil_steps)
+        return CDEM_PHASE_EQUILIBRATION;
+    return cdem_sediment_settling(&r->sed, step) ? CDEM_PHASE_SETTLING : CDEM_PHASE_DEFORMATION;
 }
 
 static void progress(run_ctx *r, int force) {
@@ -188,7 +195,7 @@ static cdem_status write_increment(run_ctx *r, cdem_error *err) {
     inf.time = (double)r->step * r->m.dt;
     inf.phase = phase_of(r, r->step);
     inf.net_displacement = cdem_bc_net_displacement(&r->bc);
-    inf.sea_level = NAN;
+    inf.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
     inf.n_elements = (int64_t)r->s.n;
     inf.has_stress = r->s.has_stress;
     CDEM_TRY(cdem_h5_writer_write_increment(r->w, &inf, &r->s, err));
@@ -227,25 +234,8 @@ static cdem_status write_sample(run_ctx *r, cdem_error *err) {
     q.boundary_force_y = bfy;
     q.base_force_x = gfx;
     q.base_force_y = gfy;
-    q.sea_level = NAN;
+    q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
     return cdem_h5_writer_append_series(r->w, &q, err);
-}
-
-/* Features of later issues: refuse clearly rather than ignore silently. */
-static cdem_status check_supported(const cdem_params *p, cdem_error *err) {
-    struct {
-        int on;
-        const char *what;
-    } const rows[] = {
-        {p->sedimentation != 0, "surface.sedimentation = on"},
-    };
-    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++)
-        if (rows[i].on)
-            return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
-                             "%s is not implemented in this build of the solver yet; turn it "
-                             "off to run",
-                             rows[i].what);
-    return CDEM_OK;
 }
 
 static cdem_status make_summary(run_ctx *r, cdem_error *err) {
@@ -265,9 +255,13 @@ static cdem_status make_summary(run_ctx *r, cdem_error *err) {
     cdem_bc_view(&r->bc, f);
     fprintf(f,
             "Solver: velocity Verlet, dt %.6g s, Verlet-list skin %.4g m, %s contacts; "
-            "cohesion/bonds created for touching pairs at the end of equilibration.\n",
+            "cohesion/bonds created for touching pairs at the end of equilibration%s.\n",
             r->m.dt, r->it.nb.skin,
-            r->p->material == CDEM_MATERIAL_BONDED ? "bonded" : "frictional-cohesive");
+            r->p->material == CDEM_MATERIAL_BONDED ? "bonded" : "frictional-cohesive",
+            r->p->sedimentation ? " and for the pairs of each sediment deposit at the end of its "
+                                  "settling (settling steps count in the runtime; boundaries "
+                                  "still)"
+                                : "");
     fclose(f);
     free(text);
     r->summary = buf;
@@ -290,8 +284,8 @@ static void log_removed(run_ctx *r) {
 static cdem_status run_body(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
-    CDEM_TRY(check_supported(p, err));
     CDEM_TRY(cdem_model_derive(p, &r->m, err));
+    CDEM_TRY(cdem_sediment_init(&r->sed, p, &r->m, err));
     CDEM_TRY(cdem_state_init(&r->s, 1024, p->calculate_stress, err));
     CDEM_TRY(cdem_assembly_build(p, &r->m, &r->s, &r->info, err));
     long n_weak = 0;
@@ -333,7 +327,10 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     long next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
     while (r->step < total) {
         const long step = r->step + 1;
-        const int deforming = step > equil;
+        /* settling after a sediment deposit: boundaries still, not a deformation step */
+        const int deforming = step > equil && !cdem_sediment_settling(&r->sed, step);
+        if (deforming)
+            r->k_def++;
         if (step == equil + 1) {
             /* the mode's start-of-deformation event (e.g. repose removes its walls) */
             size_t nrem = 0;
@@ -348,8 +345,8 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
         }
         /* wall forces are summed only on the steps whose sample reports them */
         r->it.boundary_forces = (step % interval == 0);
-        cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL,
-                                              step - equil, r->m.displacement_per_step, err);
+        cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL, r->k_def,
+                                              r->m.displacement_per_step, err);
         if (st != CDEM_OK)
             return st;
         r->step = step;
@@ -358,17 +355,34 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
             assign_layers(&r->s);
             cdem_integrator_classify(&r->it, &r->s);
             set_erosion_level(r);
+            cdem_sediment_begin(&r->sed, &r->s);
             long made = cdem_integrator_make_cohesive(&r->it, &r->s);
             if (logging(r) && !opt->progress_is_tty)
                 fprintf(opt->log, "cdem-run: end of equilibration at step %ld: %ld %s created\n",
                         step, made,
                         p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
         }
+        const long settled = cdem_sediment_after_step(&r->sed, &r->it, &r->s, step);
+        if (settled > 0 && logging(r) && !opt->progress_is_tty)
+            fprintf(opt->log, "cdem-run: end of settling at step %ld: %ld %s created\n", step,
+                    settled, p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
         if (step % interval == 0)
             CDEM_TRY(write_sample(r, err));
         while (r->next_inc <= r->m.n_increments_total && step >= next_inc_step) {
             CDEM_TRY(write_increment(r, err));
             next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
+        }
+        if (cdem_sediment_due(&r->sed, step)) {
+            long added = 0;
+            CDEM_TRY(cdem_sediment_event(&r->sed, &r->it, &r->s, step, r->next_inc, &added, err));
+            if (logging(r)) {
+                end_progress_line(r);
+                fprintf(opt->log,
+                        "cdem-run: sedimentation at step %ld: %ld growth elements (layer %d) "
+                        "below sea level %.6g m, settling %ld steps\n",
+                        step, added, (int)r->sed.settling_layer,
+                        cdem_sediment_sea_level(&r->sed, step), r->sed.settling_steps);
+            }
         }
         if (step % 64 == 0)
             progress(r, 0);
@@ -431,6 +445,7 @@ cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_err
             st = cst;
     }
     cdem_integrator_free(&r.it);
+    cdem_sediment_free(&r.sed);
     cdem_bc_free(&r.bc);
     cdem_state_free(&r.s);
     free(r.summary);

@@ -193,10 +193,6 @@ static void test_run_refuses_bad_requests(void **st) {
     assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_UNSUPPORTED);
     assert_non_null(strstr(err.msg, "biaxial"));
     p = small_params();
-    p.sedimentation = 1;
-    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_UNSUPPORTED);
-    assert_non_null(strstr(err.msg, "sedimentation"));
-    p = small_params();
     o.output_path = "/nonexistent-dir/x.h5";
     assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_IO);
     assert_int_equal(cdem_run(&p, NULL, &err), CDEM_ERR_INVALID);
