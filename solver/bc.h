@@ -38,9 +38,10 @@ typedef struct {
                                      size_t *n_remove, cdem_error *err);
     /* may be NULL (0): confining pressure in N/m on the free left/right edge elements */
     double (*lateral_pressure)(const void *ctx);
-    /* may be NULL (both 0): called at every time-series sample after the step's boundary
-     * forces are summed; step = completed time steps */
-    void (*measure)(void *ctx, const cdem_state *s, long step, double *axial_strain,
+    /* may be NULL (both 0): sample = 1 at every time-series sample, after the step's boundary
+     * forces are summed (the mode may record them); sample = 0 for an increment (current
+     * values from what was recorded, forces not read); step = completed time steps */
+    void (*measure)(void *ctx, const cdem_state *s, long step, int sample, double *axial_strain,
                     double *differential_stress);
 } cdem_bc_ops;
 
@@ -70,7 +71,7 @@ void cdem_bc_view(const cdem_bc *bc, FILE *out);
 /* The mode's lateral (confining) pressure in N/m; 0 without the hook or bc. */
 double cdem_bc_lateral_pressure(const cdem_bc *bc);
 /* The mode's measurements at a sample (both 0 without the hook). */
-void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, double *axial_strain,
+void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
                      double *differential_stress);
 /* Ramp factor of the confining pressure at completed step `step`: 0 up to equil/2, linear to
  * 1 at equil (the end of equilibration), 1 afterwards; equil <= 0: 1. */

@@ -39,6 +39,7 @@ typedef struct {
     size_t head;     /* next ring slot to write */
     int have_ref;    /* 1 once the end-of-equilibration reference is taken */
     double ref;      /* N/m, differential stress at the end of equilibration */
+    double last;     /* N/m, uncorrected differential stress of the last sample */
 } biaxial_ctx;
 
 static int is_platen(uint32_t f) {
@@ -155,9 +156,14 @@ static double biaxial_pressure(const void *vctx) {
     return ((const biaxial_ctx *)vctx)->pressure;
 }
 
-static void biaxial_measure(void *vctx, const cdem_state *s, long step, double *axial_strain,
-                            double *differential_stress) {
+static void biaxial_measure(void *vctx, const cdem_state *s, long step, int sample,
+                            double *axial_strain, double *differential_stress) {
     biaxial_ctx *c = vctx;
+    *axial_strain = c->closure / c->h0;
+    if (!sample) { /* an increment: the averages of the samples recorded so far */
+        *differential_stress = c->have_ref ? c->last - c->ref : c->last;
+        return;
+    }
     double ft = 0.0, fb = 0.0, lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible */
         const uint32_t f = s->flags[i];
@@ -187,8 +193,8 @@ static void biaxial_measure(void *vctx, const cdem_state *s, long step, double *
         c->ref = diff;
         c->have_ref = 1;
     }
+    c->last = diff;
     *differential_stress = c->have_ref ? diff - c->ref : diff;
-    *axial_strain = c->closure / c->h0;
 }
 
 static void biaxial_view(const void *vctx, FILE *out) {

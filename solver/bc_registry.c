@@ -90,12 +90,12 @@ double cdem_bc_lateral_pressure(const cdem_bc *bc) {
     return (bc && bc->ops && bc->ops->lateral_pressure) ? bc->ops->lateral_pressure(bc->ctx) : 0.0;
 }
 
-void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, double *axial_strain,
+void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
                      double *differential_stress) {
     *axial_strain = 0.0;
     *differential_stress = 0.0;
     if (bc && bc->ops && bc->ops->measure)
-        bc->ops->measure(bc->ctx, s, step, axial_strain, differential_stress);
+        bc->ops->measure(bc->ctx, s, step, sample, axial_strain, differential_stress);
 }
 
 void cdem_bc_free(cdem_bc *bc) {
