@@ -10,9 +10,7 @@
  * settings); free (releases what init allocated in the context; NULL: nothing);
  * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
  * of elements to remove, e.g. repose drops its walls; the solver removes them through the
- * escape path, histories of the rest kept); lateral_pressure (optional: N/m the solver applies
- * inward on the free side edges, ramped up during equilibration); measure (optional: axial
- * strain and differential stress at a time-series sample).
+ * escape path, histories of the rest kept); lateral_pressure, measure (optional, see below).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H

@@ -15,10 +15,8 @@
  * Heterogeneity: after each list rebuild the element-element pair classes are refined from
  * layers and flags (cdem_contact_refine). Overburden: at each rebuild the highest free
  * element of each column (width 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a
- * constant force -p x column width in y until the next rebuild. Confining pressure (biaxial):
- * at each rebuild, in row bands of height 2 x max radius from the lowest free element, the
- * leftmost and rightmost free elements are flagged CDEM_FLAG_BIAXIAL_EDGE and pushed inward in
- * x by p x band height x ramp(step) (cdem_bc_confining_ramp), until the next rebuild.
+ * constant force -p x column width in y until the next rebuild. Confining pressure: the
+ * same sideways on the band edges (cdem_integrator_find_edges), ramped during equilibration.
  * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
