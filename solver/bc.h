@@ -10,7 +10,7 @@
  * settings); free (releases what init allocated in the context; NULL: nothing);
  * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
  * of elements to remove, e.g. repose drops its walls; the solver removes them through the
- * escape path, histories of the rest kept).
+ * escape path, histories of the rest kept); lateral_pressure, measure (optional, see below).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
@@ -34,6 +34,13 @@ typedef struct {
     /* may be NULL; keep has s->n entries, all 1 on entry; *n_remove = number cleared */
     cdem_status (*begin_deformation)(void *ctx, const cdem_state *s, unsigned char *keep,
                                      size_t *n_remove, cdem_error *err);
+    /* may be NULL (0): confining pressure in N/m on the free left/right edge elements */
+    double (*lateral_pressure)(const void *ctx);
+    /* may be NULL (both 0): sample = 1 at every time-series sample, after the step's boundary
+     * forces are summed (the mode may record them); sample = 0 for an increment (current
+     * values from what was recorded, forces not read); step = completed time steps */
+    void (*measure)(void *ctx, const cdem_state *s, long step, int sample, double *axial_strain,
+                    double *differential_stress);
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
@@ -59,6 +66,20 @@ double cdem_bc_net_displacement(const cdem_bc *bc);
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,
                                       size_t *n_remove, cdem_error *err);
 void cdem_bc_view(const cdem_bc *bc, FILE *out);
+/* The mode's lateral (confining) pressure in N/m; 0 without the hook or bc. */
+double cdem_bc_lateral_pressure(const cdem_bc *bc);
+/* The mode's measurements at a sample (both 0 without the hook). */
+void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
+                     double *differential_stress);
+/* Ramp factor of the confining pressure at completed step `step`: 0 up to equil/2, linear to
+ * 1 at equil (the end of equilibration), 1 afterwards; equil <= 0: 1. */
+static inline double cdem_bc_confining_ramp(long step, long equil) {
+    if (equil <= 0 || step >= equil)
+        return 1.0;
+    const double h = 0.5 * (double)equil;
+    const double f = ((double)step - h) / ((double)equil - h);
+    return f <= 0.0 ? 0.0 : (f >= 1.0 ? 1.0 : f);
+}
 /* Releases the context; bc may be NULL or never initialised. */
 void cdem_bc_free(cdem_bc *bc);
 
@@ -86,5 +107,6 @@ extern const cdem_bc_ops *const cdem_bc_planar_fault;
 extern const cdem_bc_ops *const cdem_bc_vertical_faults;
 extern const cdem_bc_ops *const cdem_bc_detachment;
 extern const cdem_bc_ops *const cdem_bc_repose;
+extern const cdem_bc_ops *const cdem_bc_biaxial;
 
 #endif

@@ -19,11 +19,11 @@ static const bc_row registry[] = {
     {CDEM_MODE_VERTICAL_FAULTS, "vertical-faults", &cdem_bc_vertical_faults},
     {CDEM_MODE_DETACHMENT, "detachment", &cdem_bc_detachment},
     {CDEM_MODE_REPOSE, "repose", &cdem_bc_repose},
-    {CDEM_MODE_BIAXIAL, "biaxial", NULL}, /* later issue */
+    {CDEM_MODE_BIAXIAL, "biaxial", &cdem_bc_biaxial},
 };
 
 const char *cdem_bc_implemented(void) {
-    return "planar-fault, vertical-faults, detachment, repose";
+    return "planar-fault, vertical-faults, detachment, repose, biaxial";
 }
 
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err) {
@@ -84,6 +84,18 @@ cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned
 void cdem_bc_view(const cdem_bc *bc, FILE *out) {
     if (bc && bc->ops)
         bc->ops->view(bc->ctx, out);
+}
+
+double cdem_bc_lateral_pressure(const cdem_bc *bc) {
+    return (bc && bc->ops && bc->ops->lateral_pressure) ? bc->ops->lateral_pressure(bc->ctx) : 0.0;
+}
+
+void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
+                     double *differential_stress) {
+    *axial_strain = 0.0;
+    *differential_stress = 0.0;
+    if (bc && bc->ops && bc->ops->measure)
+        bc->ops->measure(bc->ctx, s, step, sample, axial_strain, differential_stress);
 }
 
 void cdem_bc_free(cdem_bc *bc) {

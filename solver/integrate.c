@@ -53,6 +53,8 @@ void cdem_integrator_free(cdem_integrator *it) {
     free(it->keep);
     free(it->removed_ids);
     free(it->col_top);
+    free(it->band_lo);
+    free(it->band_hi);
     memset(it, 0, sizeof *it);
 }
 
@@ -137,6 +139,8 @@ static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) 
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
+    if (it->confining_pressure > 0.0)
+        CDEM_TRY(cdem_integrator_find_edges(it, s, err));
     return CDEM_OK;
 }
 
@@ -167,6 +171,81 @@ cdem_status cdem_integrator_set_overburden(cdem_integrator *it, double pressure,
                          pressure);
     it->overburden_pressure = pressure;
     it->overburden_force = pressure * it->column_width;
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_set_confining(cdem_integrator *it, double pressure, long equil_steps,
+                                          cdem_error *err) {
+    if (!isfinite(pressure) || pressure < 0.0)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "integrator: boundary.confining_pressure = %g N/m: must be a finite "
+                         "number >= 0",
+                         pressure);
+    it->confining_pressure = pressure;
+    it->confining_equil = equil_steps;
+    it->confining_factor = cdem_bc_confining_ramp(it->step, equil_steps);
+    return CDEM_OK;
+}
+
+cdem_status cdem_integrator_find_edges(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    double ymin = INFINITY, ymax = -INFINITY, xmin = INFINITY, xmax = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        s->flags[i] &= ~(uint32_t)CDEM_FLAG_BIAXIAL_EDGE;
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        ymin = fmin(ymin, s->y[i]);
+        ymax = fmax(ymax, s->y[i]);
+        xmin = fmin(xmin, s->x[i]);
+        xmax = fmax(xmax, s->x[i]);
+    }
+    it->n_edge = 0;
+    if (!isfinite(ymin) || !(it->column_width > 0.0))
+        return CDEM_OK;
+    it->edge_x_mid = 0.5 * (xmin + xmax);
+    const double w = it->column_width;
+    const double span = (ymax - ymin) / w;
+    if (!(span < 1e8))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "integrator: free elements span %g m = %g bands of %g m: too many for "
+                         "the edge search",
+                         ymax - ymin, span, w);
+    const size_t nb = (size_t)span + 1;
+    if (nb > it->bandcap) {
+        const size_t c = nb + nb / 2 + 16;
+        int32_t *lo = realloc(it->band_lo, c * sizeof *lo);
+        if (lo)
+            it->band_lo = lo;
+        int32_t *hi = lo ? realloc(it->band_hi, c * sizeof *hi) : NULL;
+        if (!lo || !hi)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu bands)", c);
+        it->band_hi = hi;
+        it->bandcap = c;
+    }
+    for (size_t b = 0; b < nb; b++)
+        it->band_lo[b] = it->band_hi[b] = -1;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        size_t b = (size_t)((s->y[i] - ymin) / w);
+        if (b >= nb)
+            b = nb - 1;
+        const int32_t lo = it->band_lo[b], hi = it->band_hi[b];
+        if (lo < 0 || s->x[i] < s->x[lo])
+            it->band_lo[b] = (int32_t)i;
+        if (hi < 0 || s->x[i] > s->x[hi])
+            it->band_hi[b] = (int32_t)i;
+    }
+    long count = 0;
+    for (size_t b = 0; b < nb; b++) {
+        const int32_t e[2] = {it->band_lo[b], it->band_hi[b]};
+        for (int k = 0; k < 2; k++) {
+            if (e[k] < 0 || (s->flags[e[k]] & CDEM_FLAG_BIAXIAL_EDGE))
+                continue;
+            s->flags[e[k]] |= CDEM_FLAG_BIAXIAL_EDGE;
+            count++;
+        }
+    }
+    it->n_edge = count;
     return CDEM_OK;
 }
 
@@ -271,9 +350,12 @@ static inline void pair_force(const cdem_contact_law *law, long p, const double 
 static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
-                                  double hdt, double c, double g, double ob, int kick) {
+                                  double hdt, double c, double g, double ob, int kick,
+                                  const double *restrict x, double ef, double exmid) {
     const double m = mass[i];
     sy -= m * g + ((flags[i] & CDEM_FLAG_SURFACE) ? ob : 0.0);
+    if (flags[i] & CDEM_FLAG_BIAXIAL_EDGE)
+        sx += x[i] < exmid ? ef : -ef;
     if (kick) {
         /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
         const double inv = 1.0 / (m + c * hdt);
@@ -307,6 +389,8 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     double *restrict fx = s->fx, *restrict fy = s->fy;
     double *restrict vxw = s->vx, *restrict vyw = s->vy;
     const double hdt = 0.5 * dt, c = it->damping, g = it->gravity, ob = it->overburden_force;
+    const double ef = it->confining_pressure * it->column_width * it->confining_factor;
+    const double exmid = it->edge_x_mid;
     const int threaded = (np > it->par_min || n > it->par_min) && omp_get_max_threads() > 1;
 
     if (!threaded) {
@@ -322,7 +406,8 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         }
         for (long i = 0; i < n; i++)
             if (!(flags[i] & CDEM_FLAGS_BOUNDARY))
-                finish_element(i, fx[i], fy[i], mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick);
+                finish_element(i, fx[i], fy[i], mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick,
+                               x, ef, exmid);
         return;
     }
 
@@ -357,7 +442,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
             fy[i] = sy;
             continue;
         }
-        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick);
+        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid);
     }
 }
 
@@ -401,6 +486,8 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         }
     }
     it->step++;
+    if (it->confining_pressure > 0.0)
+        it->confining_factor = cdem_bc_confining_ramp(it->step, it->confining_equil);
     if (bc)
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, dt, err));
     if (cdem_neighbour_needs_rebuild(&it->nb, s)) {
@@ -422,6 +509,8 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
+    if (it->confining_pressure > 0.0)
+        CDEM_TRY(cdem_integrator_find_edges(it, s, err));
     const double dt = it->dt;
     it->dt = 0.0;
     forces_and_kick(it, s, 0);

@@ -15,7 +15,8 @@
  * Heterogeneity: after each list rebuild the element-element pair classes are refined from
  * layers and flags (cdem_contact_refine). Overburden: at each rebuild the highest free
  * element of each column (width 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a
- * constant force -p x column width in y until the next rebuild.
+ * constant force -p x column width in y until the next rebuild. Confining pressure: the
+ * same sideways on the band edges (cdem_integrator_find_edges), ramped during equilibration.
  * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
@@ -60,6 +61,15 @@ typedef struct {
     long n_surface;             /* surface elements flagged at the last rebuild */
     int32_t *col_top;           /* per-column scratch: index of the highest element (colcap) */
     size_t colcap;              /* capacity of col_top */
+
+    /* confining pressure on the free side edges (enabled when confining_pressure > 0) */
+    double confining_pressure;  /* N/m, full lateral pressure, >= 0 */
+    long confining_equil;       /* steps of equilibration: ramp 0 at half of it, 1 at its end */
+    double confining_factor;    /* ramp factor of the current step, 0..1 */
+    double edge_x_mid;          /* m, edge elements left of this are pushed in +x, others -x */
+    long n_edge;                /* edge elements flagged at the last rebuild */
+    int32_t *band_lo, *band_hi; /* per-band scratch: leftmost / rightmost element (bandcap) */
+    size_t bandcap;             /* capacity of band_lo, band_hi */
 } cdem_integrator;
 
 /* Sets up the stepper from the model constants (dt, damping, gravity, kn, ks, max radius)
@@ -91,6 +101,18 @@ cdem_status cdem_integrator_set_overburden(cdem_integrator *it, double pressure,
  * column_width from the leftmost free element, the free element with the highest centre.
  * Called at every rebuild when the overburden is on; public for tests and views. */
 cdem_status cdem_integrator_find_surface(cdem_integrator *it, cdem_state *s, cdem_error *err);
+
+/* Enables the confining pressure: pressure in N/m (>= 0, finite; 0 disables) on the free side
+ * edges, ramped by cdem_bc_confining_ramp(step, equil_steps). Fails with CDEM_ERR_RANGE naming
+ * boundary.confining_pressure when the value is negative or not finite. */
+cdem_status cdem_integrator_set_confining(cdem_integrator *it, double pressure, long equil_steps,
+                                          cdem_error *err);
+
+/* Flags the edge elements now (clears CDEM_FLAG_BIAXIAL_EDGE elsewhere): per band of height
+ * column_width from the lowest free centre, the leftmost and rightmost free element; sets
+ * edge_x_mid to the middle of the free span. Called at every rebuild when the confining
+ * pressure is on; public for tests. */
+cdem_status cdem_integrator_find_edges(cdem_integrator *it, cdem_state *s, cdem_error *err);
 
 /* Re-derives the material class of every pair from the current layers and flags (call
  * after layers change, e.g. at the end of equilibration). */

@@ -198,6 +198,7 @@ static cdem_status write_increment(run_ctx *r, cdem_error *err) {
     inf.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
     inf.n_elements = (int64_t)r->s.n;
     inf.has_stress = r->s.has_stress;
+    cdem_bc_measure(&r->bc, &r->s, r->step, 0, &inf.axial_strain, &inf.differential_stress);
     CDEM_TRY(cdem_h5_writer_write_increment(r->w, &inf, &r->s, err));
     r->next_inc++;
     r->last_written_step = r->step;
@@ -235,6 +236,7 @@ static cdem_status write_sample(run_ctx *r, cdem_error *err) {
     q.base_force_x = gfx;
     q.base_force_y = gfy;
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
+    cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
     return cdem_h5_writer_append_series(r->w, &q, err);
 }
 
@@ -302,6 +304,8 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
+    CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
+                                           r->m.equil_steps, err));
     CDEM_TRY(make_summary(r, err));
     const cdem_run_meta meta = {
         .params = p,

@@ -1,0 +1,233 @@
+/* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (common/model.c).
+ * Init: the base row is the bottom platen; a top platen of wall elements (base radius r,
+ * spaced r) is added one radius above the highest free element; both platens are extended
+ * 25% of the base length beyond each end so the sample keeps touching them as it widens.
+ * Both platens are CDEM_FLAG_MOVING. Equilibration: the lateral walls hold the sample while the
+ * solver ramps the confining pressure (lateral_pressure hook) from 0 at mid-equilibration to
+ * full at its end. Start of deformation: the lateral walls are removed (the sides are free,
+ * loaded only by the confining pressure). Deformation: each platen moves toward the other at
+ * half the boundary speed, so the closure per step is the boundary increment du and the net
+ * displacement is the closure. Measurements at each time-series sample: axial strain =
+ * closure / H0 (H0 = platen gap at the end of equilibration, between the platens' inner
+ * faces); differential stress = F / L - p x ramp, F = mean |contact force y| of the two
+ * platens, L = span of the free elements (left edge to right edge), F and L averaged over the
+ * samples of the last 5 increments (v3.1), minus the value at the end of equilibration (v2.6)
+ * from then on (during equilibration the uncorrected value is reported). Units: m, N, N/m. */
+#include "bc.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    double pressure; /* N/m, confining pressure (boundary.confining_pressure), >= 0 */
+    long equil;      /* steps of equilibration (ramp and correction reference) */
+    double y_mid;    /* m, platen elements above this are the top platen */
+    double y_bottom; /* m, bottom platen centre height (moves up by du/2 per step) */
+    double y_top;    /* m, top platen centre height (moves down by du/2 per step) */
+    double r_bottom; /* m, bottom platen radius (the smallest base radius) */
+    double r_top;    /* m, top platen radius, = r_bottom */
+    double h0;       /* m, gap between the platens' inner faces before deformation, > 0 */
+    double closure;  /* m, platen closure so far, >= 0 */
+    long n_top;      /* top platen elements added */
+    long n_extend;   /* bottom platen elements added beyond the base ends */
+    long n_walls;    /* lateral wall elements (removed at the start of deformation) */
+    size_t window;   /* samples averaged (5 increments' worth), >= 1 */
+    double *ring_f;  /* window entries: mean |platen force y|, N */
+    double *ring_l;  /* window entries: free-element span, m */
+    size_t n_ring;   /* entries filled, <= window */
+    size_t head;     /* next ring slot to write */
+    int have_ref;    /* 1 once the end-of-equilibration reference is taken */
+    double ref;      /* N/m, differential stress at the end of equilibration */
+    double last;     /* N/m, uncorrected differential stress of the last sample */
+} biaxial_ctx;
+
+static int is_platen(uint32_t f) {
+    return (f & CDEM_FLAG_WALL) && (f & CDEM_FLAG_MOVING);
+}
+
+static cdem_status biaxial_init(void *vctx, const cdem_params *p, const cdem_model *m,
+                                cdem_state *s, cdem_error *err) {
+    biaxial_ctx *c = vctx;
+    if (!(p->confining_pressure >= 0.0) || !isfinite(p->confining_pressure))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "biaxial: boundary.confining_pressure = %g N/m: must be a finite "
+                         "number >= 0",
+                         p->confining_pressure);
+    if (p->overburden_pressure > 0.0)
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "biaxial: surface.overburden_pressure = %g N/m: the biaxial test takes "
+                         "no overburden; set it to 0",
+                         p->overburden_pressure);
+    cdem_bc_walls w;
+    CDEM_TRY(cdem_bc_find_walls(s, m, "biaxial", &w, err));
+    double top = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        uint32_t *f = &s->flags[i];
+        *f &= ~(uint32_t)CDEM_FLAG_MOVING;
+        if (*f & CDEM_FLAG_WALL) {
+            if (cdem_bc_is_base(&w, s, i))
+                *f |= CDEM_FLAG_MOVING;
+            else
+                c->n_walls++;
+        } else if (!(*f & CDEM_FLAGS_BOUNDARY)) {
+            top = fmax(top, s->y[i] + s->radius[i]);
+        }
+    }
+    if (!isfinite(top))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "biaxial: the assembly has no free elements");
+    const double r = w.r_base;
+    const double ext = 0.25 * (w.x_max - w.x_min);
+    const long n_side = (long)ceil(ext / r);
+    const double mass = p->density * M_PI * r * r;
+    const uint32_t fl = CDEM_FLAG_WALL | CDEM_FLAG_MOVING;
+    for (long k = 1; k <= n_side; k++) { /* bottom platen beyond both base ends */
+        CDEM_TRY(cdem_state_append(s, -1, w.x_min - (double)k * r, w.y_base, r, mass, 0, fl, 0,
+                                   NULL, err));
+        CDEM_TRY(cdem_state_append(s, -1, w.x_max + (double)k * r, w.y_base, r, mass, 0, fl, 0,
+                                   NULL, err));
+        c->n_extend += 2;
+    }
+    c->r_bottom = c->r_top = r;
+    c->y_bottom = w.y_base;
+    c->y_top = top + r;
+    const long n_top = (long)ceil((w.x_max - w.x_min + 2.0 * ext) / r);
+    for (long k = 0; k <= n_top; k++) {
+        CDEM_TRY(cdem_state_append(s, -1, w.x_min - ext + (double)k * r, c->y_top, r, mass, 0, fl,
+                                   0, NULL, err));
+        c->n_top++;
+    }
+    c->h0 = (c->y_top - r) - (c->y_bottom + r);
+    if (!(c->h0 > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "biaxial: platen gap = %g m: must be > 0", c->h0);
+    c->y_mid = 0.5 * (c->y_top + c->y_bottom);
+    c->pressure = p->confining_pressure;
+    c->equil = m->equil_steps;
+    const long interval = p->series_interval > 0 ? p->series_interval : 1;
+    const double win = ceil(5.0 * m->display_steps / (double)interval);
+    c->window = win >= 1.0 ? (win < 1e6 ? (size_t)win : 1000000) : 1;
+    c->ring_f = calloc(c->window, sizeof *c->ring_f);
+    c->ring_l = calloc(c->window, sizeof *c->ring_l);
+    if (!c->ring_f || !c->ring_l)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "biaxial: out of memory for %zu averaging samples",
+                         c->window);
+    return CDEM_OK;
+}
+
+static cdem_status biaxial_apply(void *vctx, cdem_state *s, long k, double du, double dt,
+                                 cdem_error *err) {
+    (void)k;
+    (void)err;
+    biaxial_ctx *c = vctx;
+    const double h = 0.5 * du, v = dt > 0.0 ? h / dt : 0.0;
+    for (size_t i = 0; i < s->n; i++) {
+        if (!is_platen(s->flags[i]))
+            continue;
+        const double sign = s->y[i] > c->y_mid ? -1.0 : 1.0;
+        s->y[i] += sign * h;
+        s->vx[i] = 0.0;
+        s->vy[i] = sign * v;
+    }
+    c->y_top -= h;
+    c->y_bottom += h;
+    c->closure += du;
+    return CDEM_OK;
+}
+
+static cdem_status biaxial_begin(void *vctx, const cdem_state *s, unsigned char *keep,
+                                 size_t *n_remove, cdem_error *err) {
+    (void)vctx;
+    (void)err;
+    size_t n = 0;
+    for (size_t i = 0; i < s->n; i++)
+        if ((s->flags[i] & CDEM_FLAG_WALL) && !(s->flags[i] & CDEM_FLAG_MOVING)) {
+            keep[i] = 0;
+            n++;
+        }
+    *n_remove = n;
+    return CDEM_OK;
+}
+
+static double biaxial_net(const void *vctx) {
+    return ((const biaxial_ctx *)vctx)->closure;
+}
+
+static double biaxial_pressure(const void *vctx) {
+    return ((const biaxial_ctx *)vctx)->pressure;
+}
+
+static void biaxial_measure(void *vctx, const cdem_state *s, long step, int sample,
+                            double *axial_strain, double *differential_stress) {
+    biaxial_ctx *c = vctx;
+    *axial_strain = c->closure / c->h0;
+    if (!sample) { /* an increment: the averages of the samples recorded so far */
+        *differential_stress = c->have_ref ? c->last - c->ref : c->last;
+        return;
+    }
+    double ft = 0.0, fb = 0.0, lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible */
+        const uint32_t f = s->flags[i];
+        if (is_platen(f)) {
+            if (s->y[i] > c->y_mid)
+                ft += s->fy[i];
+            else
+                fb += s->fy[i];
+        } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            lo = fmin(lo, s->x[i] - s->radius[i]);
+            hi = fmax(hi, s->x[i] + s->radius[i]);
+        }
+    }
+    c->ring_f[c->head] = 0.5 * (fabs(ft) + fabs(fb));
+    c->ring_l[c->head] = hi > lo ? hi - lo : 0.0;
+    c->head = (c->head + 1) % c->window;
+    if (c->n_ring < c->window)
+        c->n_ring++;
+    double sf = 0.0, sl = 0.0;
+    for (size_t k = 0; k < c->n_ring; k++) {
+        sf += c->ring_f[k];
+        sl += c->ring_l[k];
+    }
+    const double axial = sl > 0.0 ? sf / sl : 0.0;
+    const double diff = axial - c->pressure * cdem_bc_confining_ramp(step, c->equil);
+    if (step >= c->equil && !c->have_ref) {
+        c->ref = diff;
+        c->have_ref = 1;
+    }
+    c->last = diff;
+    *differential_stress = c->have_ref ? diff - c->ref : diff;
+}
+
+static void biaxial_view(const void *vctx, FILE *out) {
+    const biaxial_ctx *c = vctx;
+    fprintf(out,
+            "Boundary mode: biaxial test, confining pressure %.6g N/m on the free edges (ramped "
+            "from 0 at mid-equilibration to full at its end); top platen of %ld elements added "
+            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); both platens "
+            "move toward each other at half the boundary speed; the %ld lateral wall elements "
+            "are removed at the start of deformation; initial sample height %.6g m; axial "
+            "strain = closure / height; differential stress averaged over %zu samples (5 "
+            "increments) and corrected to 0 at the end of equilibration.\n",
+            c->pressure, c->n_top, c->y_top, c->n_extend, c->n_walls, c->h0, c->window);
+}
+
+static void biaxial_free(void *vctx) {
+    biaxial_ctx *c = vctx;
+    free(c->ring_f);
+    free(c->ring_l);
+    c->ring_f = c->ring_l = NULL;
+}
+
+static const cdem_bc_ops biaxial_ops = {
+    .name = "biaxial",                    /* name */
+    .state_size = sizeof(biaxial_ctx),    /* state_size */
+    .init = biaxial_init,                 /* adds the top platen */
+    .apply = biaxial_apply,               /* moves both platens */
+    .net_displacement = biaxial_net,      /* platen closure */
+    .view = biaxial_view,                 /* view */
+    .free = biaxial_free,                 /* averaging buffers */
+    .begin_deformation = biaxial_begin,   /* removes the lateral walls */
+    .lateral_pressure = biaxial_pressure, /* confining pressure */
+    .measure = biaxial_measure,           /* axial strain, differential stress */
+};
+
+const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;
