@@ -16,6 +16,8 @@
 
 /* Exponent k of the listric dip law dip(y) = d0 + (90 - d0) (y / H)^k. */
 #define CDEM_LISTRIC_EXPONENT 2.0
+/* Segments of the listric polyline built by bc_listric (equal heights). */
+#define CDEM_LISTRIC_SEGMENTS 200
 
 typedef struct {
     size_t n;      /* number of vertices, >= 2 */

@@ -1,0 +1,275 @@
+/* bc_listric: listric and irregular normal/reverse faults with constant heave (CH).
+ *
+ * Geometry (docs/solver.md, "Listric and irregular faults"): the left wall is sculpted into a
+ * fault curve from (x0 = fault_location x width, 0) up-dip toward -x (dipping toward +x, the
+ * hanging wall on the right): listric = dip(y) = d0 + (90 - d0) (y/H)^2 from the base (d0 =
+ * fault_dip) to the top of the assembly H (fault_file.h), irregular = the vertex file's
+ * polyline. Fault elements (CDEM_FLAG_FAULT | MOVING, radius of the base elements, spaced by
+ * one radius) lie on the curve, extended below the base along the basal segment for the whole
+ * displacement plus 4 radii and vertically above its top to the top of the walls. Free
+ * elements left of the curve, or closer to it than their radius plus the fault radius, and
+ * the left wall become fixed display-only footwall elements (CDEM_FLAG_FOOTWALL; they never
+ * interact). The base left of x0 stays: fixed when the motion is normal only, moving with the
+ * hanging wall when it has a reverse part (so no gap opens under the rising block).
+ * CH kinematics: per step the fault elements move horizontally by the heave du cos(db)
+ * (toward +x for normal) and the hanging-wall base (base right of x0, right wall) vertically
+ * by du sin(db) (down for normal), db = dip of the basal segment, so the hanging wall follows
+ * the basal segment with du along it. Reverse/inversion as in bc_planar_fault.c. CD
+ * ("mylar sheet") kinematics are refused (CDEM_ERR_UNSUPPORTED). */
+#include "bc.h"
+#include "fault_file.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    int irregular;            /* 1: irregular-fault (vertex file), 0: listric-fault */
+    double dip_base_deg;      /* dip of the basal segment, degrees, (0, 90] */
+    int sense;                /* initial cdem_fault_sense */
+    int inversion;            /* 1: the sense reverses after k_inversion */
+    long k_inversion;         /* last deformation step of the initial sense */
+    double x_fault;           /* m, x0: where the curve meets the base surface (y = 0) */
+    double height;            /* m, H: top of the assembly (highest free element top) */
+    double heave;             /* horizontal fault motion per metre along the basal segment */
+    double throw_;            /* vertical base motion per metre along the basal segment */
+    cdem_fault_polyline line; /* the fault curve from (x0, 0) up-dip (owned) */
+    long n_fault;             /* fault elements added */
+    long n_footwall;          /* elements flagged CDEM_FLAG_FOOTWALL */
+    long n_base_moving;       /* wall elements of the moving hanging-wall base/right wall */
+    double net;               /* m, net displacement along the basal segment (initial sense +) */
+} listric_ctx;
+
+static const char *mode_name(const listric_ctx *c) {
+    return c->irregular ? "irregular fault" : "listric fault";
+}
+
+/* Lays fault elements every r along the path ramp -> curve -> vertical top. */
+static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s, double r,
+                             double ramp, double y_top, cdem_error *err) {
+    const cdem_fault_polyline *pl = &c->line;
+    const size_t nv = pl->n + 2;
+    /* path vertices: ramp start, the curve, the top (vertical extension) */
+    double px[CDEM_LISTRIC_SEGMENTS + 3], py[CDEM_LISTRIC_SEGMENTS + 3];
+    const double *vx = pl->x, *vy = pl->y;
+    double *hx = NULL, *hy = NULL;
+    if (nv > CDEM_LISTRIC_SEGMENTS + 3) {
+        hx = malloc(nv * sizeof *hx);
+        hy = malloc(nv * sizeof *hy);
+        if (!hx || !hy) {
+            free(hx);
+            free(hy);
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu path vertices",
+                             mode_name(c), nv);
+        }
+    }
+    double *qx = hx ? hx : px, *qy = hy ? hy : py;
+    const double db = c->dip_base_deg * M_PI / 180.0;
+    qx[0] = vx[0] + ramp * cos(db);
+    qy[0] = vy[0] - ramp * sin(db);
+    for (size_t k = 0; k < pl->n; k++) {
+        qx[k + 1] = vx[k];
+        qy[k + 1] = vy[k];
+    }
+    qx[nv - 1] = vx[pl->n - 1];
+    qy[nv - 1] = fmax(y_top, vy[pl->n - 1]);
+    const double mass = p->density * M_PI * r * r;
+    cdem_status st = CDEM_OK;
+    double along = 0.0; /* arc length of the next element from the segment start */
+    for (size_t k = 1; k < nv && st == CDEM_OK; k++) {
+        const double ex = qx[k] - qx[k - 1], ey = qy[k] - qy[k - 1];
+        const double len = hypot(ex, ey);
+        for (; along <= len && st == CDEM_OK; along += r) {
+            const double t = len > 0.0 ? along / len : 0.0;
+            st = cdem_state_append(s, -1, qx[k - 1] + t * ex, qy[k - 1] + t * ey, r, mass, 0,
+                                   CDEM_FLAG_FAULT | CDEM_FLAG_MOVING, 0, NULL, err);
+            c->n_fault++;
+        }
+        along -= len;
+    }
+    free(hx);
+    free(hy);
+    return st;
+}
+
+static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, const cdem_model *m,
+                                       cdem_state *s, cdem_error *err) {
+    const char *name = mode_name(c);
+    if (p->kinematics == CDEM_KIN_CD)
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "%s: boundary.kinematics = cd (constant displacement, mylar sheet) is "
+                         "not implemented in this build; use kinematics = ch (constant heave)",
+                         name);
+    if (!(p->fault_location > 0.0 && p->fault_location < 1.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s: boundary.fault_location = %g: must be in (0, 1)",
+                         name, p->fault_location);
+    if (p->inversion && !(p->inversion_percent >= 0.0 && p->inversion_percent <= 100.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "%s: boundary.inversion_percent = %g: must be in 0-100", name,
+                         p->inversion_percent);
+    cdem_bc_walls w;
+    CDEM_TRY(cdem_bc_find_walls(s, m, name, &w, err));
+    double top = -INFINITY, wall_top = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            wall_top = fmax(wall_top, s->y[i]);
+        else
+            top = fmax(top, s->y[i] + s->radius[i]);
+    }
+    if (!(top > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: the assembly has no free element above the base (top = %g m)", name,
+                         top);
+    c->height = top;
+    c->x_fault = p->fault_location * m->width_m;
+    if (c->irregular) {
+        CDEM_TRY(
+            cdem_fault_file_read(p->fault_file, c->x_fault, 0.5 * m->radius[0], &c->line, err));
+        c->dip_base_deg =
+            atan2(c->line.y[1] - c->line.y[0], c->line.x[0] - c->line.x[1]) * 180.0 / M_PI;
+    } else {
+        if (!(p->fault_dip > 0.0 && p->fault_dip <= 90.0))
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "%s: boundary.fault_dip = %g degrees: must be in (0, 90]", name,
+                             p->fault_dip);
+        CDEM_TRY(cdem_fault_file_listric(c->x_fault, c->height, p->fault_dip, CDEM_LISTRIC_SEGMENTS,
+                                         &c->line, err));
+        c->dip_base_deg = p->fault_dip;
+    }
+    const cdem_fault_polyline *pl = &c->line;
+    const double x_left = pl->x[pl->n - 1];
+    if (!(x_left > w.x_min + 2.0 * w.r_base))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "%s: the fault curve reaches x = %g m at y = %g m, at or left of the "
+                         "left wall (x = %g m); move boundary.fault_location right or steepen "
+                         "the fault (fault_dip = %g degrees)",
+                         name, x_left, pl->y[pl->n - 1], w.x_min, c->dip_base_deg);
+    c->sense = p->fault_sense;
+    c->inversion = p->inversion ? 1 : 0;
+    const long def_steps = m->total_steps - m->equil_steps;
+    c->k_inversion =
+        c->inversion ? lround(p->inversion_percent / 100.0 * (double)def_steps) : def_steps + 1;
+    const double db = c->dip_base_deg * M_PI / 180.0;
+    c->heave = cos(db);
+    c->throw_ = sin(db);
+    const int has_reverse = p->fault_sense == CDEM_SENSE_REVERSE || c->inversion;
+    const double rf = w.r_base;
+    /* footwall, hanging-wall base and right wall */
+    for (size_t i = 0; i < s->n; i++) {
+        uint32_t f = s->flags[i] & ~(uint32_t)CDEM_FLAG_MOVING;
+        if (f & CDEM_FLAG_WALL) {
+            const int is_base = cdem_bc_is_base(&w, s, i);
+            if (!is_base && s->x[i] < w.x_mid) {
+                f = (f & ~(uint32_t)CDEM_FLAG_WALL) | CDEM_FLAG_FOOTWALL; /* left wall */
+                c->n_footwall++;
+            } else if (!is_base || s->x[i] > c->x_fault || has_reverse) {
+                f |= CDEM_FLAG_MOVING;
+                c->n_base_moving++;
+            }
+        } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            const double xi = s->x[i], yi = s->y[i];
+            if (xi < cdem_fault_file_x_at(pl, yi) ||
+                cdem_fault_file_distance(pl, xi, yi) < s->radius[i] + rf) {
+                f |= CDEM_FLAG_FOOTWALL;
+                s->vx[i] = s->vy[i] = 0.0;
+                c->n_footwall++;
+            }
+        }
+        s->flags[i] = f;
+    }
+    const double ramp = m->total_displacement + 4.0 * rf;
+    return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height), err);
+}
+
+static cdem_status listric_init(void *vctx, const cdem_params *p, const cdem_model *m,
+                                cdem_state *s, cdem_error *err) {
+    listric_ctx *c = vctx;
+    c->irregular = 0;
+    return listric_init_common(c, p, m, s, err);
+}
+
+static cdem_status irregular_init(void *vctx, const cdem_params *p, const cdem_model *m,
+                                  cdem_state *s, cdem_error *err) {
+    listric_ctx *c = vctx;
+    c->irregular = 1;
+    return listric_init_common(c, p, m, s, err);
+}
+
+static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, double dt,
+                                 cdem_error *err) {
+    listric_ctx *c = vctx;
+    if (!(dt > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
+    const double sgn =
+        ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
+    const double ux = sgn * du * c->heave, uy = -sgn * du * c->throw_;
+    const double vx = ux / dt, vy = uy / dt;
+    const long n = (long)s->n;
+    double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
+    const uint32_t *restrict fl = s->flags;
+#pragma omp parallel for schedule(static) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        if (!(fl[i] & CDEM_FLAG_MOVING))
+            continue;
+        if (fl[i] & CDEM_FLAG_FAULT) {
+            x[i] += ux;
+            vxa[i] = vx;
+            vya[i] = 0.0;
+        } else {
+            y[i] += uy;
+            vxa[i] = 0.0;
+            vya[i] = vy;
+        }
+    }
+    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
+    return CDEM_OK;
+}
+
+static double listric_net(const void *vctx) {
+    return ((const listric_ctx *)vctx)->net;
+}
+
+static void listric_view(const void *vctx, FILE *out) {
+    const listric_ctx *c = vctx;
+    fprintf(out,
+            "Boundary mode: %s %s, constant heave (CH); from the base at x = %.1f m up-dip "
+            "toward -x to x = %.1f m at y = %.1f m (%zu vertices%s); basal dip %.1f deg; "
+            "per metre along the basal segment the fault moves %.4f m horizontally and the "
+            "hanging-wall base %.4f m vertically; %ld fault elements, %ld footwall display "
+            "elements, %ld moving base/right-wall elements.",
+            c->irregular ? "irregular" : "listric",
+            c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault", c->x_fault,
+            c->line.x[c->line.n - 1], c->line.y[c->line.n - 1], c->line.n,
+            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0)(y/H)^2",
+            c->dip_base_deg, c->heave, c->throw_, c->n_fault, c->n_footwall, c->n_base_moving);
+    if (c->inversion)
+        fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
+    fprintf(out, "\n");
+}
+
+static void listric_free(void *vctx) {
+    cdem_fault_file_free(&((listric_ctx *)vctx)->line);
+}
+
+static const cdem_bc_ops listric_ops = {
+    .name = "listric-fault",
+    .state_size = sizeof(listric_ctx),
+    .init = listric_init,
+    .apply = listric_apply,
+    .net_displacement = listric_net,
+    .view = listric_view,
+    .free = listric_free,
+};
+
+static const cdem_bc_ops irregular_ops = {
+    .name = "irregular-fault",
+    .state_size = sizeof(listric_ctx),
+    .init = irregular_init,
+    .apply = listric_apply,
+    .net_displacement = listric_net,
+    .view = listric_view,
+    .free = listric_free,
+};
+
+const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;
+const cdem_bc_ops *const cdem_bc_irregular_fault = &irregular_ops;
