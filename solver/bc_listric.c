@@ -2,7 +2,7 @@
  *
  * Geometry (docs/solver.md, "Listric and irregular faults"): the left wall is sculpted into a
  * fault curve from (x0 = fault_location x width, 0) up-dip toward -x (dipping toward +x, the
- * hanging wall on the right): listric = dip(y) = d0 + (90 - d0) (y/H)^2 from the base (d0 =
+ * hanging wall on the right): listric = dip(y) = d0 + (90 - d0) (y/H) from the base (d0 =
  * fault_dip) to the top of the assembly H (fault_file.h), irregular = the vertex file's
  * polyline. Fault elements (CDEM_FLAG_FAULT | MOVING, radius of the base elements, spaced by
  * one radius) lie on the curve, extended below the base along the basal segment for the whole
@@ -240,8 +240,8 @@ static void listric_view(const void *vctx, FILE *out) {
             c->irregular ? "irregular" : "listric",
             c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault", c->x_fault,
             c->line.x[c->line.n - 1], c->line.y[c->line.n - 1], c->line.n,
-            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0)(y/H)^2",
-            c->dip_base_deg, c->heave, c->throw_, c->n_fault, c->n_footwall, c->n_base_moving);
+            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0) y/H", c->dip_base_deg,
+            c->heave, c->throw_, c->n_fault, c->n_footwall, c->n_base_moving);
     if (c->inversion)
         fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
     fprintf(out, "\n");

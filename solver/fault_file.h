@@ -3,8 +3,9 @@
  * Sources: an irregular-fault vertex file (cdem_fault_file_read: one "x y" per line in m,
  * whitespace or comma separated, '#' comments, blank lines and CRLF accepted; first point at
  * (fault location x width, 0), every later one at lower x and higher y), or the listric
- * curve (cdem_fault_file_listric: dip(y) = d0 + (90 - d0) (y / H)^2 from the base to the top
- * of the assembly H). Both curves dip toward +x (hanging wall on the right).
+ * curve (cdem_fault_file_listric: dip(y) = d0 + (90 - d0) (y / H)^k, k = 1, i.e. the dip
+ * grows linearly with height from d0 at the base to 90 at the top of the assembly H; its
+ * horizontal extent is H ln(1 / sin d0) / (90 - d0 in radians)). Both dip toward +x.
  * Ownership: a cdem_fault_polyline owns its arrays; cdem_fault_file_free releases them (NULL
  * accepted). Thread safety: reentrant, no shared state. Units: m, degrees. */
 #ifndef CDEM_FAULT_FILE_H
@@ -15,7 +16,7 @@
 #include <stddef.h>
 
 /* Exponent k of the listric dip law dip(y) = d0 + (90 - d0) (y / H)^k. */
-#define CDEM_LISTRIC_EXPONENT 2.0
+#define CDEM_LISTRIC_EXPONENT 1.0
 /* Segments of the listric polyline built by bc_listric (equal heights). */
 #define CDEM_LISTRIC_SEGMENTS 200
 

@@ -1,5 +1,5 @@
 /* test_fault_file: the irregular-fault vertex reader (every error names file and line) and
- * the listric curve (dip law checked against its definition). */
+ * the listric curve (dip law, k = 1, checked against its definition). */
 #include "fault_file.h"
 
 #include <math.h>
@@ -100,7 +100,7 @@ static void test_fault_file_crlf_comma_comments(void **st) {
     cdem_fault_file_free(NULL);
 }
 
-/* The listric curve's segment dips follow dip(y) = d0 + (90 - d0) (y/H)^2 at the segment
+/* The listric curve's segment dips follow dip(y) = d0 + (90 - d0) (y/H)^k at the segment
  * midpoints: 30 deg at the base, 90 deg at the top. */
 static void test_fault_file_listric_dip_law(void **st) {
     (void)st;
@@ -115,11 +115,12 @@ static void test_fault_file_listric_dip_law(void **st) {
     for (size_t k = 1; k <= ns; k++) {
         const double dip = atan2(pl.y[k] - pl.y[k - 1], pl.x[k - 1] - pl.x[k]) * 180.0 / M_PI;
         const double eta = ((double)k - 0.5) / (double)ns;
-        assert_float_equal(dip, d0 + (90.0 - d0) * eta * eta, 1e-9);
+        assert_float_equal(dip, d0 + (90.0 - d0) * pow(eta, CDEM_LISTRIC_EXPONENT), 1e-9);
     }
-    /* the first segment dips at ~d0; the top segment is nearly vertical */
-    assert_true(pl.x[1] < X0 && X0 - pl.x[1] > 0.99 * (H / ns) / tan(d0 * M_PI / 180.0));
-    assert_true(pl.x[ns - 1] - pl.x[ns] < 0.05 * H / ns);
+    /* horizontal extent: H integral of cot(dip) = H ln(1 / sin d0) / (90 - d0 in rad) */
+    const double d0r = d0 * M_PI / 180.0;
+    assert_float_equal(X0 - pl.x[ns], H * log(1.0 / sin(d0r)) / (M_PI / 2.0 - d0r), 0.5);
+    assert_true(pl.x[ns - 1] - pl.x[ns] < 0.05 * H / ns); /* nearly vertical at the top */
     cdem_fault_file_free(&pl);
     assert_int_equal(cdem_fault_file_listric(X0, H, 0.0, ns, &pl, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "fault_dip = 0 degrees: must be in (0, 90]"));
