@@ -6,16 +6,19 @@
  * fault_dip) to the top of the assembly H (fault_file.h), irregular = the vertex file's
  * polyline. Fault elements (CDEM_FLAG_FAULT | MOVING, radius of the base elements, spaced by
  * one radius) lie on the curve, extended below the base along the basal segment for the whole
- * displacement plus 4 radii and vertically above its top to the top of the walls. Free
- * elements left of the curve, or closer to it than their radius plus the fault radius, and
- * the left wall become fixed display-only footwall elements (CDEM_FLAG_FOOTWALL; they never
- * interact). The base left of x0 stays: fixed when the motion is normal only, moving with the
- * hanging wall when it has a reverse part (so no gap opens under the rising block).
- * CH kinematics: per step the fault elements move horizontally by the heave du cos(db)
- * (toward +x for normal) and the hanging-wall base (base right of x0, right wall) vertically
- * by du sin(db) (down for normal), db = dip of the basal segment, so the hanging wall follows
- * the basal segment with du along it. Reverse/inversion as in bc_planar_fault.c. CD
- * ("mylar sheet") kinematics are refused (CDEM_ERR_UNSUPPORTED). */
+ * displacement plus 4 radii and vertically above its top to the top of the walls plus the
+ * whole displacement. Free elements left of the curve, or closer to it than their radius
+ * plus the fault radius, and the left wall become fixed display-only footwall elements
+ * (CDEM_FLAG_FOOTWALL; they never interact). The whole base moves with the hanging wall (the
+ * part left of x0 stays left of the moving fault, so it never touches the hanging wall).
+ * CH kinematics (Verrall 1981): relative to the footwall the hanging wall moves by the heave
+ * du cos(db) horizontally and the throw du sin(db) vertically, db = dip of the basal segment,
+ * and collapses by vertical shear onto the fault. In the model frame (hanging-wall base fixed
+ * in x) the fault elements move horizontally by the heave AWAY from the hanging wall (-x for
+ * normal, +x for reverse) and the hanging-wall base (the base, the right wall) vertically by
+ * the throw (down for normal), so the base-fault junction stays at x = x0 and slides down
+ * the basal segment by du per step. Inversion as in bc_planar_fault.c. CD ("mylar sheet")
+ * kinematics are refused (CDEM_ERR_UNSUPPORTED). */
 #include "bc.h"
 #include "fault_file.h"
 
@@ -152,7 +155,6 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
     const double db = c->dip_base_deg * M_PI / 180.0;
     c->heave = cos(db);
     c->throw_ = sin(db);
-    const int has_reverse = p->fault_sense == CDEM_SENSE_REVERSE || c->inversion;
     const double rf = w.r_base;
     /* footwall, hanging-wall base and right wall */
     for (size_t i = 0; i < s->n; i++) {
@@ -162,7 +164,7 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
             if (!is_base && s->x[i] < w.x_mid) {
                 f = (f & ~(uint32_t)CDEM_FLAG_WALL) | CDEM_FLAG_FOOTWALL; /* left wall */
                 c->n_footwall++;
-            } else if (!is_base || s->x[i] > c->x_fault || has_reverse) {
+            } else {
                 f |= CDEM_FLAG_MOVING;
                 c->n_base_moving++;
             }
@@ -178,7 +180,7 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
         s->flags[i] = f;
     }
     const double ramp = m->total_displacement + 4.0 * rf;
-    return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height), err);
+    return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height) + m->total_displacement, err);
 }
 
 static cdem_status listric_init(void *vctx, const cdem_params *p, const cdem_model *m,
@@ -202,7 +204,7 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
     const double sgn =
         ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
-    const double ux = sgn * du * c->heave, uy = -sgn * du * c->throw_;
+    const double ux = -sgn * du * c->heave, uy = -sgn * du * c->throw_;
     const double vx = ux / dt, vy = uy / dt;
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
@@ -234,8 +236,9 @@ static void listric_view(const void *vctx, FILE *out) {
     fprintf(out,
             "Boundary mode: %s %s, constant heave (CH); from the base at x = %.1f m up-dip "
             "toward -x to x = %.1f m at y = %.1f m (%zu vertices%s); basal dip %.1f deg; "
-            "per metre along the basal segment the fault moves %.4f m horizontally and the "
-            "hanging-wall base %.4f m vertically; %ld fault elements, %ld footwall display "
+            "per metre along the basal segment the fault moves %.4f m horizontally away from "
+            "the hanging wall and the hanging-wall base %.4f m vertically; %ld fault elements, %ld "
+            "footwall display "
             "elements, %ld moving base/right-wall elements.",
             c->irregular ? "irregular" : "listric",
             c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault", c->x_fault,
