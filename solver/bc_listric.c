@@ -140,13 +140,16 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
         c->dip_base_deg = p->fault_dip;
     }
     const cdem_fault_polyline *pl = &c->line;
+    /* the fault moves up to the whole heave toward the left wall */
     const double x_left = pl->x[pl->n - 1];
-    if (!(x_left > w.x_min + 2.0 * w.r_base))
+    const double max_heave = m->total_displacement * cos(c->dip_base_deg * M_PI / 180.0);
+    if (!(x_left - max_heave > w.x_min + 2.0 * w.r_base))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "%s: the fault curve reaches x = %g m at y = %g m, at or left of the "
-                         "left wall (x = %g m); move boundary.fault_location right or steepen "
-                         "the fault (fault_dip = %g degrees)",
-                         name, x_left, pl->y[pl->n - 1], w.x_min, c->dip_base_deg);
+                         "%s: the fault curve reaches x = %g m at y = %g m and moves up to %g m "
+                         "(the total heave) further toward the left wall (x = %g m): it would "
+                         "reach or pass it; move boundary.fault_location right, steepen the "
+                         "fault (fault_dip = %g degrees) or shorten the run",
+                         name, x_left, pl->y[pl->n - 1], max_heave, w.x_min, c->dip_base_deg);
     c->sense = p->fault_sense;
     c->inversion = p->inversion ? 1 : 0;
     const long def_steps = m->total_steps - m->equil_steps;
