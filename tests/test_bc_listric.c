@@ -223,18 +223,31 @@ static void test_bc_listric_errors(void **st) {
     cdem_state_free(&s);
 }
 
-/* listric-fault through cdem_run on a small default model. */
+/* listric-fault (normal) and irregular-fault (reverse, tests/data/fault_demo_irregular.txt)
+ * through cdem_run on a small default model. */
 static void test_bc_listric_cdem_run(void **st) {
     (void)st;
-    cdem_params p;
-    cdem_params_defaults(&p);
-    p.mode = CDEM_MODE_LISTRIC_FAULT;
-    cdem_increment_info last;
-    cdem_model m;
-    fx_cdem_run(p, "test_bc_listric_run", 300, &last, &m);
-    assert_int_equal(last.step, m.equil_steps + 300);
-    assert_int_equal(last.phase, CDEM_PHASE_DEFORMATION);
-    assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
+    for (int k = 0; k < 2; k++) {
+        cdem_params p;
+        cdem_params_defaults(&p);
+        p.fault.friction = 0.0;
+        p.fault.cohesion = 0.0;
+        if (k == 0) {
+            p.mode = CDEM_MODE_LISTRIC_FAULT;
+        } else {
+            p.mode = CDEM_MODE_IRREGULAR_FAULT;
+            p.fault_sense = CDEM_SENSE_REVERSE;
+            const char *d = getenv("CDEM_TEST_DATA");
+            snprintf(p.fault_file, sizeof p.fault_file, "%s/fault_demo_irregular.txt",
+                     d && *d ? d : "tests/data");
+        }
+        cdem_increment_info last;
+        cdem_model m;
+        fx_cdem_run(p, k == 0 ? "test_bc_listric_run" : "test_bc_irregular_run", 300, &last, &m);
+        assert_int_equal(last.step, m.equil_steps + 300);
+        assert_int_equal(last.phase, CDEM_PHASE_DEFORMATION);
+        assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
+    }
 }
 
 int main(void) {
