@@ -41,68 +41,87 @@ typedef struct {
     long n_footwall;          /* elements flagged CDEM_FLAG_FOOTWALL */
     long n_base_moving;       /* wall elements of the moving hanging-wall base/right wall */
     double net;               /* m, net displacement along the basal segment (initial sense +) */
+    int cd;                   /* 1: constant displacement (mylar sheet), 0: constant heave */
+    size_t path_n;            /* vertices of the fault-element path (ramp, curve, top) */
+    double *path_x, *path_y;  /* m, the path from the ramp bottom up (owned) */
+    double *path_s;           /* m, arc length of each path vertex from the ramp bottom */
+    double spacing;           /* m, arc spacing of the fault elements (the base radius) */
+    int32_t first_id;         /* id of the first fault element; ids are consecutive */
+    double sheet;             /* m, CD: arc offset of the sheet so far (down-dip negative) */
 } listric_ctx;
 
 static const char *mode_name(const listric_ctx *c) {
     return c->irregular ? "irregular fault" : "listric fault";
 }
 
-/* Lays fault elements every r along the path ramp -> curve -> vertical top. */
+/* Position at arc length a along the path (linear extrapolation beyond its ends). */
+static void path_at(const listric_ctx *c, double a, double *x, double *y) {
+    size_t k = 1;
+    if (a >= c->path_s[c->path_n - 1]) {
+        k = c->path_n - 1;
+    } else if (a > 0.0) {
+        size_t lo = 1, hi = c->path_n - 1; /* first vertex with path_s >= a */
+        while (lo < hi) {
+            const size_t mid = (lo + hi) / 2;
+            if (c->path_s[mid] >= a)
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        k = lo;
+    }
+    const double len = c->path_s[k] - c->path_s[k - 1];
+    const double t = len > 0.0 ? (a - c->path_s[k - 1]) / len : 0.0;
+    *x = c->path_x[k - 1] + t * (c->path_x[k] - c->path_x[k - 1]);
+    *y = c->path_y[k - 1] + t * (c->path_y[k] - c->path_y[k - 1]);
+}
+
+/* Builds the path ramp -> curve -> vertical top and lays fault elements every r along it
+ * (element j at arc length j r). */
 static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s, double r,
                              double ramp, double y_top, cdem_error *err) {
     const cdem_fault_polyline *pl = &c->line;
     const size_t nv = pl->n + 2;
-    /* path vertices: ramp start, the curve, the top (vertical extension) */
-    double px[CDEM_LISTRIC_SEGMENTS + 3], py[CDEM_LISTRIC_SEGMENTS + 3];
-    const double *vx = pl->x, *vy = pl->y;
-    double *hx = NULL, *hy = NULL;
-    if (nv > CDEM_LISTRIC_SEGMENTS + 3) {
-        hx = malloc(nv * sizeof *hx);
-        hy = malloc(nv * sizeof *hy);
-        if (!hx || !hy) {
-            free(hx);
-            free(hy);
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu path vertices",
-                             mode_name(c), nv);
-        }
-    }
-    double *qx = hx ? hx : px, *qy = hy ? hy : py;
+    c->path_x = malloc(nv * sizeof *c->path_x);
+    c->path_y = malloc(nv * sizeof *c->path_y);
+    c->path_s = malloc(nv * sizeof *c->path_s);
+    if (!c->path_x || !c->path_y || !c->path_s)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu path vertices",
+                         mode_name(c), nv);
+    c->path_n = nv;
+    double *qx = c->path_x, *qy = c->path_y;
     const double db = c->dip_base_deg * M_PI / 180.0;
-    qx[0] = vx[0] + ramp * cos(db);
-    qy[0] = vy[0] - ramp * sin(db);
+    qx[0] = pl->x[0] + ramp * cos(db);
+    qy[0] = pl->y[0] - ramp * sin(db);
     for (size_t k = 0; k < pl->n; k++) {
-        qx[k + 1] = vx[k];
-        qy[k + 1] = vy[k];
+        qx[k + 1] = pl->x[k];
+        qy[k + 1] = pl->y[k];
     }
-    qx[nv - 1] = vx[pl->n - 1];
-    qy[nv - 1] = fmax(y_top, vy[pl->n - 1]);
+    qx[nv - 1] = pl->x[pl->n - 1];
+    qy[nv - 1] = fmax(y_top, pl->y[pl->n - 1]);
+    c->path_s[0] = 0.0;
+    for (size_t k = 1; k < nv; k++)
+        c->path_s[k] = c->path_s[k - 1] + hypot(qx[k] - qx[k - 1], qy[k] - qy[k - 1]);
+    c->spacing = r;
+    c->first_id = s->next_id;
     const double mass = p->density * M_PI * r * r;
-    cdem_status st = CDEM_OK;
-    double along = 0.0; /* arc length of the next element from the segment start */
-    for (size_t k = 1; k < nv && st == CDEM_OK; k++) {
-        const double ex = qx[k] - qx[k - 1], ey = qy[k] - qy[k - 1];
-        const double len = hypot(ex, ey);
-        for (; along <= len && st == CDEM_OK; along += r) {
-            const double t = len > 0.0 ? along / len : 0.0;
-            st = cdem_state_append(s, -1, qx[k - 1] + t * ex, qy[k - 1] + t * ey, r, mass, 0,
-                                   CDEM_FLAG_FAULT | CDEM_FLAG_MOVING, 0, NULL, err);
-            c->n_fault++;
-        }
-        along -= len;
+    const uint32_t fl =
+        CDEM_FLAG_FAULT | CDEM_FLAG_MOVING | (c->cd ? (uint32_t)CDEM_FLAG_MYLAR : 0u);
+    const long n = (long)floor(c->path_s[nv - 1] / r) + 1;
+    for (long j = 0; j < n; j++) {
+        double x, y;
+        path_at(c, (double)j * r, &x, &y);
+        CDEM_TRY(
+            cdem_state_append(s, c->first_id + (int32_t)j, x, y, r, mass, 0, fl, 0, NULL, err));
+        c->n_fault++;
     }
-    free(hx);
-    free(hy);
-    return st;
+    return CDEM_OK;
 }
 
 static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, const cdem_model *m,
                                        cdem_state *s, cdem_error *err) {
     const char *name = mode_name(c);
-    if (p->kinematics == CDEM_KIN_CD)
-        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
-                         "%s: boundary.kinematics = cd (constant displacement, mylar sheet) is "
-                         "not implemented in this build; use kinematics = ch (constant heave)",
-                         name);
+    c->cd = p->kinematics == CDEM_KIN_CD;
     if (!(p->fault_location > 0.0 && p->fault_location < 1.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s: boundary.fault_location = %g: must be in (0, 1)",
                          name, p->fault_location);
@@ -200,6 +219,37 @@ static cdem_status irregular_init(void *vctx, const cdem_params *p, const cdem_m
     return listric_init_common(c, p, m, s, err);
 }
 
+/* CD: the sheet (fault elements) slides along the fixed path by du per step (down-dip for
+ * normal), the base and right wall move along the basal segment by du. */
+static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, double du,
+                            double dt) {
+    c->sheet -= sgn * du;
+    const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
+    const long n = (long)s->n;
+#pragma omp parallel for schedule(static) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        const uint32_t f = s->flags[i];
+        if (!(f & CDEM_FLAG_MOVING))
+            continue;
+        if (f & CDEM_FLAG_MYLAR) {
+            const double a = (double)(s->id[i] - c->first_id) * c->spacing + c->sheet;
+            double x, y;
+            path_at(c, a, &x, &y);
+            s->vx[i] = (x - s->x[i]) / dt;
+            s->vy[i] = (y - s->y[i]) / dt;
+            s->x[i] = x;
+            s->y[i] = y;
+        } else {
+            s->x[i] += bx;
+            s->y[i] += by;
+            s->vx[i] = bx / dt;
+            s->vy[i] = by / dt;
+        }
+    }
+    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
+    return CDEM_OK;
+}
+
 static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, double dt,
                                  cdem_error *err) {
     listric_ctx *c = vctx;
@@ -207,6 +257,8 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
     const double sgn =
         ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
+    if (c->cd)
+        return cd_apply(c, s, k, sgn, du, dt);
     const double ux = -sgn * du * c->heave, uy = -sgn * du * c->throw_;
     const double vx = ux / dt, vy = uy / dt;
     const long n = (long)s->n;
@@ -237,24 +289,39 @@ static double listric_net(const void *vctx) {
 static void listric_view(const void *vctx, FILE *out) {
     const listric_ctx *c = vctx;
     fprintf(out,
-            "Boundary mode: %s %s, constant heave (CH); from the base at x = %.1f m up-dip "
-            "toward -x to x = %.1f m at y = %.1f m (%zu vertices%s); basal dip %.1f deg; "
-            "per metre along the basal segment the fault moves %.4f m horizontally away from "
-            "the hanging wall and the hanging-wall base %.4f m vertically; %ld fault elements, %ld "
-            "footwall display "
-            "elements, %ld moving base/right-wall elements.",
+            "Boundary mode: %s %s, %s; from the base at x = %.1f m up-dip toward -x to "
+            "x = %.1f m at y = %.1f m (%zu vertices%s); basal dip %.1f deg; ",
             c->irregular ? "irregular" : "listric",
-            c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault", c->x_fault,
+            c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault",
+            c->cd ? "constant displacement (CD, mylar sheet)" : "constant heave (CH)", c->x_fault,
             c->line.x[c->line.n - 1], c->line.y[c->line.n - 1], c->line.n,
-            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0) y/H", c->dip_base_deg,
-            c->heave, c->throw_, c->n_fault, c->n_footwall, c->n_base_moving);
+            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0) y/H", c->dip_base_deg);
+    if (c->cd)
+        fprintf(out,
+                "per metre of displacement the fault elements slide 1 m along the fault and "
+                "the base and right wall move (%.4f, %.4f) m along the basal segment; ",
+                c->heave, -c->throw_);
+    else
+        fprintf(out,
+                "per metre along the basal segment the fault moves %.4f m horizontally away "
+                "from the hanging wall and the hanging-wall base %.4f m vertically; ",
+                c->heave, c->throw_);
+    fprintf(out,
+            "%ld fault elements, %ld footwall display elements, %ld moving base/right-wall "
+            "elements.",
+            c->n_fault, c->n_footwall, c->n_base_moving);
     if (c->inversion)
         fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
     fprintf(out, "\n");
 }
 
 static void listric_free(void *vctx) {
-    cdem_fault_file_free(&((listric_ctx *)vctx)->line);
+    listric_ctx *c = vctx;
+    cdem_fault_file_free(&c->line);
+    free(c->path_x);
+    free(c->path_y);
+    free(c->path_s);
+    c->path_x = c->path_y = c->path_s = NULL;
 }
 
 static const cdem_bc_ops listric_ops = {

@@ -191,6 +191,71 @@ static void test_bc_listric_reverse_and_inversion(void **st) {
     check_kinematics(p, 0.0, 0.0, 0.0);
 }
 
+/* CD (mylar sheet): after K steps the sheet elements slid u = K du down-dip along the fault
+ * (exactly u (cos d, -sin d) on the ramp, (0, -u) on the vertical top, on the curve in
+ * between), the base and right wall moved u (cos d, -sin d), the footwall not at all; with
+ * inversion at 50 % everything is back. */
+static void check_cd(int inversion) {
+    const double d = DIP * M_PI / 180.0, u = inversion ? 0.0 : (double)K * DPS;
+    cdem_params p = listric_params(CDEM_MODE_LISTRIC_FAULT);
+    p.kinematics = CDEM_KIN_CD;
+    p.inversion = inversion;
+    p.inversion_percent = 50.0;
+    const double H = fixture_top();
+    cdem_fault_polyline pl;
+    cdem_error err;
+    assert_int_equal(cdem_fault_file_listric(X0, H, DIP, CDEM_LISTRIC_SEGMENTS, &pl, &err),
+                     CDEM_OK);
+    fx_result r;
+    fx_run(p, K, &r);
+    long nramp = 0, ntop = 0, ncurve = 0, nbase = 0;
+    for (size_t i = 0; i < r.s0.n; i++) {
+        const uint32_t f = r.s0.flags[i];
+        if (!(f & CDEM_FLAGS_BOUNDARY))
+            continue;
+        double dx, dy, ex = 0.0, ey = 0.0;
+        fx_displacement(&r.s0, &r.s, r.s0.id[i], &dx, &dy);
+        const double y0 = r.s0.y[i];
+        if (f & CDEM_FLAG_MYLAR) {
+            assert_true(f & CDEM_FLAG_FAULT);
+            if (y0 < 0.0) {
+                ex = u * cos(d);
+                ey = -u * sin(d);
+                nramp++;
+            } else if (y0 - u > H + 1e-6) {
+                ey = -u;
+                ntop++;
+            } else {
+                ncurve++;
+                const size_t b = fx_find(&r.s, r.s0.id[i]);
+                const double yn = r.s.y[b], xn = r.s.x[b];
+                const double off = yn < 0.0 ? fabs((xn - X0) * sin(d) + yn * cos(d))
+                                            : cdem_fault_file_distance(&pl, xn, yn);
+                assert_true(off < 1e-6);
+                assert_true(hypot(dx, dy) <= u + 1e-9 && hypot(dx, dy) >= 0.99 * u);
+                continue;
+            }
+        } else if (f & CDEM_FLAG_WALL) {
+            ex = u * cos(d);
+            ey = -u * sin(d);
+            nbase++;
+        }
+        if (fabs(dx - ex) > 1e-9 || fabs(dy - ey) > 1e-9)
+            fail_msg("element %d (flags %u) at (%g, %g) moved (%g, %g), expected (%g, %g)",
+                     (int)r.s0.id[i], (unsigned)f, r.s0.x[i], y0, dx, dy, ex, ey);
+    }
+    assert_true(nramp > 2 && ntop > 10 && ncurve > 5 && nbase > 50);
+    assert_float_equal(r.net_end, u, 1e-9);
+    fx_result_free(&r);
+    cdem_fault_file_free(&pl);
+}
+
+static void test_bc_listric_cd_kinematics(void **st) {
+    (void)st;
+    check_cd(0);
+    check_cd(1);
+}
+
 static void test_bc_listric_errors(void **st) {
     (void)st;
     cdem_model m = fx_model(K);
@@ -199,10 +264,6 @@ static void test_bc_listric_errors(void **st) {
     cdem_state s;
     fx_assembly(&s);
     cdem_params p = listric_params(CDEM_MODE_LISTRIC_FAULT);
-    p.kinematics = CDEM_KIN_CD;
-    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_UNSUPPORTED);
-    assert_non_null(strstr(err.msg, "kinematics = cd (constant displacement, mylar sheet)"));
-    p = listric_params(CDEM_MODE_LISTRIC_FAULT);
     p.fault_location = 0.05;
     p.fault_dip = 20.0; /* the curve runs through the left wall */
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
@@ -256,6 +317,7 @@ int main(void) {
         cmocka_unit_test(test_bc_listric_irregular_geometry),
         cmocka_unit_test(test_bc_listric_normal_kinematics),
         cmocka_unit_test(test_bc_listric_reverse_and_inversion),
+        cmocka_unit_test(test_bc_listric_cd_kinematics),
         cmocka_unit_test(test_bc_listric_errors),
         cmocka_unit_test(test_bc_listric_cdem_run),
     };
