@@ -1,4 +1,4 @@
-/* bc_listric: listric and irregular normal/reverse faults with constant heave (CH).
+/* bc_listric: listric and irregular normal/reverse faults, constant heave (CH) or CD.
  *
  * Geometry (docs/solver.md, "Listric and irregular faults"): the left wall is sculpted into a
  * fault curve from (x0 = fault_location x width, 0) up-dip toward -x (dipping toward +x, the
@@ -17,8 +17,10 @@
  * in x) the fault elements move horizontally by the heave AWAY from the hanging wall (-x for
  * normal, +x for reverse) and the hanging-wall base (the base, the right wall) vertically by
  * the throw (down for normal), so the base-fault junction stays at x = x0 and slides down
- * the basal segment by du per step. Inversion as in bc_planar_fault.c. CD ("mylar sheet")
- * kinematics are refused (CDEM_ERR_UNSUPPORTED). */
+ * the basal segment by du per step. Inversion as in bc_planar_fault.c.
+ * CD kinematics ("mylar sheet", kinematics = cd): the path stays fixed and the fault elements
+ * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
+ * right wall move du along the basal segment. */
 #include "bc.h"
 #include "fault_file.h"
 

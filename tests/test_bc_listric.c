@@ -284,17 +284,21 @@ static void test_bc_listric_errors(void **st) {
     cdem_state_free(&s);
 }
 
-/* listric-fault (normal) and irregular-fault (reverse, tests/data/fault_demo_irregular.txt)
- * through cdem_run on a small default model. */
+/* listric-fault CH (normal), irregular-fault CH (reverse, tests/data/
+ * fault_demo_irregular.txt) and listric-fault CD through cdem_run on a small default model. */
 static void test_bc_listric_cdem_run(void **st) {
     (void)st;
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         cdem_params p;
         cdem_params_defaults(&p);
         p.fault.friction = 0.0;
         p.fault.cohesion = 0.0;
         if (k == 0) {
             p.mode = CDEM_MODE_LISTRIC_FAULT;
+        } else if (k == 2) {
+            cdem_params_defaults(&p); /* CD: the default frictional-cohesive fault */
+            p.mode = CDEM_MODE_LISTRIC_FAULT;
+            p.kinematics = CDEM_KIN_CD;
         } else {
             p.mode = CDEM_MODE_IRREGULAR_FAULT;
             p.fault_sense = CDEM_SENSE_REVERSE;
