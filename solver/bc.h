@@ -108,5 +108,7 @@ extern const cdem_bc_ops *const cdem_bc_vertical_faults;
 extern const cdem_bc_ops *const cdem_bc_detachment;
 extern const cdem_bc_ops *const cdem_bc_repose;
 extern const cdem_bc_ops *const cdem_bc_biaxial;
+extern const cdem_bc_ops *const cdem_bc_listric_fault;   /* bc_listric.c */
+extern const cdem_bc_ops *const cdem_bc_irregular_fault; /* bc_listric.c */
 
 #endif

@@ -14,8 +14,8 @@ typedef struct {
 
 static const bc_row registry[] = {
     {CDEM_MODE_PLANAR_FAULT, "planar-fault", &cdem_bc_planar_fault},
-    {CDEM_MODE_LISTRIC_FAULT, "listric-fault", NULL},     /* later issue */
-    {CDEM_MODE_IRREGULAR_FAULT, "irregular-fault", NULL}, /* later issue */
+    {CDEM_MODE_LISTRIC_FAULT, "listric-fault", &cdem_bc_listric_fault},
+    {CDEM_MODE_IRREGULAR_FAULT, "irregular-fault", &cdem_bc_irregular_fault},
     {CDEM_MODE_VERTICAL_FAULTS, "vertical-faults", &cdem_bc_vertical_faults},
     {CDEM_MODE_DETACHMENT, "detachment", &cdem_bc_detachment},
     {CDEM_MODE_REPOSE, "repose", &cdem_bc_repose},
@@ -23,7 +23,8 @@ static const bc_row registry[] = {
 };
 
 const char *cdem_bc_implemented(void) {
-    return "planar-fault, vertical-faults, detachment, repose, biaxial";
+    return "planar-fault, listric-fault, irregular-fault, vertical-faults, detachment, repose, "
+           "biaxial";
 }
 
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err) {

@@ -1,0 +1,350 @@
+/* bc_listric: listric and irregular normal/reverse faults, constant heave (CH) or CD.
+ *
+ * Geometry (docs/solver.md, "Listric and irregular faults"): the left wall is sculpted into a
+ * fault curve from (x0 = fault_location x width, 0) up-dip toward -x (dipping toward +x, the
+ * hanging wall on the right): listric = dip(y) = d0 + (90 - d0) (y/H) from the base (d0 =
+ * fault_dip) to the top of the assembly H (fault_file.h), irregular = the vertex file's
+ * polyline. Fault elements (CDEM_FLAG_FAULT | MOVING, radius of the base elements, spaced by
+ * one radius) lie on the curve, extended below the base along the basal segment for the whole
+ * displacement plus 4 radii and vertically above its top to the top of the walls plus the
+ * whole displacement. Free elements left of the curve, or closer to it than their radius
+ * plus the fault radius, and the left wall become fixed display-only footwall elements
+ * (CDEM_FLAG_FOOTWALL; they never interact). The whole base moves with the hanging wall (the
+ * part left of x0 stays left of the moving fault, so it never touches the hanging wall).
+ * CH kinematics (Verrall 1981): relative to the footwall the hanging wall moves by the heave
+ * du cos(db) horizontally and the throw du sin(db) vertically, db = dip of the basal segment,
+ * and collapses by vertical shear onto the fault. In the model frame (hanging-wall base fixed
+ * in x) the fault elements move horizontally by the heave AWAY from the hanging wall (-x for
+ * normal, +x for reverse) and the hanging-wall base (the base, the right wall) vertically by
+ * the throw (down for normal), so the base-fault junction stays at x = x0 and slides down
+ * the basal segment by du per step. Inversion as in bc_planar_fault.c.
+ * CD kinematics ("mylar sheet", kinematics = cd): the path stays fixed and the fault elements
+ * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
+ * right wall move du along the basal segment. */
+#include "bc.h"
+#include "fault_file.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    int irregular;            /* 1: irregular-fault (vertex file), 0: listric-fault */
+    double dip_base_deg;      /* dip of the basal segment, degrees, (0, 90] */
+    int sense;                /* initial cdem_fault_sense */
+    int inversion;            /* 1: the sense reverses after k_inversion */
+    long k_inversion;         /* last deformation step of the initial sense */
+    double x_fault;           /* m, x0: where the curve meets the base surface (y = 0) */
+    double height;            /* m, H: top of the assembly (highest free element top) */
+    double heave;             /* horizontal fault motion per metre along the basal segment */
+    double throw_;            /* vertical base motion per metre along the basal segment */
+    cdem_fault_polyline line; /* the fault curve from (x0, 0) up-dip (owned) */
+    long n_fault;             /* fault elements added */
+    long n_footwall;          /* elements flagged CDEM_FLAG_FOOTWALL */
+    long n_base_moving;       /* wall elements of the moving hanging-wall base/right wall */
+    double net;               /* m, net displacement along the basal segment (initial sense +) */
+    int cd;                   /* 1: constant displacement (mylar sheet), 0: constant heave */
+    size_t path_n;            /* vertices of the fault-element path (ramp, curve, top) */
+    double *path_x, *path_y;  /* m, the path from the ramp bottom up (owned) */
+    double *path_s;           /* m, arc length of each path vertex from the ramp bottom */
+    double spacing;           /* m, arc spacing of the fault elements (the base radius) */
+    int32_t first_id;         /* id of the first fault element; ids are consecutive */
+    double sheet;             /* m, CD: arc offset of the sheet so far (down-dip negative) */
+} listric_ctx;
+
+static const char *mode_name(const listric_ctx *c) {
+    return c->irregular ? "irregular fault" : "listric fault";
+}
+
+/* Position at arc length a along the path (linear extrapolation beyond its ends). */
+static void path_at(const listric_ctx *c, double a, double *x, double *y) {
+    size_t k = 1;
+    if (a >= c->path_s[c->path_n - 1]) {
+        k = c->path_n - 1;
+    } else if (a > 0.0) {
+        size_t lo = 1, hi = c->path_n - 1; /* first vertex with path_s >= a */
+        while (lo < hi) {
+            const size_t mid = (lo + hi) / 2;
+            if (c->path_s[mid] >= a)
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        k = lo;
+    }
+    const double len = c->path_s[k] - c->path_s[k - 1];
+    const double t = len > 0.0 ? (a - c->path_s[k - 1]) / len : 0.0;
+    *x = c->path_x[k - 1] + t * (c->path_x[k] - c->path_x[k - 1]);
+    *y = c->path_y[k - 1] + t * (c->path_y[k] - c->path_y[k - 1]);
+}
+
+/* Builds the path ramp -> curve -> vertical top and lays fault elements every r along it
+ * (element j at arc length j r). */
+static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s, double r,
+                             double ramp, double y_top, cdem_error *err) {
+    const cdem_fault_polyline *pl = &c->line;
+    const size_t nv = pl->n + 2;
+    c->path_x = malloc(nv * sizeof *c->path_x);
+    c->path_y = malloc(nv * sizeof *c->path_y);
+    c->path_s = malloc(nv * sizeof *c->path_s);
+    if (!c->path_x || !c->path_y || !c->path_s)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu path vertices",
+                         mode_name(c), nv);
+    c->path_n = nv;
+    double *qx = c->path_x, *qy = c->path_y;
+    const double db = c->dip_base_deg * M_PI / 180.0;
+    qx[0] = pl->x[0] + ramp * cos(db);
+    qy[0] = pl->y[0] - ramp * sin(db);
+    for (size_t k = 0; k < pl->n; k++) {
+        qx[k + 1] = pl->x[k];
+        qy[k + 1] = pl->y[k];
+    }
+    qx[nv - 1] = pl->x[pl->n - 1];
+    qy[nv - 1] = fmax(y_top, pl->y[pl->n - 1]);
+    c->path_s[0] = 0.0;
+    for (size_t k = 1; k < nv; k++)
+        c->path_s[k] = c->path_s[k - 1] + hypot(qx[k] - qx[k - 1], qy[k] - qy[k - 1]);
+    c->spacing = r;
+    c->first_id = s->next_id;
+    const double mass = p->density * M_PI * r * r;
+    const uint32_t fl =
+        CDEM_FLAG_FAULT | CDEM_FLAG_MOVING | (c->cd ? (uint32_t)CDEM_FLAG_MYLAR : 0u);
+    const long n = (long)floor(c->path_s[nv - 1] / r) + 1;
+    for (long j = 0; j < n; j++) {
+        double x, y;
+        path_at(c, (double)j * r, &x, &y);
+        CDEM_TRY(
+            cdem_state_append(s, c->first_id + (int32_t)j, x, y, r, mass, 0, fl, 0, NULL, err));
+        c->n_fault++;
+    }
+    return CDEM_OK;
+}
+
+static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, const cdem_model *m,
+                                       cdem_state *s, cdem_error *err) {
+    const char *name = mode_name(c);
+    c->cd = p->kinematics == CDEM_KIN_CD;
+    if (!(p->fault_location > 0.0 && p->fault_location < 1.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s: boundary.fault_location = %g: must be in (0, 1)",
+                         name, p->fault_location);
+    if (p->inversion && !(p->inversion_percent >= 0.0 && p->inversion_percent <= 100.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "%s: boundary.inversion_percent = %g: must be in 0-100", name,
+                         p->inversion_percent);
+    cdem_bc_walls w;
+    CDEM_TRY(cdem_bc_find_walls(s, m, name, &w, err));
+    double top = -INFINITY, wall_top = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            wall_top = fmax(wall_top, s->y[i]);
+        else
+            top = fmax(top, s->y[i] + s->radius[i]);
+    }
+    if (!(top > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: the assembly has no free element above the base (top = %g m)", name,
+                         top);
+    c->height = top;
+    c->x_fault = p->fault_location * m->width_m;
+    if (c->irregular) {
+        CDEM_TRY(
+            cdem_fault_file_read(p->fault_file, c->x_fault, 0.5 * m->radius[0], &c->line, err));
+        c->dip_base_deg =
+            atan2(c->line.y[1] - c->line.y[0], c->line.x[0] - c->line.x[1]) * 180.0 / M_PI;
+    } else {
+        if (!(p->fault_dip > 0.0 && p->fault_dip <= 90.0))
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "%s: boundary.fault_dip = %g degrees: must be in (0, 90]", name,
+                             p->fault_dip);
+        CDEM_TRY(cdem_fault_file_listric(c->x_fault, c->height, p->fault_dip, CDEM_LISTRIC_SEGMENTS,
+                                         &c->line, err));
+        c->dip_base_deg = p->fault_dip;
+    }
+    const cdem_fault_polyline *pl = &c->line;
+    /* the fault moves up to the whole heave toward the left wall */
+    const double x_left = pl->x[pl->n - 1];
+    const double max_heave = m->total_displacement * cos(c->dip_base_deg * M_PI / 180.0);
+    if (!(x_left - max_heave > w.x_min + 2.0 * w.r_base))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "%s: the fault curve reaches x = %g m at y = %g m and moves up to %g m "
+                         "(the total heave) further toward the left wall (x = %g m): it would "
+                         "reach or pass it; move boundary.fault_location right, steepen the "
+                         "fault (fault_dip = %g degrees) or shorten the run",
+                         name, x_left, pl->y[pl->n - 1], max_heave, w.x_min, c->dip_base_deg);
+    c->sense = p->fault_sense;
+    c->inversion = p->inversion ? 1 : 0;
+    const long def_steps = m->total_steps - m->equil_steps;
+    c->k_inversion =
+        c->inversion ? lround(p->inversion_percent / 100.0 * (double)def_steps) : def_steps + 1;
+    const double db = c->dip_base_deg * M_PI / 180.0;
+    c->heave = cos(db);
+    c->throw_ = sin(db);
+    const double rf = w.r_base;
+    /* footwall, hanging-wall base and right wall */
+    for (size_t i = 0; i < s->n; i++) {
+        uint32_t f = s->flags[i] & ~(uint32_t)CDEM_FLAG_MOVING;
+        if (f & CDEM_FLAG_WALL) {
+            const int is_base = cdem_bc_is_base(&w, s, i);
+            if (!is_base && s->x[i] < w.x_mid) {
+                f = (f & ~(uint32_t)CDEM_FLAG_WALL) | CDEM_FLAG_FOOTWALL; /* left wall */
+                c->n_footwall++;
+            } else {
+                f |= CDEM_FLAG_MOVING;
+                c->n_base_moving++;
+            }
+        } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            const double xi = s->x[i], yi = s->y[i];
+            if (xi < cdem_fault_file_x_at(pl, yi) ||
+                cdem_fault_file_distance(pl, xi, yi) < s->radius[i] + rf) {
+                f |= CDEM_FLAG_FOOTWALL;
+                s->vx[i] = s->vy[i] = 0.0;
+                c->n_footwall++;
+            }
+        }
+        s->flags[i] = f;
+    }
+    const double ramp = m->total_displacement + 4.0 * rf;
+    return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height) + m->total_displacement, err);
+}
+
+static cdem_status listric_init(void *vctx, const cdem_params *p, const cdem_model *m,
+                                cdem_state *s, cdem_error *err) {
+    listric_ctx *c = vctx;
+    c->irregular = 0;
+    return listric_init_common(c, p, m, s, err);
+}
+
+static cdem_status irregular_init(void *vctx, const cdem_params *p, const cdem_model *m,
+                                  cdem_state *s, cdem_error *err) {
+    listric_ctx *c = vctx;
+    c->irregular = 1;
+    return listric_init_common(c, p, m, s, err);
+}
+
+/* CD: the sheet (fault elements) slides along the fixed path by du per step (down-dip for
+ * normal), the base and right wall move along the basal segment by du. */
+static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, double du,
+                            double dt) {
+    c->sheet -= sgn * du;
+    const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
+    const long n = (long)s->n;
+#pragma omp parallel for schedule(static) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        const uint32_t f = s->flags[i];
+        if (!(f & CDEM_FLAG_MOVING))
+            continue;
+        if (f & CDEM_FLAG_MYLAR) {
+            const double a = (double)(s->id[i] - c->first_id) * c->spacing + c->sheet;
+            double x, y;
+            path_at(c, a, &x, &y);
+            s->vx[i] = (x - s->x[i]) / dt;
+            s->vy[i] = (y - s->y[i]) / dt;
+            s->x[i] = x;
+            s->y[i] = y;
+        } else {
+            s->x[i] += bx;
+            s->y[i] += by;
+            s->vx[i] = bx / dt;
+            s->vy[i] = by / dt;
+        }
+    }
+    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
+    return CDEM_OK;
+}
+
+static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, double dt,
+                                 cdem_error *err) {
+    listric_ctx *c = vctx;
+    if (!(dt > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
+    const double sgn =
+        ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
+    if (c->cd)
+        return cd_apply(c, s, k, sgn, du, dt);
+    const double ux = -sgn * du * c->heave, uy = -sgn * du * c->throw_;
+    const double vx = ux / dt, vy = uy / dt;
+    const long n = (long)s->n;
+    double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
+    const uint32_t *restrict fl = s->flags;
+#pragma omp parallel for schedule(static) if (n > 20000)
+    for (long i = 0; i < n; i++) {
+        if (!(fl[i] & CDEM_FLAG_MOVING))
+            continue;
+        if (fl[i] & CDEM_FLAG_FAULT) {
+            x[i] += ux;
+            vxa[i] = vx;
+            vya[i] = 0.0;
+        } else {
+            y[i] += uy;
+            vxa[i] = 0.0;
+            vya[i] = vy;
+        }
+    }
+    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
+    return CDEM_OK;
+}
+
+static double listric_net(const void *vctx) {
+    return ((const listric_ctx *)vctx)->net;
+}
+
+static void listric_view(const void *vctx, FILE *out) {
+    const listric_ctx *c = vctx;
+    fprintf(out,
+            "Boundary mode: %s %s, %s; from the base at x = %.1f m up-dip toward -x to "
+            "x = %.1f m at y = %.1f m (%zu vertices%s); basal dip %.1f deg; ",
+            c->irregular ? "irregular" : "listric",
+            c->sense == CDEM_SENSE_NORMAL ? "normal fault" : "reverse fault",
+            c->cd ? "constant displacement (CD, mylar sheet)" : "constant heave (CH)", c->x_fault,
+            c->line.x[c->line.n - 1], c->line.y[c->line.n - 1], c->line.n,
+            c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0) y/H", c->dip_base_deg);
+    if (c->cd)
+        fprintf(out,
+                "per metre of displacement the fault elements slide 1 m along the fault and "
+                "the base and right wall move (%.4f, %.4f) m along the basal segment; ",
+                c->heave, -c->throw_);
+    else
+        fprintf(out,
+                "per metre along the basal segment the fault moves %.4f m horizontally away "
+                "from the hanging wall and the hanging-wall base %.4f m vertically; ",
+                c->heave, c->throw_);
+    fprintf(out,
+            "%ld fault elements, %ld footwall display elements, %ld moving base/right-wall "
+            "elements.",
+            c->n_fault, c->n_footwall, c->n_base_moving);
+    if (c->inversion)
+        fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
+    fprintf(out, "\n");
+}
+
+static void listric_free(void *vctx) {
+    listric_ctx *c = vctx;
+    cdem_fault_file_free(&c->line);
+    free(c->path_x);
+    free(c->path_y);
+    free(c->path_s);
+    c->path_x = c->path_y = c->path_s = NULL;
+}
+
+static const cdem_bc_ops listric_ops = {
+    .name = "listric-fault",
+    .state_size = sizeof(listric_ctx),
+    .init = listric_init,
+    .apply = listric_apply,
+    .net_displacement = listric_net,
+    .view = listric_view,
+    .free = listric_free,
+};
+
+static const cdem_bc_ops irregular_ops = {
+    .name = "irregular-fault",
+    .state_size = sizeof(listric_ctx),
+    .init = irregular_init,
+    .apply = listric_apply,
+    .net_displacement = listric_net,
+    .view = listric_view,
+    .free = listric_free,
+};
+
+const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;
+const cdem_bc_ops *const cdem_bc_irregular_fault = &irregular_ops;

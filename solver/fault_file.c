@@ -1,0 +1,209 @@
+/* fault_file: fault polylines from a vertex file or the listric law (see fault_file.h). */
+#include "fault_file.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cdem_fault_file_free(cdem_fault_polyline *pl) {
+    if (!pl)
+        return;
+    free(pl->x);
+    free(pl->y);
+    memset(pl, 0, sizeof *pl);
+}
+
+static cdem_status pl_push(cdem_fault_polyline *pl, size_t *cap, double x, double y,
+                           cdem_error *err) {
+    if (pl->n == *cap) {
+        const size_t nc = *cap ? 2 * *cap : 16;
+        double *nx = realloc(pl->x, nc * sizeof *nx);
+        if (!nx)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "fault polyline: out of memory for %zu vertices",
+                             nc);
+        pl->x = nx;
+        double *ny = realloc(pl->y, nc * sizeof *ny);
+        if (!ny)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "fault polyline: out of memory for %zu vertices",
+                             nc);
+        pl->y = ny;
+        *cap = nc;
+    }
+    pl->x[pl->n] = x;
+    pl->y[pl->n] = y;
+    pl->n++;
+    return CDEM_OK;
+}
+
+/* Parses one number field of [*p, end); advances *p. 0 on success. */
+static int parse_field(char **p, double *v) {
+    char *s = *p;
+    while (*s == ' ' || *s == '\t' || *s == ',')
+        s++;
+    if (*s == '\0')
+        return 1; /* missing */
+    char *e = NULL;
+    errno = 0;
+    const double d = strtod(s, &e);
+    if (e == s || errno == ERANGE || !isfinite(d) ||
+        !(*e == '\0' || *e == ' ' || *e == '\t' || *e == ','))
+        return 2; /* not a number */
+    *v = d;
+    *p = e;
+    return 0;
+}
+
+static cdem_status read_lines(FILE *f, const char *path, double x0, double tol,
+                              cdem_fault_polyline *pl, cdem_error *err) {
+    char line[1024];
+    long lineno = 0;
+    size_t cap = 0;
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        size_t len = strlen(line);
+        if (len == sizeof line - 1 && line[len - 1] != '\n' && !feof(f))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "fault file %s, line %ld: line longer than %zu characters", path,
+                             lineno, sizeof line - 2);
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = '\0';
+        len = strlen(line);
+        while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r' || line[len - 1] == ' ' ||
+                           line[len - 1] == '\t'))
+            line[--len] = '\0';
+        char *p = line;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\0')
+            continue;
+        double xy[2];
+        for (int k = 0; k < 2; k++) {
+            const int rc = parse_field(&p, &xy[k]);
+            if (rc == 1)
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "fault file %s, line %ld: '%s': expected two numbers x y (m), "
+                                 "found only one",
+                                 path, lineno, line);
+            if (rc == 2)
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "fault file %s, line %ld: '%s': field %d is not a number; "
+                                 "expected two numbers x y (m)",
+                                 path, lineno, line, k + 1);
+        }
+        while (*p == ' ' || *p == '\t' || *p == ',')
+            p++;
+        if (*p != '\0')
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "fault file %s, line %ld: '%s': extra field '%s'; expected exactly "
+                             "two numbers x y (m)",
+                             path, lineno, line, p);
+        if (pl->n == 0) {
+            if (fabs(xy[0] - x0) > tol || fabs(xy[1]) > tol)
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "fault file %s, line %ld: first point (%g, %g) m must be at the "
+                                 "fault location (x = %g m, y = 0) within %g m",
+                                 path, lineno, xy[0], xy[1], x0, tol);
+        } else {
+            const double px = pl->x[pl->n - 1], py = pl->y[pl->n - 1];
+            if (!(xy[0] < px && xy[1] > py))
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "fault file %s, line %ld: point (%g, %g) m must have lower x "
+                                 "and higher y than the previous point (%g, %g) m (the fault "
+                                 "dips toward +x and is listed from the base up-dip)",
+                                 path, lineno, xy[0], xy[1], px, py);
+        }
+        CDEM_TRY(pl_push(pl, &cap, pl->n == 0 ? x0 : xy[0], pl->n == 0 ? 0.0 : xy[1], err));
+    }
+    if (ferror(f))
+        return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: read error after line %ld", path,
+                         lineno);
+    if (pl->n == 0)
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "fault file %s: empty (%ld lines, no x y point); expected at least two "
+                         "points from the base up-dip",
+                         path, lineno);
+    if (pl->n < 2)
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "fault file %s, line %ld: only one point; expected at least two points "
+                         "from the base up-dip",
+                         path, lineno);
+    return CDEM_OK;
+}
+
+cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_fault_polyline *pl,
+                                 cdem_error *err) {
+    memset(pl, 0, sizeof *pl);
+    if (!path || !*path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "fault file: no path given");
+    if (!(tol > 0.0) || !isfinite(x0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "fault file %s: x0 = %g m, tol = %g m: need a "
+                         "finite x0 and tol > 0",
+                         path, x0, tol);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: cannot open: %s", path, strerror(errno));
+    const cdem_status st = read_lines(f, path, x0, tol, pl, err);
+    fclose(f);
+    if (st != CDEM_OK)
+        cdem_fault_file_free(pl);
+    return st;
+}
+
+cdem_status cdem_fault_file_listric(double x0, double height, double dip0_deg, size_t n_seg,
+                                    cdem_fault_polyline *pl, cdem_error *err) {
+    memset(pl, 0, sizeof *pl);
+    if (!(dip0_deg > 0.0 && dip0_deg <= 90.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "listric fault: boundary.fault_dip = %g degrees: must be in (0, 90]",
+                         dip0_deg);
+    if (!(height > 0.0 && isfinite(height)) || !isfinite(x0) || n_seg < 1 || n_seg > 100000)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "listric fault: height = %g m, x0 = %g m, %zu segments: need height > "
+                         "0 and 1-100000 segments",
+                         height, x0, n_seg);
+    pl->x = malloc((n_seg + 1) * sizeof *pl->x);
+    pl->y = malloc((n_seg + 1) * sizeof *pl->y);
+    if (!pl->x || !pl->y) {
+        cdem_fault_file_free(pl);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "listric fault: out of memory for %zu vertices",
+                         n_seg + 1);
+    }
+    pl->n = n_seg + 1;
+    pl->x[0] = x0;
+    pl->y[0] = 0.0;
+    const double dy = height / (double)n_seg;
+    for (size_t k = 1; k <= n_seg; k++) {
+        const double eta = ((double)k - 0.5) / (double)n_seg;
+        const double dip = dip0_deg + (90.0 - dip0_deg) * pow(eta, CDEM_LISTRIC_EXPONENT);
+        pl->y[k] = (double)k * dy;
+        pl->x[k] = pl->x[k - 1] - dy / tan(dip * M_PI / 180.0);
+    }
+    return CDEM_OK;
+}
+
+double cdem_fault_file_x_at(const cdem_fault_polyline *pl, double y) {
+    if (y >= pl->y[pl->n - 1])
+        return pl->x[pl->n - 1];
+    size_t k = 1;
+    while (k < pl->n - 1 && pl->y[k] < y)
+        k++;
+    const double t = (y - pl->y[k - 1]) / (pl->y[k] - pl->y[k - 1]);
+    return pl->x[k - 1] + t * (pl->x[k] - pl->x[k - 1]);
+}
+
+double cdem_fault_file_distance(const cdem_fault_polyline *pl, double px, double py) {
+    double best = INFINITY;
+    for (size_t k = 1; k < pl->n; k++) {
+        const double ax = pl->x[k - 1], ay = pl->y[k - 1];
+        const double ex = pl->x[k] - ax, ey = pl->y[k] - ay;
+        const double l2 = ex * ex + ey * ey;
+        double t = l2 > 0.0 ? ((px - ax) * ex + (py - ay) * ey) / l2 : 0.0;
+        t = fmin(1.0, fmax(0.0, t));
+        best = fmin(best, hypot(px - ax - t * ex, py - ay - t * ey));
+    }
+    return best;
+}
