@@ -5,7 +5,14 @@
 #  1. the default model (paper Fig. 7A, planar normal fault, 30 deg): full run, 56 / 282
 #     increments, the hanging-wall block moved by the net displacement along the dip;
 #  2. a planar reverse fault (50 deg, shorter run);
-#  3. a planar normal fault with inversion at 50 %: net displacement zero at the end.
+#  3. a planar normal fault with inversion at 50 %: net displacement zero at the end;
+#  4. repose-collapse of the default material (right wall removed): the slope angle of the
+#     final surface is between 20 and 45 degrees;
+#  5. biaxial tests at 0 and 10 MPa (1e7 N/m): the differential stress rises, peaks and
+#     softens, and the confined peak is above the unconfined one;
+#  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
+#     assembly runs to the end with growth strata in the final increment;
+#  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth.
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -36,6 +43,55 @@ check inversion-run "$RUN" -q -o "$TMP/inversion.h5" -s boundary.inversion=on \
     -s boundary.inversion_percent=50 -s time.runtime=1000 -s time.display_interval=10
 EQ=$(/usr/bin/python3 -c "import h5py,sys; f=h5py.File('$TMP/inversion.h5','r'); g=[f['increments'][k] for k in sorted(f['increments'])]; print(max(int(x.attrs['number']) for x in g if int(x.attrs['phase'])==0), len(g)-1)" 2>/dev/null)
 check inversion-kinematics $CHECK "$TMP/inversion.h5" --equil ${EQ% *} --total ${EQ#* } --dip 30 --sense normal --net-fraction 0
+
+STRAIN="$BUILD/cdem-strain"
+PY=/usr/bin/python3
+
+check repose-run "$RUN" -q -o "$TMP/repose.h5" -s boundary.mode=repose \
+    -s time.display_interval=20 -s time.runtime=3000
+check repose-angle sh -c "'$STRAIN' repose '$TMP/repose.h5' | head -n 1 | tee /dev/stderr |
+    awk '{ a = \$5 + 0; if (a >= 20 && a <= 45) { print \"angle \" a \" deg in [20, 45]\"; exit 0 } exit 1 }'"
+
+check biaxial-0-run "$RUN" -q -o "$TMP/biax0.h5" -s boundary.mode=biaxial \
+    -s time.equilibration=800 -s time.runtime=2220 -s time.display_interval=10
+check biaxial-10-run "$RUN" -q -o "$TMP/biax10.h5" -s boundary.mode=biaxial \
+    -s boundary.confining_pressure=1e7 -s time.equilibration=800 -s time.runtime=2220 \
+    -s time.display_interval=10
+check biaxial-peaks $PY - "$TMP/biax0.h5" "$TMP/biax10.h5" <<'PYEOF'
+import sys, h5py, numpy as np
+peaks, problems = [], []
+for path in sys.argv[1:]:
+    with h5py.File(path, "r") as f:
+        q = np.asarray(f["series/differential_stress"][:])
+        e = np.asarray(f["series/axial_strain"][:])
+    q, e = q[e > 0], e[e > 0]
+    k = int(np.argmax(q))
+    peak, end = q[k], q[-1]
+    print(f"{path}: peak {peak / 1e6:.1f} MN/m at axial strain {e[k]:.3f}, final {end / 1e6:.1f} MN/m")
+    if not (peak > 0 and 0 < k < len(q) - 1 and end < peak):
+        problems.append(f"{path}: no peak followed by softening within axial strain {e[-1]:.3f}")
+    peaks.append(peak)
+if peaks[1] <= peaks[0]:
+    problems.append("confined peak not above the unconfined one")
+assert not problems, "; ".join(problems)
+print(f"peaks {peaks[0] / 1e6:.1f} < {peaks[1] / 1e6:.1f} MN/m")
+PYEOF
+
+check growth-run "$RUN" -q -o "$TMP/growth.h5" -s surface.sedimentation=on \
+    -s surface.sea_level_rise=null -s material.first_slip=off
+check growth-strata $PY - "$TMP/growth.h5" <<'PYEOF'
+import sys, h5py, numpy as np
+with h5py.File(sys.argv[1], "r") as f:
+    last = max(f["increments"], key=lambda k: int(f["increments"][k].attrs["number"]))
+    g = f["increments"][last]
+    flags = np.asarray(g["flags"][:])
+    n = int(np.count_nonzero(flags & (1 << 3)))
+    print(f"increment {last}: {n} growth elements, stop reason {f.attrs['stop_reason']}")
+    assert n > 0
+PYEOF
+
+check stress-run "$RUN" -q -o "$TMP/stress.h5" -s physics.calculate_stress=on -s time.runtime=410
+check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
