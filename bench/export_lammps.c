@@ -10,7 +10,8 @@
  *      writes OUTDIR/cdem_phys.dump (ITEM: ATOMS id type x y radius) and prints the
  *      kinetic energy of the free elements (physics check; overlaps by lammps_overlap.py);
  *   4. continues with REPS timed runs of NTIME steps for 1 and then 2 OpenMP threads and
- *      prints one "CDEM_TIME threads T rep R seconds S" line per run.
+ *      prints one "CDEM_TIME threads T rep R ... seconds S ... cpu_seconds C" line per run
+ *      (C: CPU time of all threads, the steadier figure when other jobs share the cores).
  * LAMMPS masses: the data file's density is m / (4/3 pi r^3), because LAMMPS (29 Sep 2021)
  * computes the mass of atom_style sphere from the 3-D volume even in 2-D; the bench script
  * checks that LAMMPS's total free mass equals ours.
@@ -30,6 +31,12 @@
 static double now_s(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double cpu_s(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -182,13 +189,14 @@ int main(int argc, char **argv) {
          * runs serially with 2 threads too; the half-radii and larger models are threaded */
         for (int r = 1; r <= reps; r++) {
             const long b1 = it.nb.n_builds;
-            const double t1 = now_s();
+            const double t1 = now_s(), u1 = cpu_s();
             for (long k = 0; k < ntime; k++)
                 if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err))
                     return fail(&err);
-            const double t2 = now_s();
-            printf("CDEM_TIME threads %d rep %d N %zu steps %ld seconds %.4f builds %ld\n", threads,
-                   r, s.n, ntime, t2 - t1, it.nb.n_builds - b1);
+            const double t2 = now_s(), u2 = cpu_s();
+            printf("CDEM_TIME threads %d rep %d N %zu steps %ld seconds %.4f builds %ld "
+                   "cpu_seconds %.4f\n",
+                   threads, r, s.n, ntime, t2 - t1, it.nb.n_builds - b1, u2 - u1);
             fflush(stdout);
         }
     }

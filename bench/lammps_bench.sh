@@ -101,6 +101,11 @@ for size in $SIZES; do
     l2=$(grep '^Loop time' "$dir/lmp2.log" | tail -n "$REPS" | awk '{print $4}' | median)
     nb=$(grep '^Neighbor list builds' "$dir/lmp1.log" | tail -n "$REPS" | awk '{s += $NF} END {print s}')
     cb=$(awk '/^CDEM_TIME threads 1/ {s += $13} END {print s}' "$dir/cdem.out")
+    # CPU seconds: cdem from CLOCK_PROCESS_CPUTIME_ID; LAMMPS = Loop time x its "% CPU use"
+    # (1 rank only: with 2 ranks MPI busy-waiting makes CPU time meaningless)
+    u1=$(awk '/^CDEM_TIME threads 1/ {print $15}' "$dir/cdem.out" | median)
+    v1=$(awk '/^Loop time/ {t = $4} /% CPU use/ && t {sub("%", "", $1); print t * $1 / 100; t = 0}' \
+        "$dir/lmp1.log" | tail -n "$REPS" | median)
     rate() { awk -v n="$n" -v s="$ntime" -v t="$1" 'BEGIN {printf "%.3g", n * s / t}'; }
     ratio() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.2f", b / a}'; }
     echo "   timing (median of $REPS x $ntime steps; element-steps/s counting all $n elements):"
@@ -108,7 +113,9 @@ for size in $SIZES; do
     echo "     cdem   2 threads: $c2 s  $(rate "$c2") el-steps/s"
     echo "     LAMMPS 1 rank   : $l1 s  $(rate "$l1") el-steps/s  (list builds in the $REPS runs: $nb)"
     echo "     LAMMPS 2 ranks  : $l2 s  $(rate "$l2") el-steps/s"
-    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x, 2 cores $(ratio "$c2" "$l2")x"
+    echo "     per CPU-second, 1 core: cdem $u1 s $(rate "$u1") el-steps/s, LAMMPS $v1 s $(rate "$v1") el-steps/s"
+    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x"
+    echo "     load average after the size: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
     echo "   peak memory: cdem $(peak_mb "$dir/cdem.time") MB (whole process incl. equilibration)," \
         "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)"
 done
