@@ -54,6 +54,7 @@ relerr() { awk -v a="$1" -v b="$2" 'BEGIN {d=a-b; if (d<0) d=-d; m=(b<0?-b:b); p
 
 echo "lammps_bench: $(lmp -h | grep -m1 '^Large-scale' || true) $(lmp -h | grep -m1 'LAMMPS (' || true)"
 echo "lammps_bench: machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+failed=""
 for size in $SIZES; do
     width=${size%%:*}
     half=${size##*:}
@@ -94,6 +95,7 @@ for size in $SIZES; do
     echo "   physics after $NPHYS steps: kinetic energy cdem $kc J/m, LAMMPS $kl (2 ranks: $kl2), rel. diff $ek (tol $KE_TOL)"
     echo "   physics after $NPHYS steps: mean overlap cdem $oc m, LAMMPS $ol m, rel. diff $eo (tol $OV_TOL); largest position difference $dpos m"
     echo "   physics check: $ok"
+    [ "$ok" = PASS ] || failed="$failed ${width}:${half}"
 
     c1=$(awk '/^CDEM_TIME threads 1/ {print $11}' "$dir/cdem.out" | median)
     c2=$(awk '/^CDEM_TIME threads 2/ {print $11}' "$dir/cdem.out" | median)
@@ -119,3 +121,7 @@ for size in $SIZES; do
     echo "   peak memory: cdem $(peak_mb "$dir/cdem.time") MB (whole process incl. equilibration)," \
         "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)"
 done
+if [ -n "$failed" ]; then
+    echo "lammps_bench: physics check FAILED for$failed: the timings do not compare the same run"
+    exit 1
+fi
