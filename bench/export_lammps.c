@@ -123,38 +123,47 @@ int main(int argc, char **argv) {
     const int reps = argc > 6 ? atoi(argv[6]) : 3;
     cdem_model m;
     cdem_error err;
-    cdem_state s;
+    int rc = 1;
+    cdem_state s = {0};
     cdem_assembly_info info;
-    cdem_integrator it;
+    cdem_integrator it = {0};
     if (cdem_model_derive(&p, &m, &err) || cdem_state_init(&s, 4096, 0, &err) ||
-        cdem_assembly_build(&p, &m, &s, &info, &err) || cdem_integrator_init(&it, &p, &m, &err))
-        return fail(&err);
+        cdem_assembly_build(&p, &m, &s, &info, &err) || cdem_integrator_init(&it, &p, &m, &err)) {
+        rc = fail(&err);
+        goto done;
+    }
     cdem_integrator_enable_escape(&it);
     it.boundary_forces = 0;
     const long equil = argc > 7 ? atol(argv[7]) : m.equil_steps;
     double t0 = now_s();
     for (long k = 0; k < equil; k++)
-        if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err))
-            return fail(&err);
+        if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err)) {
+            rc = fail(&err);
+            goto done;
+        }
     const double tequil = now_s() - t0;
 
     /* identical start: no shear history (LAMMPS cannot read it), forces recomputed */
     for (size_t q = 0; q < it.nb.np; q++)
         it.nb.xs[q] = 0.0;
-    if (cdem_integrator_prime(&it, &s, &err))
-        return fail(&err);
+    if (cdem_integrator_prime(&it, &s, &err)) {
+        rc = fail(&err);
+        goto done;
+    }
 
     char path[4096];
     snprintf(path, sizeof path, "%s/cdem.data", dir);
     if (write_data(path, &s, 4.0 * m.max_radius)) {
         fprintf(stderr, "export_lammps: cannot write %s\n", path);
-        return 1;
+        rc = 1;
+        goto done;
     }
     snprintf(path, sizeof path, "%s/cdem_consts.in", dir);
     FILE *f = fopen(path, "w");
     if (!f) {
         fprintf(stderr, "export_lammps: cannot write %s\n", path);
-        return 1;
+        rc = 1;
+        goto done;
     }
     /* the default model uses one friction for every class; the LAMMPS pair style has one */
     fprintf(f,
@@ -173,15 +182,18 @@ int main(int argc, char **argv) {
            s.n, nfree, s.n - nfree, equil, tequil, mass, ke, it.nb.skin, it.dt);
     const long b0 = it.nb.n_builds;
     for (long k = 0; k < nphys; k++)
-        if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err))
-            return fail(&err);
+        if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err)) {
+            rc = fail(&err);
+            goto done;
+        }
     free_stats(&s, &ke, &mass, &nfree);
     printf("CDEM_PHYS steps %ld ke %.6g builds %ld removed %ld\n", nphys, ke, it.nb.n_builds - b0,
            it.n_removed);
     snprintf(path, sizeof path, "%s/cdem_phys.dump", dir);
     if (write_dump(path, &s)) {
         fprintf(stderr, "export_lammps: cannot write %s\n", path);
-        return 1;
+        rc = 1;
+        goto done;
     }
     for (int threads = 1; threads <= 2; threads++) {
         omp_set_num_threads(threads);
@@ -191,8 +203,10 @@ int main(int argc, char **argv) {
             const long b1 = it.nb.n_builds;
             const double t1 = now_s(), u1 = cpu_s();
             for (long k = 0; k < ntime; k++)
-                if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err))
-                    return fail(&err);
+                if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err)) {
+                    rc = fail(&err);
+                    goto done;
+                }
             const double t2 = now_s(), u2 = cpu_s();
             printf("CDEM_TIME threads %d rep %d N %zu steps %ld seconds %.4f builds %ld "
                    "cpu_seconds %.4f\n",
@@ -200,7 +214,9 @@ int main(int argc, char **argv) {
             fflush(stdout);
         }
     }
+    rc = 0;
+done:
     cdem_integrator_free(&it);
     cdem_state_free(&s);
-    return 0;
+    return rc;
 }
