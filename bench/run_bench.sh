@@ -22,3 +22,5 @@ for t in 1 2; do
     printf 'bench_solver 100 x 5 half radii, OMP_NUM_THREADS=%s: ' "$t"
     OMP_NUM_THREADS=$t "$BUILD/bench_solver" 500 2000 100 1
 done
+# side by side with LAMMPS on the same settled packing (installs Debian's lammps if missing)
+sh bench/lammps_bench.sh "$BUILD"
