@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "bc.h"
+#include "bc_fixtures.h"
 #include "integrate.h"
 
 #include <math.h>
@@ -16,54 +17,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define KN    1.544871985e9
-#define RHO   2500.0
-#define DT    0.028
-#define WIDTH 4000.0
+#define KN  1.544871985e9
+#define RHO 2500.0
+#define DT  0.028
 
-static double rnd(uint64_t *s) {
-    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double disc_mass(double r) {
-    return RHO * M_PI * r * r;
-}
-
-static cdem_model hand_model(long def_steps) {
-    cdem_model m;
-    memset(&m, 0, sizeof m);
-    const double r[4] = {50.0, 75.0, 100.0, 125.0};
-    for (int k = 0; k < 4; k++) {
-        m.radius[k] = r[k];
-        m.mass[k] = disc_mass(r[k]);
-    }
-    m.min_mass = m.mass[0];
-    m.max_radius = 125.0;
-    m.kn = m.ks = KN;
-    m.dt = DT;
-    m.damping = DT * 3.0e9;
-    m.gravity = 9.81;
-    m.boundary_speed = CDEM_BOUNDARY_ACCEL * DT;
-    m.displacement_per_step = m.boundary_speed * DT;
-    m.width_m = WIDTH;
-    m.height_m = 1000.0;
-    m.equil_steps = 0;
-    m.total_steps = def_steps;
-    m.total_displacement = (double)def_steps * m.displacement_per_step;
-    return m;
-}
-
+/* The shared fixture parameters, as a planar normal fault dipping 60 degrees. */
 static cdem_params hand_params(void) {
-    cdem_params p;
-    memset(&p, 0, sizeof p);
-    p.material = CDEM_MATERIAL_GRANULAR;
+    cdem_params p = fx_params(CDEM_MODE_PLANAR_FAULT);
     p.first_slip = 0;
-    p.density = RHO;
-    p.element = (cdem_contact_material){.friction = 0.25, .cohesion = 5e9, .breaking_strain = 0.1};
-    p.wall = p.element;
-    p.fault = p.element;
-    p.mode = CDEM_MODE_PLANAR_FAULT;
     p.fault_sense = CDEM_SENSE_NORMAL;
     p.fault_location = 0.5;
     p.fault_dip = 60.0;
@@ -77,23 +38,23 @@ static void make_assembly(cdem_state *s) {
     const double rw = 50.0;
     for (double x = 0.0; x <= WIDTH + 1e-9; x += 2.0 * rw)
         assert_int_equal(
-            cdem_state_append(s, -1, x, 0.0, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            cdem_state_append(s, -1, x, 0.0, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
             CDEM_OK);
     for (double y = 2.0 * rw; y <= 1500.0; y += 2.0 * rw) {
         assert_int_equal(
-            cdem_state_append(s, -1, 0.0, y, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            cdem_state_append(s, -1, 0.0, y, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
             CDEM_OK);
         assert_int_equal(
-            cdem_state_append(s, -1, WIDTH, y, rw, disc_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            cdem_state_append(s, -1, WIDTH, y, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
             CDEM_OK);
     }
     uint64_t g = 5;
     for (int j = 0; j < 4; j++)
         for (double x = 150.0 + (j % 2) * 100.0; x < WIDTH - 100.0; x += 200.0) {
-            double r = 99.0 - 4.0 * rnd(&g);
-            assert_int_equal(cdem_state_append(s, -1, x, 150.0 + j * 173.2, r, disc_mass(r), 1, 0,
-                                               0, NULL, &err),
-                             CDEM_OK);
+            double r = 99.0 - 4.0 * fx_rnd(&g);
+            assert_int_equal(
+                cdem_state_append(s, -1, x, 150.0 + j * 173.2, r, fx_mass(r), 1, 0, 0, NULL, &err),
+                CDEM_OK);
         }
 }
 
@@ -108,7 +69,7 @@ typedef struct {
 } run_result;
 
 static void run_fault(cdem_params p, long steps, run_result *out) {
-    cdem_model m = hand_model(steps);
+    cdem_model m = fx_model(steps);
     cdem_error err;
     cdem_bc bc;
     cdem_integrator it;
@@ -245,7 +206,7 @@ static void test_bc_planar_reverse_inversion(void **st) {
 static void test_bc_planar_registry_errors(void **st) {
     (void)st;
     cdem_params p = hand_params();
-    cdem_model m = hand_model(100);
+    cdem_model m = fx_model(100);
     cdem_error err;
     cdem_bc bc;
     cdem_state s;
