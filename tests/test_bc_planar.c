@@ -31,33 +31,6 @@ static cdem_params hand_params(void) {
     return p;
 }
 
-/* Base (y = 0) and lateral walls of wall elements; 4 rows of free elements above. */
-static void make_assembly(cdem_state *s) {
-    cdem_error err;
-    assert_int_equal(cdem_state_init(s, 256, 0, &err), CDEM_OK);
-    const double rw = 50.0;
-    for (double x = 0.0; x <= WIDTH + 1e-9; x += 2.0 * rw)
-        assert_int_equal(
-            cdem_state_append(s, -1, x, 0.0, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
-            CDEM_OK);
-    for (double y = 2.0 * rw; y <= 1500.0; y += 2.0 * rw) {
-        assert_int_equal(
-            cdem_state_append(s, -1, 0.0, y, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
-            CDEM_OK);
-        assert_int_equal(
-            cdem_state_append(s, -1, WIDTH, y, rw, fx_mass(rw), 0, CDEM_FLAG_WALL, 0, NULL, &err),
-            CDEM_OK);
-    }
-    uint64_t g = 5;
-    for (int j = 0; j < 4; j++)
-        for (double x = 150.0 + (j % 2) * 100.0; x < WIDTH - 100.0; x += 200.0) {
-            double r = 99.0 - 4.0 * fx_rnd(&g);
-            assert_int_equal(
-                cdem_state_append(s, -1, x, 150.0 + j * 173.2, r, fx_mass(r), 1, 0, 0, NULL, &err),
-                CDEM_OK);
-        }
-}
-
 typedef struct {
     long steps;     /* deformation steps run */
     double net_mid; /* net displacement after half the steps */
@@ -74,7 +47,7 @@ static void run_fault(cdem_params p, long steps, run_result *out) {
     cdem_bc bc;
     cdem_integrator it;
     memset(out, 0, sizeof *out);
-    make_assembly(&out->s);
+    fx_assembly(&out->s);
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &out->s, &err), CDEM_OK);
     for (size_t i = 0; i < out->s.n; i++) {
         if ((out->s.flags[i] & CDEM_FLAG_FAULT) && (out->s.flags[i] & CDEM_FLAG_MOVING))
@@ -210,7 +183,7 @@ static void test_bc_planar_registry_errors(void **st) {
     cdem_error err;
     cdem_bc bc;
     cdem_state s;
-    make_assembly(&s);
+    fx_assembly(&s);
     p.mode = (cdem_mode)42;
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "42"));
