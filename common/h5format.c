@@ -1503,3 +1503,30 @@ cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_
     H5Dclose(ds);
     return st;
 }
+
+/* ------------------------------------------------------------ checkpoints */
+/* Interface agreed for the checkpoint/resume work; storage lands with the SWMR layout. */
+cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapshot *snap,
+                                            cdem_error *err) {
+    (void)snap;
+    return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED, "%s: checkpoints are not stored by this version",
+                     w ? w->path : "(no file)");
+}
+
+cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increment,
+                                  int64_t keep_through_step, cdem_h5_writer **out,
+                                  cdem_error *err) {
+    (void)keep_through_increment;
+    (void)keep_through_step;
+    *out = NULL;
+    return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                     "%s: resuming a run is not supported by this version", path);
+}
+
+cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *snap,
+                                           int32_t *increment_number, cdem_error *err) {
+    (void)snap;
+    *increment_number = -1;
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: the file holds no checkpoint",
+                     r ? r->path : "(no file)");
+}

@@ -21,12 +21,13 @@
 
 #include "cdem_error.h"
 #include "params.h"
+#include "snapshot.h"
 #include "state.h"
 
 #include <stddef.h>
 #include <stdint.h>
 
-#define CDEM_FORMAT_NAME "cdem-c"
+#define CDEM_FORMAT_NAME    "cdem-c"
 #define CDEM_FORMAT_VERSION 1
 
 typedef enum {
@@ -37,16 +38,16 @@ typedef enum {
 
 /* What is known about one display increment. */
 typedef struct {
-    int32_t number;          /* increment number, 0 = start of equilibration */
-    int64_t step;            /* time step at which it was written */
-    double time;             /* model time, s */
-    int32_t phase;           /* cdem_phase */
-    double net_displacement; /* m, displacement of the moving boundary (net under inversion) */
-    double axial_strain;     /* biaxial test: platen shortening / initial height; else 0 */
+    int32_t number;             /* increment number, 0 = start of equilibration */
+    int64_t step;               /* time step at which it was written */
+    double time;                /* model time, s */
+    int32_t phase;              /* cdem_phase */
+    double net_displacement;    /* m, displacement of the moving boundary (net under inversion) */
+    double axial_strain;        /* biaxial test: platen shortening / initial height; else 0 */
     double differential_stress; /* biaxial test: sigma1 - sigma3 in N/m; else 0 */
-    double sea_level;        /* m; NaN when there is no sedimentation */
-    int64_t n_elements;      /* element count of the increment (filled by the reader) */
-    int32_t has_stress;      /* 1 when sxx, syy, sxy are stored (filled by the reader) */
+    double sea_level;           /* m; NaN when there is no sedimentation */
+    int64_t n_elements;         /* element count of the increment (filled by the reader) */
+    int32_t has_stress;         /* 1 when sxx, syy, sxy are stored (filled by the reader) */
 } cdem_increment_info;
 
 /* One time-series sample. Columns with no meaning for the mode are 0. */
@@ -81,8 +82,8 @@ typedef struct cdem_h5_writer cdem_h5_writer;
 
 /* Creates path (truncating), writes the metadata and the .xmf sidecar placeholder, and
  * flushes. Fails with CDEM_ERR_IO naming the path if it cannot be created. */
-cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta,
-                                  cdem_h5_writer **out, cdem_error *err);
+cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,
+                                  cdem_error *err);
 
 /* Appends one increment (all s->n elements; stress when s->has_stress), updates the .xmf
  * sidecar and flushes the file. */
@@ -101,6 +102,19 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
 /* Flushes everything and closes; w may be NULL. Returns the first error met. */
 cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err);
 
+/* ------------------------------------------------------------ checkpoints */
+/* Stores snap as the file's checkpoint, belonging to the increment written last (a resumed
+ * run continues after it). The previous checkpoint stays readable until the new one is
+ * complete, so a kill at any moment leaves one valid checkpoint. */
+cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapshot *snap,
+                                            cdem_error *err);
+
+/* Re-opens an existing run file to go on writing it (cdem-run --resume): increments numbered
+ * above keep_through_increment and series samples with step > keep_through_step are
+ * dropped, so the resumed run writes them again. */
+cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increment,
+                                  int64_t keep_through_step, cdem_h5_writer **out, cdem_error *err);
+
 /* ---------------------------------------------------------------- reader */
 typedef struct cdem_h5_reader cdem_h5_reader;
 
@@ -116,8 +130,8 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
 
 /* Resolves "K" (an increment number), "last", "first" or "equil" (the last increment of the
  * equilibration phase) to an index. */
-cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec,
-                                          size_t *index, cdem_error *err);
+cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
+                                          cdem_error *err);
 
 /* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
  * s must be zeroed ({0}) or initialised; on failure it is left empty. */
@@ -143,6 +157,11 @@ const char *cdem_h5_reader_created(const cdem_h5_reader *r);
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */
+/* Loads the newest complete checkpoint into snap (cleared first) and the number of the
+ * increment it belongs to. CDEM_ERR_NOTFOUND, naming the path, when the file has none. */
+cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *snap,
+                                           int32_t *increment_number, cdem_error *err);
+
 cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err);
 
 #endif
