@@ -29,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
@@ -923,10 +924,13 @@ static cdem_status start_swmr(cdem_h5_writer *w, cdem_error *err) {
     return CDEM_OK;
 }
 
-static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cdem_error *err) {
+/* The file is built under a temporary name (tmp) and renamed to w->path once its layout
+ * is complete and SWMR writing has started: whatever is found at w->path opens. */
+static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, const char *tmp,
+                                cdem_error *err) {
     hid_t fapl = writer_fapl();
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-    w->file = H5Fcreate(w->path, H5F_ACC_TRUNC, fcpl, fapl);
+    w->file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
     hid_t es = keep_errors(w->file < 0);
     H5Pclose(fapl);
     H5Pclose(fcpl);
@@ -953,8 +957,11 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cd
     CDEM_TRY(create_layout(w, err));
     CDEM_TRY(flush_file(w, err));
     CDEM_TRY(start_swmr(w, err));
-    CDEM_TRY(write_xmf(w, err));
-    return flush_file(w, err);
+    CDEM_TRY(flush_file(w, err));
+    if (rename(tmp, w->path) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", w->path, tmp,
+                         strerror(errno));
+    return write_xmf(w, err);
 }
 
 /* Allocates a writer with every handle unset. */
@@ -998,11 +1005,21 @@ cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, c
     quiet_hdf5();
     cdem_h5_writer *w = NULL;
     CDEM_TRY(writer_alloc(path, &w, err));
-    cdem_status st = writer_setup(w, meta, err);
+    size_t n = strlen(path) + 10;
+    char *tmp = malloc(n);
+    if (!tmp) {
+        writer_release(w);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
+    }
+    snprintf(tmp, n, "%s.creating", path);
+    cdem_status st = writer_setup(w, meta, tmp, err);
     if (st != CDEM_OK) {
         writer_release(w);
+        remove(tmp);
+        free(tmp);
         return st;
     }
+    free(tmp);
     *out = w;
     return CDEM_OK;
 }
@@ -2090,6 +2107,29 @@ cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_
     }
     H5Dclose(ds);
     return st;
+}
+
+cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err) {
+    if (!path || !*path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_check_free_space: no path");
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    struct statvfs sv;
+    if (statvfs(dir, &sv) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot examine the output directory %s: %s", path,
+                         dir, strerror(errno));
+    double avail = (double)sv.f_bavail * (double)sv.f_frsize;
+    if (avail < bytes_needed)
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: the output needs about %.1f MB but %s has %.1f MB free", path,
+                         bytes_needed / 1e6, dir, avail / 1e6);
+    return CDEM_OK;
 }
 
 /* ------------------------------------------------------------ checkpoints */

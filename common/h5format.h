@@ -170,6 +170,11 @@ int cdem_h5_reader_format_version(const cdem_h5_reader *r);
  * default run (docs/format.md, "Size"); for the free-space check before a run. */
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress);
 
+/* Checks, before a run starts, that the directory of path has at least bytes_needed bytes
+ * free for an unprivileged user (statvfs). Fails with CDEM_ERR_IO naming the directory, the
+ * estimate and the free space when it has not (or when it cannot be examined). */
+cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err);
+
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */
 /* Loads the newest complete checkpoint into snap (cleared first) and the number of the
  * increment it belongs to. CDEM_ERR_NOTFOUND, naming the path, when the file has none. */

@@ -37,6 +37,7 @@ static void on_signal(int sig) {
 static const char usage_text[] =
     "usage: cdem-run [MODEL.ini] [-o OUT.h5] [-s section.key=value]... [-q] [--summary]\n"
     "                [--dry-run] [--print-defaults] [--params-markdown] [--max-steps N]\n"
+    "                [--ignore-free-space]\n"
     "                [--version] [-h|--help]\n"
     "\n"
     "Simulates a 2-D discrete element model and writes every display increment to an HDF5\n"
@@ -53,6 +54,8 @@ static const char usage_text[] =
     "                       values (defaults + file + overrides) and exit\n"
     "  --params-markdown    print the parameter table in markdown (docs/parameters.md)\n"
     "  --max-steps N        stop after N time steps (tests, benchmarks)\n"
+    "  --ignore-free-space  run even when the output directory has less free space than\n"
+    "                       the estimated file size\n"
     "  --version            print the version and exit\n"
     "  -h, --help           print this help and exit\n"
     "\n"
@@ -91,6 +94,7 @@ typedef struct {
     int params_markdown;     /* --params-markdown */
     int help, version;       /* -h/--help, --version */
     long max_steps;          /* --max-steps, 0 = no limit */
+    int ignore_free_space;   /* --ignore-free-space */
 } cli_args;
 
 /* Returns EXIT_OK or EXIT_USAGE (message already printed). */
@@ -121,6 +125,8 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->overrides[a->n_overrides++] = argv[++i];
         } else if (strncmp(arg, "-s", 2) == 0 && strchr(arg, '=')) {
             a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
+        } else if (strcmp(arg, "--ignore-free-space") == 0) {
+            a->ignore_free_space = 1;
         } else if (strcmp(arg, "--max-steps") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a number of time steps", arg);
@@ -283,6 +289,7 @@ int main(int argc, char **argv) {
         .log = stderr,
         .stop_requested = &stop_requested,
         .max_steps = a.max_steps,
+        .ignore_free_space = a.ignore_free_space,
     };
     cdem_status st = cdem_run(&p, &opt, &err);
     free(params_text);
