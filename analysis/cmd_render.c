@@ -216,16 +216,16 @@ static int parse_args(int argc, char **argv, render_args *a) {
             NEED_VALUE();
             if (!parse_int(next, &a->go.delay_cs) || a->go.delay_cs < 1 || a->go.delay_cs > 65535)
                 return usage("--delay must be 1 to 65535 hundredths of a second");
-        } else if (arg[0] == '-' && arg[1]) {
-            char m[160];
-            snprintf(m, sizeof m, "unknown option '%s'", arg);
-            return usage(m);
         } else if (!strcmp(arg, "--follow")) {
             a->follow = 1;
         } else if (!strcmp(arg, "--interval")) {
             NEED_VALUE();
             if (!parse_double(next, &a->interval) || !(a->interval > 0.0) || a->interval > 86400.0)
                 return usage("--interval: expected seconds > 0 (at most 86400)");
+        } else if (arg[0] == '-' && arg[1]) {
+            char m[160];
+            snprintf(m, sizeof m, "unknown option '%s'", arg);
+            return usage(m);
         } else if (!a->path) {
             a->path = arg;
         } else {

@@ -1607,8 +1607,9 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
      * read-only open it only skips the check (the file is not changed). File locking is
      * off in both cases so that a live writer's lock does not block the reader. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    if (r->unclosed)
-        H5Pset_file_locking(fapl, 0, 1);
+    /* Always off for readers: a process may open the same file twice (cdem-strain render
+     * --follow), and HDF5 refuses a second open whose locking setting differs. */
+    H5Pset_file_locking(fapl, 0, 1);
     if (status & 0x04) {
         r->file = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
         r->swmr = r->file >= 0;
