@@ -5,14 +5,14 @@
  *    checksum, so flipped bytes fail a checksum instead of being parsed. Raw chunks carry
  *    Fletcher-32. Strings are fixed-length: variable-length ones live in the global heap,
  *    which has no checksum, and HDF5 1.10 crashes on a corrupt one.
- *  - A v3 superblock is marked "open for write" while the writer runs; a writer killed
- *    before close leaves the mark and a plain H5Fopen refuses the file. The reader reads
- *    the superblock itself first (also comparing its end-of-file address with the real
- *    size, which catches truncation before HDF5 parses anything) and opens a marked file
- *    with the "clear_status_flags" property h5clear uses (read-only: nothing is written).
- *  - Crash consistency between flushes: no metadata cache evictions (metadata is written
- *    only by the flush after each increment), compact links in /increments and unfiltered
- *    series chunks (nothing the last flushed metadata points to is freed and reused).
+ *  - Version 2 is SWMR: all objects are created first (HDF5 1.10 forbids creating objects in
+ *    SWMR-write mode), then the file is only appended to. The index row of an increment is
+ *    written and flushed after its data: the commit record.
+ *  - Each increment starts at a chunk boundary, so compressed chunks are written once.
+ *  - The reader reads the superblock's status flags itself: SWMR-read for a running or
+ *    killed version-2 writer, "clear_status_flags" (read-only, what h5clear uses) for an
+ *    unclosed version-1 file. It also compares the superblock's end-of-file with the real
+ *    size, which catches truncation before HDF5 parses anything.
  *  - Object time stamps are off: same input, same bytes except the attribute "created".
  *  - HDF5's error printing is off; its error stack becomes part of cdem_error messages.
  *  - append_series is called from the time-step loop: it never allocates (fixed buffer). */
