@@ -14,14 +14,14 @@
 #include <stdio.h>
 
 typedef struct {
-    const char *output_path;               /* HDF5 file to write */
-    const char *params_text;               /* original parameter-file text (stored), or NULL */
-    int quiet;                             /* 1: no progress output */
-    int progress_is_tty;                   /* 1: redraw one progress line; 0: periodic log lines */
-    FILE *log;                             /* where progress goes (stderr) */
+    const char *output_path;         /* HDF5 file to write */
+    const char *params_text;         /* original parameter-file text (stored), or NULL */
+    int quiet;                       /* 1: no progress output */
+    int progress_is_tty;             /* 1: redraw one progress line; 0: periodic log lines */
+    FILE *log;                       /* where progress goes (stderr) */
     volatile sig_atomic_t *stop_requested; /* set to 1 by the signal handler; may be NULL */
-    long max_steps;                        /* > 0: stop after this many steps (tests, benchmarks) */
-    int ignore_free_space;                 /* 1: skip the free-space check before the run */
+    long max_steps;                  /* > 0: stop after this many steps (tests, benchmarks) */
+    int ignore_free_space;           /* 1: skip the free-space check before the run */
 } cdem_run_options;
 
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was
