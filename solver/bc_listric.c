@@ -22,6 +22,7 @@
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
  * right wall move du along the basal segment. */
 #include "bc.h"
+#include "checkpoint.h"
 #include "fault_file.h"
 
 #include <math.h>
@@ -326,6 +327,30 @@ static void listric_free(void *vctx) {
     c->path_x = c->path_y = c->path_s = NULL;
 }
 
+/* Checkpoint: the net displacement and (CD) the sheet offset evolve; the curve, the path and
+ * the fault elements are set by init on the same assembly (x_fault, first_id checked). */
+static cdem_status listric_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const listric_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_fault", c->x_fault, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, "bc", "first_id", c->first_id, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "net", c->net, err));
+    return cdem_ckpt_put_f64(snap, "bc", "sheet", c->sheet, err);
+}
+
+static cdem_status listric_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    listric_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x_fault", c->x_fault, err));
+    int64_t first = 0;
+    CDEM_TRY(cdem_ckpt_get_i64(snap, "bc", "first_id", &first, err));
+    if (first != c->first_id)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint bc.first_id = %lld but this run's first fault element has id "
+                         "%d: the checkpoint belongs to another model",
+                         (long long)first, (int)c->first_id);
+    CDEM_TRY(cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err));
+    return cdem_ckpt_get_f64(snap, "bc", "sheet", &c->sheet, err);
+}
+
 static const cdem_bc_ops listric_ops = {
     .name = "listric-fault",
     .state_size = sizeof(listric_ctx),
@@ -334,6 +359,8 @@ static const cdem_bc_ops listric_ops = {
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
+    .save = listric_save,
+    .restore = listric_restore,
 };
 
 static const cdem_bc_ops irregular_ops = {
@@ -344,6 +371,8 @@ static const cdem_bc_ops irregular_ops = {
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
+    .save = listric_save,
+    .restore = listric_restore,
 };
 
 const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;
