@@ -696,11 +696,12 @@ cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_
     if (st == CDEM_OK) {
         st = cdem_h5_reader_read_checkpoint(rd, snap, &inc, err);
         if (st == CDEM_ERR_NOTFOUND)
-            st = CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
-                           "%s has no checkpoint to resume from: it was written with "
-                           "output.checkpoint_interval = 0 (= %d here) or stopped before its first "
-                           "checkpoint; run the model again from the start",
-                           path, p.checkpoint_interval);
+            st = CDEM_FAIL(
+                err, CDEM_ERR_NOTFOUND,
+                "%s has no checkpoint to resume from (its output.checkpoint_interval is %d "
+                "increments, 0 = none): it stopped before its first checkpoint or was "
+                "written without; run the model again from the start",
+                path, p.checkpoint_interval);
     }
     cdem_h5_reader_close(rd);
     if (st == CDEM_OK) {
