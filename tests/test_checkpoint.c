@@ -5,8 +5,9 @@
  * stepper, boundary mode, sedimentation with its RNG, run counters). Cases: the planar-fault
  * default with bonds (k in equilibration and in deformation), listric CD, biaxial (platens,
  * averaging window, reference), sedimentation with growth strata (k during a settling), plus
- * erosion/overburden. Also: refused restores (another parameter set, version text, missing
- * array) with their messages. No file is written (output_path NULL). */
+ * erosion/overburden, vertical faults, detachment and repose (the irregular fault shares the
+ * listric code). Also: refused restores (another parameter set, version text, missing array) with
+ * their messages. No file is written (output_path NULL). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -70,18 +71,33 @@ static int64_t snap_i64(const cdem_snapshot *s, const char *name) {
     return v;
 }
 
-/* Straight to n versus k, capture, free, restore, on to n: every array identical. Returns the
- * straight capture's total step count through *total_out (may be NULL). */
-static void check_resume(const cdem_params *p, long k, long n) {
+/* Straight to n versus k, capture, free, restore, on to n: every array identical. With
+ * separate = 0 the straight run is the one captured at k (capturing only reads the state;
+ * the separate runs of the first case check that too), which saves k steps. */
+static void check_resume_opt(const cdem_params *p, long k, long n, int separate) {
     cdem_snapshot *straight = NULL, *mid = NULL, *resumed = NULL;
     cdem_error err;
     assert_int_equal(cdem_snapshot_alloc(&straight, &err), CDEM_OK);
     assert_int_equal(cdem_snapshot_alloc(&mid, &err), CDEM_OK);
     assert_int_equal(cdem_snapshot_alloc(&resumed, &err), CDEM_OK);
-    long total = 0;
-    run_to(p, NULL, n, straight, &total);
-    assert_true(n <= total);
-    run_to(p, NULL, k, mid, NULL);
+    if (separate) {
+        long total = 0;
+        run_to(p, NULL, n, straight, &total);
+        assert_true(n <= total);
+        run_to(p, NULL, k, mid, NULL);
+    } else {
+        cdem_run_options o = mem_options();
+        cdem_run_ctx *r = NULL;
+        if (cdem_run_open(p, &o, NULL, &r, &err) != CDEM_OK)
+            fail_msg("cdem_run_open: %s", err.msg);
+        assert_true(n <= cdem_run_total_steps(r));
+        assert_int_equal(cdem_run_advance(r, k, &err), CDEM_OK);
+        assert_int_equal(cdem_run_capture(r, mid, &err), CDEM_OK);
+        assert_int_equal(cdem_run_advance(r, n, &err), CDEM_OK);
+        assert_int_equal(cdem_run_current_step(r), n);
+        assert_int_equal(cdem_run_capture(r, straight, &err), CDEM_OK);
+        assert_int_equal(cdem_run_close(r, CDEM_OK, &err), CDEM_OK);
+    }
     assert_int_equal(snap_i64(mid, "run.step"), k);
     run_to(p, mid, n, resumed, NULL);
     const char *diff = NULL;
@@ -93,6 +109,10 @@ static void check_resume(const cdem_params *p, long k, long n) {
     cdem_snapshot_free(straight);
     cdem_snapshot_free(mid);
     cdem_snapshot_free(resumed);
+}
+
+static void check_resume(const cdem_params *p, long k, long n) {
+    check_resume_opt(p, k, n, 0);
 }
 
 static long model_steps(const cdem_params *p, long *equil) {
@@ -111,8 +131,8 @@ static void test_checkpoint_planar_bonded_resume_is_bit_identical(void **st) {
     long equil = 0;
     const long total = model_steps(&p, &equil);
     assert_true(total > equil + 40);
-    /* across the end of equilibration (bonds made after the restore) */
-    check_resume(&p, equil - 7, equil + 30);
+    /* across the end of equilibration (bonds made after the restore); separate runs */
+    check_resume_opt(&p, equil - 7, equil + 30, 1);
     /* inside deformation, to the end of the run (final increment, completed) */
     check_resume(&p, equil + 13, total);
 }
@@ -173,6 +193,20 @@ static void test_checkpoint_sedimentation_resume_is_bit_identical(void **st) {
     check_resume(&p, k, n);
     /* the deposit after the restore draws the same random numbers */
     check_resume(&p, first - 3, first + 2);
+}
+
+/* The other modes, across the start of deformation (repose removes its walls, the others
+ * start moving after the restore). */
+static void test_checkpoint_other_modes_resume_is_bit_identical(void **st) {
+    (void)st;
+    const cdem_mode modes[] = {CDEM_MODE_VERTICAL_FAULTS, CDEM_MODE_DETACHMENT, CDEM_MODE_REPOSE};
+    for (size_t i = 0; i < sizeof modes / sizeof modes[0]; i++) {
+        cdem_params p = small_params();
+        p.mode = modes[i];
+        long equil = 0;
+        model_steps(&p, &equil);
+        check_resume(&p, equil - 2, equil + 25);
+    }
 }
 
 /* A restore into a run of other parameters, another version text or a damaged snapshot is
@@ -242,6 +276,7 @@ int main(void) {
         cmocka_unit_test(test_checkpoint_listric_cd_resume_is_bit_identical),
         cmocka_unit_test(test_checkpoint_biaxial_resume_is_bit_identical),
         cmocka_unit_test(test_checkpoint_sedimentation_resume_is_bit_identical),
+        cmocka_unit_test(test_checkpoint_other_modes_resume_is_bit_identical),
         cmocka_unit_test(test_checkpoint_refuses_mismatched_restore),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
