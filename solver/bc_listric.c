@@ -333,6 +333,8 @@ static cdem_status listric_save(const void *vctx, cdem_snapshot *snap, cdem_erro
     const listric_ctx *c = vctx;
     CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_fault", c->x_fault, err));
     CDEM_TRY(cdem_ckpt_put_i64(snap, "bc", "first_id", c->first_id, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, "bc", "line_x", CDEM_SNAP_F64, c->line.n, c->line.x, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, "bc", "line_y", CDEM_SNAP_F64, c->line.n, c->line.y, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "net", c->net, err));
     return cdem_ckpt_put_f64(snap, "bc", "sheet", c->sheet, err);
 }
@@ -347,6 +349,17 @@ static cdem_status listric_restore(void *vctx, const cdem_snapshot *snap, cdem_e
                          "checkpoint bc.first_id = %lld but this run's first fault element has id "
                          "%d: the checkpoint belongs to another model",
                          (long long)first, (int)c->first_id);
+    /* the fault curve (for irregular faults re-read from the vertex file) must be the same */
+    const cdem_snapshot_array *lx = NULL, *ly = NULL;
+    CDEM_TRY(cdem_ckpt_get_array(snap, "bc", "line_x", CDEM_SNAP_F64, SIZE_MAX, &lx, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, "bc", "line_y", CDEM_SNAP_F64, lx->count, &ly, err));
+    if (lx->count != c->line.n || memcmp(lx->data, c->line.x, c->line.n * sizeof(double)) != 0 ||
+        memcmp(ly->data, c->line.y, c->line.n * sizeof(double)) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "%s: the fault curve of the checkpoint (%zu vertices) differs from this "
+                         "run's (%zu vertices%s): the checkpoint belongs to another fault",
+                         mode_name(c), lx->count, c->line.n,
+                         c->irregular ? ", read again from boundary.fault_file" : "");
     CDEM_TRY(cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err));
     return cdem_ckpt_get_f64(snap, "bc", "sheet", &c->sheet, err);
 }
