@@ -432,11 +432,16 @@ static cdem_status restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *er
     return CDEM_OK;
 }
 
-static cdem_status write_checkpoint(run_ctx *r, cdem_error *err) {
+/* Captures the run and stores it in the file as the checkpoint of the increment written last.
+ * scheduled = 1: a periodic checkpoint (it records itself in last_ckpt_inc, which sets the
+ * schedule of the next); 0: the checkpoint of a stop (signal, max_steps), which leaves the
+ * schedule as it is so a resumed run writes the same periodic checkpoints. */
+static cdem_status write_checkpoint(run_ctx *r, int scheduled, cdem_error *err) {
     if (!r->snap)
         CDEM_TRY(cdem_snapshot_alloc(&r->snap, err));
     const int saved = r->last_ckpt_inc;
-    r->last_ckpt_inc = r->next_inc - 1; /* the checkpoint records itself */
+    if (scheduled)
+        r->last_ckpt_inc = r->next_inc - 1; /* the checkpoint records itself */
     cdem_status st = cdem_run_capture(r, r->snap, err);
     if (st == CDEM_OK)
         st = cdem_h5_writer_write_checkpoint(r->w, r->snap, err);
@@ -528,9 +533,16 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
          * checkpoint_interval increments; reading the state only, it never changes results */
         if (r->w && !r->ckpt_off && p->checkpoint_interval > 0 && r->last_written_step == step &&
             step < total && r->next_inc - 1 - r->last_ckpt_inc >= p->checkpoint_interval)
-            CDEM_TRY(write_checkpoint(r, err));
+            CDEM_TRY(write_checkpoint(r, 1, err));
         if (step % 64 == 0)
             progress(r, 0);
+        /* a stop (signal, max_steps) first checkpoints the state of this step, before the
+         * final increment (whose erosion would change it): a resume continues from here and
+         * drops that unscheduled increment */
+        const int stopping = (opt->stop_requested && *opt->stop_requested) ||
+                             (opt->max_steps > 0 && step >= opt->max_steps && step < total);
+        if (stopping && r->w && !r->ckpt_off && p->checkpoint_interval > 0 && step < total)
+            CDEM_TRY(write_checkpoint(r, 0, err));
         if (opt->stop_requested && *opt->stop_requested) {
             if (r->last_written_step != step)
                 CDEM_TRY(write_increment(r, err));

@@ -216,7 +216,8 @@ static void test_resume_determinism_threads_1_2_3(void **state) {
 static void test_resume_refusals(void **state) {
     const rs_ctx *c = *state;
     /* a completed run */
-    assert_int_equal(run(c, NULL, "-q -o done.h5 --max-steps 1 " SMALL), 0);
+    assert_int_equal(
+        run(c, NULL, "-q -o done.h5 --max-steps 1 -s output.checkpoint_interval=0 " SMALL), 0);
     assert_int_equal(run(c, NULL,
                          "-q -o full.h5 -s time.runtime=100.5 -s assembly.width=10 "
                          "-s assembly.height=2.5 -s time.equilibration=100"),
@@ -237,7 +238,7 @@ static void test_resume_refusals(void **state) {
     expect_err(c, "missing.h5");
     assert_int_equal(run(c, NULL, "--resume err.txt"), 1);
     expect_err(c, "err.txt");
-    /* stopped before its first checkpoint (1 step): nothing to resume from */
+    /* written without checkpoints (and stopped after 1 step): nothing to resume from */
     assert_int_equal(run(c, NULL, "--resume done.h5"), 1);
     expect_err(c, "has no checkpoint to resume from");
     /* the refused resume left the file as it was */
