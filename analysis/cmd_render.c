@@ -12,7 +12,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <time.h>
 
 typedef struct {
     const char *path;       /* run file */
@@ -28,6 +30,8 @@ typedef struct {
     int above_tenth;        /* 1: colour only values above 0.1 x the maximum */
     int zoom_given;         /* 1: zoom box given */
     double zoom[4];         /* xmin, xmax, ymin, ymax in m */
+    int follow;             /* 1: --follow, re-render the newest increment of a growing file */
+    double interval;        /* s, --interval between checks for a new increment (> 0) */
     cdem_render_options ro; /* drawing options */
     cdem_gif_options go;    /* GIF options */
 } render_args;
@@ -51,7 +55,9 @@ static int usage(const char *what) {
         "#RRGGBB,#RRGGBB]\n"
         "         [-o OUT.png|.pdf|.svg | -o DIR with --increment all [--prefix P] [--format "
         "png|pdf|svg]]\n"
-        "         [--gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]]\n",
+        "         [--gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]]\n"
+        "         [--follow [--interval SECONDS]]  re-render the newest increment of a run\n"
+        "         that is still being written (default -o live.png) until it stops\n",
         what);
     return 2;
 }
@@ -82,6 +88,7 @@ static int parse_args(int argc, char **argv, render_args *a) {
     a->prefix = "cdem";
     a->format = "png";
     a->axes = -1;
+    a->interval = 2.0;
     cdem_render_options_default(&a->ro);
     cdem_gif_options_default(&a->go);
     cdem_error err;
@@ -209,6 +216,12 @@ static int parse_args(int argc, char **argv, render_args *a) {
             NEED_VALUE();
             if (!parse_int(next, &a->go.delay_cs) || a->go.delay_cs < 1 || a->go.delay_cs > 65535)
                 return usage("--delay must be 1 to 65535 hundredths of a second");
+        } else if (!strcmp(arg, "--follow")) {
+            a->follow = 1;
+        } else if (!strcmp(arg, "--interval")) {
+            NEED_VALUE();
+            if (!parse_double(next, &a->interval) || !(a->interval > 0.0) || a->interval > 86400.0)
+                return usage("--interval: expected seconds > 0 (at most 86400)");
         } else if (arg[0] == '-' && arg[1]) {
             char m[160];
             snprintf(m, sizeof m, "unknown option '%s'", arg);
@@ -224,6 +237,11 @@ static int parse_args(int argc, char **argv, render_args *a) {
     }
     if (!a->path)
         return usage("no run file given");
+    if (a->follow && (a->gif || !strcmp(a->increment, "all")))
+        return usage("--follow renders one picture: it cannot be combined with --gif or "
+                     "--increment all");
+    if (a->follow && !a->output)
+        a->output = "live.png";
     if (!a->output && !a->gif)
         return usage("give -o OUTPUT (a picture, or a directory with --increment all) or --gif");
     return 0;
@@ -441,6 +459,115 @@ done:
     return rc;
 }
 
+/* Renders the newest increment of path to a->output through a temporary file renamed
+ * over it (a viewer never sees half a picture); *number receives its number. */
+static cdem_status follow_render(const render_args *a, const cdem_quantity *q, int32_t *number,
+                                 cdem_error *err) {
+    cdem_analysis *an = NULL;
+    CDEM_TRY(cdem_analysis_open(a->path, &an, err));
+    cdem_status st = CDEM_OK;
+    size_t n = cdem_analysis_count(an);
+    if (n == 0) {
+        *number = -1;
+        cdem_analysis_close(an);
+        return CDEM_OK;
+    }
+    cdem_render_options o = a->ro;
+    o.growth1_layers = cdem_analysis_params(an)->growth_sequence1_layers;
+    if (a->zoom_given)
+        set_zoom(&o, a->zoom);
+    char tmp[4200];
+    const char *dot = strrchr(a->output, '.'), *slash = strrchr(a->output, '/');
+    const char *ext = dot && (!slash || dot > slash) ? dot : "";
+    snprintf(tmp, sizeof tmp, "%s.part%s", a->output, ext);
+    st = render_one(an, n - 1, a, q, &o, tmp, err);
+    if (st == CDEM_OK && rename(tmp, a->output) != 0)
+        st = CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", a->output, tmp,
+                       strerror(errno));
+    if (st != CDEM_OK)
+        remove(tmp);
+    *number = cdem_analysis_info(an, n - 1)->number;
+    cdem_analysis_close(an);
+    return st;
+}
+
+/* Waits up to seconds for SIGINT/SIGTERM (blocked by the caller); 1 when one came. */
+static int wait_for_stop(const sigset_t *set, double seconds) {
+    struct timespec ts = {(time_t)seconds, (long)((seconds - (double)(time_t)seconds) * 1e9)};
+    for (;;) {
+        int sig = sigtimedwait(set, NULL, &ts);
+        if (sig > 0)
+            return 1;
+        if (errno != EINTR)
+            return 0; /* EAGAIN: the time is up */
+    }
+}
+
+/* --follow: watches a run file that cdem-run is writing (SWMR read, docs/format.md) and
+ * re-renders its newest increment whenever a new one arrives; ends when the run's stop
+ * reason is no longer "running" (after rendering its last increment) or on Ctrl-C. */
+static int run_follow(const render_args *a) {
+    cdem_error err;
+    cdem_error_clear(&err);
+    const cdem_quantity *q = NULL;
+    if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
+        return fail(&err);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigprocmask(SIG_BLOCK, &set, NULL);
+    cdem_h5_reader *r = NULL;
+    int rc = 0;
+    /* The run may not have created its file yet: wait for it (at most 60 s). */
+    for (double waited = 0.0; cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK;
+         waited += a->interval) {
+        if (err.code != CDEM_ERR_NOTFOUND || waited >= 60.0)
+            return fail(&err);
+        if (wait_for_stop(&set, a->interval))
+            return 0;
+    }
+    int32_t shown = -1;
+    for (;;) {
+        int stopped = strcmp(cdem_h5_reader_stop_reason(r), "running") != 0;
+        size_t n = cdem_h5_reader_increment_count(r);
+        cdem_increment_info last;
+        if (n > 0 && cdem_h5_reader_increment_info(r, n - 1, &last, &err) == CDEM_OK &&
+            last.number != shown) {
+            int32_t number = -1;
+            if (follow_render(a, q, &number, &err) != CDEM_OK) {
+                rc = fail(&err);
+                break;
+            }
+            if (number >= 0 && number != shown) {
+                shown = number;
+                printf("%s: increment %d\n", a->output, (int)number);
+                fflush(stdout);
+            }
+        }
+        if (stopped) {
+            printf("%s: the run stopped (%s), last increment %d\n", a->path,
+                   cdem_h5_reader_stop_reason(r), (int)shown);
+            break;
+        }
+        if (wait_for_stop(&set, a->interval))
+            break;
+        if (cdem_h5_reader_format_version(r) >= 2 && cdem_h5_reader_unclosed(r) &&
+            cdem_h5_reader_refresh(r, NULL, &err) == CDEM_OK)
+            continue;
+        /* Not in SWMR-read mode (a version-1 file, or one opened before its writer entered
+         * SWMR mode): open it again to see what is new. */
+        cdem_h5_reader_close(r);
+        r = NULL;
+        if (cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK) {
+            rc = fail(&err);
+            break;
+        }
+    }
+    cdem_h5_reader_close(r);
+    return rc;
+}
+
 int cdem_cmd_render(int argc, char **argv) {
     render_args a;
     int rc = parse_args(argc, argv, &a);
@@ -448,5 +575,5 @@ int cdem_cmd_render(int argc, char **argv) {
         return 0;
     if (rc != 0)
         return rc;
-    return run_render(&a);
+    return a.follow ? run_follow(&a) : run_render(&a);
 }

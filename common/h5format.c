@@ -29,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
@@ -39,6 +40,8 @@
 #define SERIES_CHUNK    512
 #define SERIES_BUFFER   256
 #define XMF_EVERY_LIMIT 1000
+#define INDEX_CHUNK     256       /* rows of /increments/index per chunk */
+#define CKPT_CHUNK      (1 << 20) /* bytes of a checkpoint slot per chunk */
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
 
@@ -240,9 +243,6 @@ static int put_i32_attr(hid_t o, const char *n, int32_t v) {
 static int put_i64_attr(hid_t o, const char *n, int64_t v) {
     return put_attr(o, n, H5T_STD_I64LE, H5T_NATIVE_INT64, &v);
 }
-static int put_f64_attr(hid_t o, const char *n, double v) {
-    return put_attr(o, n, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &v);
-}
 
 /* Reads a scalar numeric attribute converted to mtype. Returns 0, 1 when missing, -1 on a
  * bad type or read failure. */
@@ -341,65 +341,265 @@ static char *xmf_path_for(const char *h5path) {
 
 /* ------------------------------------------------------------------ writer */
 
+/* One row of /increments/index (memory layout; the file type is packed little-endian). */
 typedef struct {
-    int32_t number; /* increment number */
-    double time;    /* s */
-    int64_t n;      /* element count */
-    int has_stress; /* 1: sxx, syy, sxy stored */
+    int32_t number;             /* increment number */
+    int32_t phase;              /* cdem_phase */
+    int64_t step;               /* time step */
+    double time;                /* s */
+    double net_displacement;    /* m */
+    double axial_strain;        /* - */
+    double differential_stress; /* N/m */
+    double sea_level;           /* m, NaN when none */
+    int64_t offset;             /* first row of this increment in the element datasets */
+    int64_t n;                  /* element count */
+    int32_t has_stress;         /* 1: rows stress_offset.. of sxx, syy, sxy belong to it */
+    int64_t stress_offset;      /* first row in sxx, syy, sxy (-1 without stress) */
+} index_row;
+
+typedef enum { IX_I32, IX_I64, IX_F64 } ix_kind;
+typedef struct {
+    const char *name; /* compound member name */
+    size_t offset;    /* offsetof(index_row, field) */
+    ix_kind kind;     /* member type */
+} index_member;
+
+#define IXM(field, kind)                                                                           \
+    { #field, offsetof(index_row, field), kind }
+static const index_member index_members[] = {
+    IXM(number, IX_I32),
+    IXM(step, IX_I64),
+    IXM(time, IX_F64),
+    IXM(phase, IX_I32),
+    IXM(net_displacement, IX_F64),
+    IXM(axial_strain, IX_F64),
+    IXM(differential_stress, IX_F64),
+    IXM(sea_level, IX_F64),
+    IXM(offset, IX_I64),
+    IXM(n, IX_I64),
+    IXM(has_stress, IX_I32),
+    IXM(stress_offset, IX_I64),
+};
+#undef IXM
+#define N_INDEX_MEMBERS (sizeof index_members / sizeof index_members[0])
+
+/* One row of /checkpoint/index (one per slot). */
+typedef struct {
+    int64_t sequence;  /* 0: slot never written; larger = newer */
+    int32_t increment; /* increment the checkpoint belongs to */
+    int64_t step;      /* time step of that increment */
+    int64_t length;    /* bytes of the blob in the slot */
+    uint64_t checksum; /* FNV-1a 64 of those bytes */
+} ckpt_row;
+
+#define CKM(field, kind)                                                                           \
+    { #field, offsetof(ckpt_row, field), kind }
+static const index_member ckpt_members[] = {
+    CKM(sequence, IX_I64), CKM(increment, IX_I32), CKM(step, IX_I64),
+    CKM(length, IX_I64),   CKM(checksum, IX_I64),
+};
+#undef CKM
+#define N_CKPT_MEMBERS (sizeof ckpt_members / sizeof ckpt_members[0])
+
+/* Builds the memory (native, padded) or file (little-endian, packed) compound type. */
+static hid_t make_compound(const index_member *m, size_t nm, size_t mem_size, int file) {
+    size_t size = mem_size;
+    if (file) {
+        size = 0;
+        for (size_t i = 0; i < nm; i++)
+            size += m[i].kind == IX_I32 ? 4 : 8;
+    }
+    hid_t t = H5Tcreate(H5T_COMPOUND, size);
+    if (t < 0)
+        return t;
+    size_t at = 0;
+    for (size_t i = 0; i < nm; i++) {
+        hid_t mt;
+        if (m[i].kind == IX_I32)
+            mt = file ? H5T_STD_I32LE : H5T_NATIVE_INT32;
+        else if (m[i].kind == IX_I64)
+            mt = file ? H5T_STD_I64LE : H5T_NATIVE_INT64;
+        else
+            mt = file ? H5T_IEEE_F64LE : H5T_NATIVE_DOUBLE;
+        if (H5Tinsert(t, m[i].name, file ? at : m[i].offset, mt) < 0) {
+            H5Tclose(t);
+            return -1;
+        }
+        at += m[i].kind == IX_I32 ? 4 : 8;
+    }
+    return t;
+}
+
+/* FNV-1a, 64 bit: detects torn or corrupted checkpoint blobs. */
+static uint64_t fnv1a64(const unsigned char *p, size_t n) {
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+typedef struct {
+    int32_t number;        /* increment number */
+    double time;           /* s */
+    int64_t n;             /* element count */
+    int has_stress;        /* 1: sxx, syy, sxy stored */
+    int64_t offset;        /* first row in the element datasets */
+    int64_t stress_offset; /* first row in sxx, syy, sxy */
 } xmf_entry;
 
+#define STOP_REASON_LEN 64   /* bytes of /stop_reason (with the NUL) */
+#define STOP_DETAIL_LEN 2048 /* bytes of /stop_detail (with the NUL) */
+
 struct cdem_h5_writer {
-    hid_t file;                    /* open HDF5 file */
-    hid_t increments;              /* /increments group */
-    hid_t series[N_SERIES];        /* /series/<column> datasets */
-    char *path;                    /* the .h5 path as given */
-    char *xmf_path;                /* sidecar path */
-    char *xmf_tmp;                 /* sidecar temp path (renamed over xmf_path) */
-    const char *h5_name;           /* basename of path, referenced from the sidecar */
-    cdem_series_sample *buf;       /* SERIES_BUFFER buffered samples */
-    size_t nbuf;                   /* samples in buf */
-    void *column;                  /* SERIES_BUFFER * 8 bytes: one column being written */
-    hsize_t series_len;            /* samples already in the file */
-    xmf_entry *entries;            /* one per written increment, in write order */
-    size_t n_entries, cap_entries; /* used / allocated entries */
-    size_t xmf_written;            /* entries in the sidecar on disk */
+    hid_t file;                     /* open HDF5 file (SWMR write mode once set up) */
+    hid_t data[N_ELEMENT_FIELDS];   /* /increments/<field> */
+    hid_t index;                    /* /increments/index */
+    hid_t index_mtype;              /* memory type of index_row */
+    hid_t series[N_SERIES];         /* /series/<column> datasets */
+    hid_t stop_reason, stop_detail; /* /stop_reason, /stop_detail */
+    hid_t ckpt_data[2];             /* /checkpoint/slot0, slot1 */
+    hid_t ckpt_index;               /* /checkpoint/index, 2 rows */
+    hid_t ckpt_mtype;               /* memory type of ckpt_row */
+    char *path;                     /* the .h5 path as given */
+    char *xmf_path;                 /* sidecar path */
+    char *xmf_tmp;                  /* sidecar temp path (renamed over xmf_path) */
+    const char *h5_name;            /* basename of path, referenced from the sidecar */
+    cdem_series_sample *buf;        /* SERIES_BUFFER buffered samples */
+    size_t nbuf;                    /* samples in buf */
+    void *column;                   /* SERIES_BUFFER * 8 bytes: one column being written */
+    hsize_t series_len;             /* samples already in the file */
+    hsize_t data_len;               /* first row of the next increment in id..born (a chunk
+                                       boundary) */
+    hsize_t stress_len;             /* the same in sxx, syy, sxy */
+    hsize_t data_ext, stress_ext;   /* current extents of id..born and of sxx, syy, sxy */
+    hsize_t index_len;              /* rows in /increments/index */
+    int32_t last_number;            /* number of the last increment written (-1: none) */
+    int64_t last_step;              /* its step */
+    ckpt_row ckpt[2];               /* the checkpoint index as on disk */
+    unsigned char *ckpt_buf;        /* serialised snapshot, grown as needed */
+    size_t ckpt_cap;                /* bytes allocated in ckpt_buf */
+    int failed;                     /* 1 after a failed write: the file keeps what it had */
+    xmf_entry *entries;             /* one per written increment, in write order */
+    size_t n_entries, cap_entries;  /* used / allocated entries */
+    size_t xmf_written;             /* entries in the sidecar on disk */
 };
 
 static cdem_status flush_file(cdem_h5_writer *w, cdem_error *err) {
-    if (H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the file", w->path);
+    if (H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the file (disk full?)", w->path);
+    }
     return CDEM_OK;
+}
+
+/* Writes count values at rows [start, start + count) of the 1-D dataset ds, extending it
+ * to at least start + count. Returns 0 or -1 (HDF5 error stack kept). */
+static int write_rows(hid_t ds, hid_t mtype, hsize_t start, hsize_t count, const void *src) {
+    if (count == 0)
+        return 0;
+    hsize_t total = start + count, cur = 0;
+    hid_t fs = H5Dget_space(ds);
+    if (fs < 0)
+        return -1;
+    H5Sget_simple_extent_dims(fs, &cur, NULL);
+    H5Sclose(fs);
+    if (cur < total && H5Dset_extent(ds, &total) < 0)
+        return -1;
+    hid_t ms = -1;
+    fs = H5Dget_space(ds);
+    int ok = fs >= 0 && H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &count, NULL) >= 0 &&
+             (ms = H5Screate_simple(1, &count, NULL)) >= 0 &&
+             H5Dwrite(ds, mtype, ms, fs, H5P_DEFAULT, src) >= 0;
+    hid_t es = keep_errors(!ok);
+    if (fs >= 0)
+        H5Sclose(fs);
+    if (ms >= 0)
+        H5Sclose(ms);
+    restore_errors(es);
+    return ok ? 0 : -1;
+}
+
+/* Reads count values at rows [start, start + count) of the 1-D dataset ds. */
+static int read_rows(hid_t ds, hid_t mtype, hsize_t start, hsize_t count, void *dst) {
+    if (count == 0)
+        return 0;
+    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(1, &count, NULL);
+    int ok = fs >= 0 && ms >= 0 &&
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &count, NULL) >= 0 &&
+             H5Dread(ds, mtype, ms, fs, H5P_DEFAULT, dst) >= 0;
+    hid_t es = keep_errors(!ok);
+    if (fs >= 0)
+        H5Sclose(fs);
+    if (ms >= 0)
+        H5Sclose(ms);
+    restore_errors(es);
+    return ok ? 0 : -1;
+}
+
+/* Reads rows [0, n) of a compound dataset with memory type mt; 0 or -1. */
+static int read_all_rows(hid_t ds, hid_t mt, hsize_t n, void *dst) {
+    return read_rows(ds, mt, 0, n, dst);
+}
+
+/* Checks one index row against the extents of the element datasets; NULL when it is
+ * valid, otherwise what is wrong. */
+static const char *bad_index_row(const index_row *row, int32_t prev_number, hsize_t data_ext,
+                                 hsize_t stress_ext) {
+    if (row->number < 0 || row->number <= prev_number)
+        return "increment numbers must be >= 0 and increasing";
+    if (row->n < 0 || (hsize_t)row->n > MAX_ELEMENTS)
+        return "element count n out of range";
+    if (row->offset < 0 || (hsize_t)row->offset > data_ext ||
+        (hsize_t)row->n > data_ext - (hsize_t)row->offset)
+        return "rows offset..offset+n lie beyond the element datasets";
+    if (row->has_stress != 0 && row->has_stress != 1)
+        return "has_stress is neither 0 nor 1";
+    if (row->has_stress && (row->stress_offset < 0 || (hsize_t)row->stress_offset > stress_ext ||
+                            (hsize_t)row->n > stress_ext - (hsize_t)row->stress_offset))
+        return "rows stress_offset..stress_offset+n lie beyond sxx, syy, sxy";
+    return NULL;
+}
+
+static hsize_t extent_of(hid_t ds) {
+    hsize_t n = 0;
+    hid_t sp = H5Dget_space(ds);
+    if (sp >= 0) {
+        if (H5Sget_simple_extent_ndims(sp) == 1)
+            H5Sget_simple_extent_dims(sp, &n, NULL);
+        H5Sclose(sp);
+    }
+    return n;
+}
+
+/* Each increment starts at a chunk boundary of the element datasets, so every compressed
+ * chunk is written once and never rewritten (rewriting a partly filled compressed chunk
+ * at every append moves it and, in SWMR mode, leaves the old space unused: the file grew
+ * 2.4-fold). The padding rows belong to no increment and compress to almost nothing. */
+static hsize_t chunk_end(hsize_t rows) {
+    return (rows + CHUNK_ELEMS - 1) / CHUNK_ELEMS * CHUNK_ELEMS;
 }
 
 /* Writes the buffered series samples (appending to every /series dataset). */
 static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
     if (w->nbuf == 0)
         return CDEM_OK;
-    hsize_t start = w->series_len, count = w->nbuf, total = start + count;
     for (size_t c = 0; c < N_SERIES; c++) {
         const series_column *col = &series_columns[c];
         for (size_t i = 0; i < w->nbuf; i++) {
             const char *src = (const char *)&w->buf[i] + col->offset;
             memcpy((char *)w->column + i * 8, src, 8);
         }
-        hid_t fs = -1, ms = -1;
-        int ok = H5Dset_extent(w->series[c], &total) >= 0 &&
-                 (fs = H5Dget_space(w->series[c])) >= 0 &&
-                 H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &count, NULL) >= 0 &&
-                 (ms = H5Screate_simple(1, &count, NULL)) >= 0 &&
-                 H5Dwrite(w->series[c], col->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE,
-                          ms, fs, H5P_DEFAULT, w->column) >= 0;
-        hid_t es = keep_errors(!ok);
-        if (fs >= 0)
-            H5Sclose(fs);
-        if (ms >= 0)
-            H5Sclose(ms);
-        restore_errors(es);
-        if (!ok)
-            return H5FAIL(err, CDEM_ERR_IO, "%s: cannot append %zu samples to /series/%s", w->path,
+        if (write_rows(w->series[c], col->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE,
+                       w->series_len, w->nbuf, w->column) < 0) {
+            w->failed = 1;
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot append %zu samples to /series/%s (disk full?)", w->path,
                           w->nbuf, col->name);
+        }
     }
-    w->series_len = total;
+    w->series_len += w->nbuf;
     w->nbuf = 0;
     return CDEM_OK;
 }
@@ -425,14 +625,20 @@ static void xml_escaped(FILE *f, const char *s) {
     }
 }
 
+/* A hyperslab DataItem: rows [offset, offset + n) of /increments/<field>. */
 static void xmf_data_item(FILE *f, const cdem_h5_writer *w, const xmf_entry *e, size_t k) {
     const element_field *fd = &element_fields[k];
+    int64_t off = fd->optional ? e->stress_offset : e->offset;
+    hsize_t total = fd->optional ? w->stress_ext : w->data_ext;
     fprintf(f,
-            "        <DataItem Dimensions=\"%lld\" NumberType=\"%s\" Precision=\"%d\" "
+            "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%lld\" Type=\"HyperSlab\">\n"
+            "          <DataItem Dimensions=\"3 1\" Format=\"XML\">%lld 1 %lld</DataItem>\n"
+            "          <DataItem Dimensions=\"%llu\" NumberType=\"%s\" Precision=\"%d\" "
             "Format=\"HDF\">",
-            (long long)e->n, fd->xdmf, fd->type == EL_F64 ? 8 : 4);
+            (long long)e->n, (long long)off, (long long)e->n, (unsigned long long)total, fd->xdmf,
+            fd->type == EL_F64 ? 8 : 4);
     xml_escaped(f, w->h5_name);
-    fprintf(f, ":/increments/%06d/%s</DataItem>\n", (int)e->number, fd->name);
+    fprintf(f, ":/increments/%s</DataItem>\n        </DataItem>\n", fd->name);
 }
 
 /* Rewrites the sidecar from the list of increments: temp file, then rename. */
@@ -447,6 +653,7 @@ static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
           "  <Domain>\n"
           "    <Grid Name=\"increments\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
           f);
+    static const size_t attrs[] = {3, 4, 0, 5, 6, 7, 8, 9};
     for (size_t i = 0; i < w->n_entries; i++) {
         const xmf_entry *e = &w->entries[i];
         if (e->n == 0)
@@ -461,7 +668,6 @@ static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
         xmf_data_item(f, w, e, 1);
         xmf_data_item(f, w, e, 2);
         fputs("      </Geometry>\n", f);
-        static const size_t attrs[] = {3, 4, 0, 5, 6, 7, 8, 9};
         for (size_t a = 0; a < sizeof attrs / sizeof attrs[0]; a++) {
             size_t k = attrs[a];
             if (element_fields[k].optional && !e->has_stress)
@@ -477,7 +683,8 @@ static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
     int bad = ferror(f);
     if (fclose(f) != 0 || bad) {
         remove(w->xmf_tmp);
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot write the XDMF sidecar", w->xmf_tmp);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot write the XDMF sidecar (disk full?)",
+                         w->xmf_tmp);
     }
     if (rename(w->xmf_tmp, w->xmf_path) != 0) {
         int e = errno;
@@ -557,43 +764,141 @@ static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cde
     return st;
 }
 
-static cdem_status create_series(cdem_h5_writer *w, cdem_error *err) {
-    hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
-    hid_t g = H5Gcreate2(w->file, "series", H5P_DEFAULT, gcpl, H5P_DEFAULT);
-    H5Pclose(gcpl);
-    if (g < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create group /series", w->path);
-    /* Unfiltered on purpose: a fixed-size chunk is rewritten in place when samples are
-     * appended, so the chunk the last flushed index points to stays valid. A compressed
-     * chunk would move at every append and its old place could be reused before the next
-     * flush. The series is small (about 0.1 MB for the default run), so this costs little. */
-    hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = SERIES_CHUNK;
+/* Creates an empty extendible 1-D dataset loc/name. compress: shuffle + deflate +
+ * Fletcher-32. */
+static hid_t create_extendible(hid_t loc, const char *name, hid_t ftype, hsize_t chunk,
+                               int compress) {
+    hsize_t zero = 0, unlimited = H5S_UNLIMITED;
     hid_t sp = H5Screate_simple(1, &zero, &unlimited);
     hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
     H5Pset_chunk(dcpl, 1, &chunk);
-    cdem_status st = CDEM_OK;
-    for (size_t c = 0; c < N_SERIES; c++) {
-        hid_t ft = series_columns[c].type == COL_I64 ? H5T_STD_I64LE : H5T_IEEE_F64LE;
-        w->series[c] =
-            H5Dcreate2(g, series_columns[c].name, ft, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-        if (w->series[c] < 0) {
-            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /series/%s", w->path,
-                        series_columns[c].name);
-            break;
-        }
+    H5Pset_dset_no_attrs_hint(dcpl, 1);
+    H5Pset_fill_time(dcpl, compress ? H5D_FILL_TIME_ALLOC : H5D_FILL_TIME_NEVER);
+    if (compress) {
+        H5Pset_shuffle(dcpl);
+        H5Pset_deflate(dcpl, DEFLATE_LEVEL);
+        H5Pset_fletcher32(dcpl);
     }
+    hid_t ds = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    hid_t es = keep_errors(ds < 0);
     H5Pclose(dcpl);
     H5Sclose(sp);
-    H5Gclose(g);
+    restore_errors(es);
+    return ds;
+}
+
+/* A fixed-size contiguous dataset allocated at creation (overwriting it never grows the
+ * file, so it can be written even when the disk is full). */
+static hid_t create_fixed(hid_t loc, const char *name, hid_t ftype, hsize_t n) {
+    hid_t sp = n ? H5Screate_simple(1, &n, NULL) : H5Screate(H5S_SCALAR);
+    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
+    H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);
+    H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
+    hid_t ds = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    hid_t es = keep_errors(ds < 0);
+    H5Pclose(dcpl);
+    H5Sclose(sp);
+    restore_errors(es);
+    return ds;
+}
+
+static int write_fixed_string(hid_t ds, size_t width, const char *text) {
+    char buf[STOP_DETAIL_LEN];
+    memset(buf, 0, sizeof buf);
+    snprintf(buf, width < sizeof buf ? width : sizeof buf, "%s", text ? text : "");
+    hid_t t = fixed_string_type(width - 1);
+    int rc = t >= 0 && H5Dwrite(ds, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0 ? 0 : -1;
+    hid_t es = keep_errors(rc < 0);
+    if (t >= 0)
+        H5Tclose(t);
+    restore_errors(es);
+    return rc;
+}
+
+static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
+    hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
+    hid_t gs = H5Gcreate2(w->file, "series", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    hid_t gi = H5Gcreate2(w->file, "increments", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    hid_t gc = H5Gcreate2(w->file, "checkpoint", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+    H5Pclose(gcpl);
+    cdem_status st = CDEM_OK;
+    if (gs < 0 || gi < 0 || gc < 0)
+        st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the groups", w->path);
+    for (size_t c = 0; st == CDEM_OK && c < N_SERIES; c++) {
+        hid_t ft = series_columns[c].type == COL_I64 ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+        w->series[c] = create_extendible(gs, series_columns[c].name, ft, SERIES_CHUNK, 0);
+        if (w->series[c] < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /series/%s", w->path,
+                        series_columns[c].name);
+    }
+    for (size_t k = 0; st == CDEM_OK && k < N_ELEMENT_FIELDS; k++) {
+        const element_field *fd = &element_fields[k];
+        w->data[k] = create_extendible(gi, fd->name, el_file_type(fd->type), CHUNK_ELEMS, 1);
+        if (w->data[k] < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /increments/%s", w->path,
+                        fd->name);
+    }
+    hid_t ft = -1;
+    if (st == CDEM_OK) {
+        ft = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 1);
+        w->index = ft >= 0 ? create_extendible(gi, "index", ft, INDEX_CHUNK, 0) : -1;
+        if (w->index < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /increments/index", w->path);
+        if (ft >= 0)
+            H5Tclose(ft);
+    }
+    if (st == CDEM_OK) {
+        ft = make_compound(ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 1);
+        w->ckpt_index = ft >= 0 ? create_fixed(gc, "index", ft, 2) : -1;
+        w->ckpt_data[0] = create_extendible(gc, "slot0", H5T_STD_U8LE, CKPT_CHUNK, 0);
+        w->ckpt_data[1] = create_extendible(gc, "slot1", H5T_STD_U8LE, CKPT_CHUNK, 0);
+        if (w->ckpt_index < 0 || w->ckpt_data[0] < 0 || w->ckpt_data[1] < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the /checkpoint datasets", w->path);
+        if (ft >= 0)
+            H5Tclose(ft);
+    }
+    if (st == CDEM_OK) {
+        hid_t tr = fixed_string_type(STOP_REASON_LEN - 1),
+              td = fixed_string_type(STOP_DETAIL_LEN - 1);
+        w->stop_reason = create_fixed(w->file, "stop_reason", tr, 0);
+        w->stop_detail = create_fixed(w->file, "stop_detail", td, 0);
+        H5Tclose(tr);
+        H5Tclose(td);
+        if (w->stop_reason < 0 || w->stop_detail < 0 ||
+            write_fixed_string(w->stop_reason, STOP_REASON_LEN, "running") < 0 ||
+            write_fixed_string(w->stop_detail, STOP_DETAIL_LEN, "") < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create /stop_reason and /stop_detail",
+                        w->path);
+    }
+    if (gs >= 0)
+        H5Gclose(gs);
+    if (gi >= 0)
+        H5Gclose(gi);
+    if (gc >= 0)
+        H5Gclose(gc);
     return st;
 }
 
 static void writer_release(cdem_h5_writer *w) {
+    hid_t ds[N_SERIES + N_ELEMENT_FIELDS + 6];
+    size_t n = 0;
     for (size_t c = 0; c < N_SERIES; c++)
-        if (w->series[c] >= 0)
-            H5Dclose(w->series[c]);
-    if (w->increments >= 0)
-        H5Gclose(w->increments);
+        ds[n++] = w->series[c];
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        ds[n++] = w->data[k];
+    ds[n++] = w->index;
+    ds[n++] = w->stop_reason;
+    ds[n++] = w->stop_detail;
+    ds[n++] = w->ckpt_data[0];
+    ds[n++] = w->ckpt_data[1];
+    ds[n++] = w->ckpt_index;
+    for (size_t i = 0; i < n; i++)
+        if (ds[i] >= 0)
+            H5Dclose(ds[i]);
+    if (w->index_mtype >= 0)
+        H5Tclose(w->index_mtype);
+    if (w->ckpt_mtype >= 0)
+        H5Tclose(w->ckpt_mtype);
     if (w->file >= 0)
         H5Fclose(w->file);
     free(w->path);
@@ -602,26 +907,30 @@ static void writer_release(cdem_h5_writer *w) {
     free(w->buf);
     free(w->column);
     free(w->entries);
+    free(w->ckpt_buf);
     free(w);
 }
 
-static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cdem_error *err) {
+static hid_t writer_fapl(void) {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
-    /* Crash consistency between flushes (see the head comment): with evictions off,
-     * metadata reaches the disk only at a flush, never half-way through an increment. */
-    H5AC_cache_config_t mdc;
-    memset(&mdc, 0, sizeof mdc);
-    mdc.version = H5AC__CURR_CACHE_CONFIG_VERSION;
-    if (H5Pget_mdc_config(fapl, &mdc) >= 0) {
-        mdc.evictions_enabled = 0;
-        mdc.incr_mode = H5C_incr__off;
-        mdc.flash_incr_mode = H5C_flash_incr__off;
-        mdc.decr_mode = H5C_decr__off;
-        H5Pset_mdc_config(fapl, &mdc);
-    }
+    return fapl;
+}
+
+static cdem_status start_swmr(cdem_h5_writer *w, cdem_error *err) {
+    if (H5Fstart_swmr_write(w->file) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot enter single-writer/multiple-reader mode",
+                      w->path);
+    return CDEM_OK;
+}
+
+/* The file is built under a temporary name (tmp) and renamed to w->path once its layout
+ * is complete and SWMR writing has started: whatever is found at w->path opens. */
+static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, const char *tmp,
+                                cdem_error *err) {
+    hid_t fapl = writer_fapl();
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-    w->file = H5Fcreate(w->path, H5F_ACC_TRUNC, fcpl, fapl);
+    w->file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
     hid_t es = keep_errors(w->file < 0);
     H5Pclose(fapl);
     H5Pclose(fcpl);
@@ -642,23 +951,48 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, cd
         put_str_attr(root, "created", created) < 0 ||
         put_str_attr(root, "source", meta->source) < 0 ||
         put_str_attr(root, "summary", meta->summary) < 0 ||
-        put_str_attr(root, "params_text", meta->params_text) < 0 ||
-        put_str_attr(root, "stop_reason", "running") < 0 ||
-        put_str_attr(root, "stop_detail", "") < 0)
+        put_str_attr(root, "params_text", meta->params_text) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write the root attributes", w->path);
     CDEM_TRY(write_parameters(w, meta->params, err));
-    CDEM_TRY(create_series(w, err));
-    /* Links stay in the group's object header (compact), which only grows by new
-     * continuation blocks; dense storage (fractal heap + B-tree) moves and frees blocks
-     * as it grows, and freed space may be reused before the next flush. */
-    hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
-    H5Pset_link_phase_change(gcpl, 65535, 65534);
-    w->increments = H5Gcreate2(w->file, "increments", H5P_DEFAULT, gcpl, H5P_DEFAULT);
-    H5Pclose(gcpl);
-    if (w->increments < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create group /increments", w->path);
-    CDEM_TRY(write_xmf(w, err));
-    return flush_file(w, err);
+    CDEM_TRY(create_layout(w, err));
+    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(start_swmr(w, err));
+    CDEM_TRY(flush_file(w, err));
+    if (rename(tmp, w->path) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", w->path, tmp,
+                         strerror(errno));
+    return write_xmf(w, err);
+}
+
+/* Allocates a writer with every handle unset. */
+static cdem_status writer_alloc(const char *path, cdem_h5_writer **out, cdem_error *err) {
+    cdem_h5_writer *w = calloc(1, sizeof *w);
+    if (!w)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
+    w->file = w->index = w->index_mtype = w->stop_reason = w->stop_detail = -1;
+    w->ckpt_data[0] = w->ckpt_data[1] = w->ckpt_index = w->ckpt_mtype = -1;
+    for (size_t c = 0; c < N_SERIES; c++)
+        w->series[c] = -1;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        w->data[k] = -1;
+    w->last_number = -1;
+    w->path = dup_str(path);
+    w->xmf_path = xmf_path_for(path);
+    w->xmf_tmp = w->xmf_path ? malloc(strlen(w->xmf_path) + 5) : NULL;
+    w->buf = malloc(SERIES_BUFFER * sizeof *w->buf);
+    w->column = malloc(SERIES_BUFFER * 8);
+    w->index_mtype = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
+    w->ckpt_mtype = make_compound(ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 0);
+    if (!w->path || !w->xmf_path || !w->xmf_tmp || !w->buf || !w->column || w->index_mtype < 0 ||
+        w->ckpt_mtype < 0) {
+        writer_release(w);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
+    }
+    snprintf(w->xmf_tmp, strlen(w->xmf_path) + 5, "%s.tmp", w->xmf_path);
+    const char *slash = strrchr(w->path, '/');
+    w->h5_name = slash ? slash + 1 : w->path;
+    *out = w;
+    return CDEM_OK;
 }
 
 cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,
@@ -669,60 +1003,36 @@ cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, c
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "cdem_h5_writer_create: path, meta, meta->params and out are required");
     quiet_hdf5();
-    cdem_h5_writer *w = calloc(1, sizeof *w);
-    if (!w)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
-    w->file = w->increments = -1;
-    for (size_t c = 0; c < N_SERIES; c++)
-        w->series[c] = -1;
-    w->path = dup_str(path);
-    w->xmf_path = xmf_path_for(path);
-    w->xmf_tmp = w->xmf_path ? malloc(strlen(w->xmf_path) + 5) : NULL;
-    w->buf = malloc(SERIES_BUFFER * sizeof *w->buf);
-    w->column = malloc(SERIES_BUFFER * 8);
-    if (!w->path || !w->xmf_path || !w->xmf_tmp || !w->buf || !w->column) {
+    cdem_h5_writer *w = NULL;
+    CDEM_TRY(writer_alloc(path, &w, err));
+    size_t n = strlen(path) + 10;
+    char *tmp = malloc(n);
+    if (!tmp) {
         writer_release(w);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
     }
-    snprintf(w->xmf_tmp, strlen(w->xmf_path) + 5, "%s.tmp", w->xmf_path);
-    const char *slash = strrchr(w->path, '/');
-    w->h5_name = slash ? slash + 1 : w->path;
-    cdem_status st = writer_setup(w, meta, err);
+    snprintf(tmp, n, "%s.creating", path);
+    cdem_status st = writer_setup(w, meta, tmp, err);
     if (st != CDEM_OK) {
         writer_release(w);
+        remove(tmp);
+        free(tmp);
         return st;
     }
+    free(tmp);
     *out = w;
     return CDEM_OK;
 }
 
-static cdem_status write_element_dataset(cdem_h5_writer *w, hid_t g, const char *gname, size_t k,
-                                         const cdem_state *s, cdem_error *err) {
-    const element_field *fd = &element_fields[k];
-    hsize_t n = s->n;
-    hid_t sp = H5Screate_simple(1, &n, NULL);
-    hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
-    H5Pset_dset_no_attrs_hint(dcpl, 1);
-    H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
-    if (n > 0) {
-        hsize_t chunk = n < CHUNK_ELEMS ? n : CHUNK_ELEMS;
-        H5Pset_chunk(dcpl, 1, &chunk);
-        H5Pset_shuffle(dcpl);
-        H5Pset_deflate(dcpl, DEFLATE_LEVEL);
-        H5Pset_fletcher32(dcpl);
-    }
-    hid_t ds = H5Dcreate2(g, fd->name, el_file_type(fd->type), sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-    int ok = ds >= 0 && (n == 0 || H5Dwrite(ds, el_mem_type(fd->type), H5S_ALL, H5S_ALL,
-                                            H5P_DEFAULT, element_array(s, k)) >= 0);
-    hid_t es = keep_errors(!ok);
-    if (ds >= 0)
-        H5Dclose(ds);
-    H5Pclose(dcpl);
-    H5Sclose(sp);
-    restore_errors(es);
-    if (!ok)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write dataset /increments/%s/%s (%llu values)",
-                      w->path, gname, fd->name, (unsigned long long)n);
+static cdem_status grow_entries(cdem_h5_writer *w, cdem_error *err) {
+    if (w->n_entries < w->cap_entries)
+        return CDEM_OK;
+    size_t cap = w->cap_entries ? 2 * w->cap_entries : 64;
+    xmf_entry *e = realloc(w->entries, cap * sizeof *e);
+    if (!e)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory listing %zu increments", cap);
+    w->entries = e;
+    w->cap_entries = cap;
     return CDEM_OK;
 }
 
@@ -739,49 +1049,71 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "%s: increment %d: the state has %zu elements but missing arrays", w->path,
                          (int)info->number, s->n);
-    char gname[32];
-    snprintf(gname, sizeof gname, "%06d", (int)info->number);
-    if (H5Lexists(w->increments, gname, H5P_DEFAULT) > 0)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: increment %d was already written", w->path,
-                         (int)info->number);
-    if (w->n_entries == w->cap_entries) {
-        size_t cap = w->cap_entries ? 2 * w->cap_entries : 64;
-        xmf_entry *e = realloc(w->entries, cap * sizeof *e);
-        if (!e)
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory listing %zu increments", cap);
-        w->entries = e;
-        w->cap_entries = cap;
-    }
+    if (info->number <= w->last_number)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: increment %d was already written or is out of order (the last "
+                         "written is %d; numbers must increase)",
+                         w->path, (int)info->number, (int)w->last_number);
+    if (w->failed)
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: an earlier write failed; increment %d is not written (the file "
+                         "keeps the %llu increments before)",
+                         w->path, (int)info->number, (unsigned long long)w->index_len);
+    CDEM_TRY(grow_entries(w, err));
     CDEM_TRY(flush_series(w, err));
-
-    /* Keep the 9 attributes and 10 links in the group's object header: past 8 attributes
-     * HDF5 would otherwise move them to a fractal heap + B-tree (+1.8 KB per increment). */
-    hid_t gcpl = untimed_plist(H5P_GROUP_CREATE);
-    H5Pset_attr_phase_change(gcpl, 32, 24);
-    H5Pset_est_link_info(gcpl, (unsigned)N_ELEMENT_FIELDS, 6);
-    hid_t g = H5Gcreate2(w->increments, gname, H5P_DEFAULT, gcpl, H5P_DEFAULT);
-    H5Pclose(gcpl);
-    if (g < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create group /increments/%s", w->path, gname);
-    cdem_status st = CDEM_OK;
-    if (put_i32_attr(g, "number", info->number) < 0 || put_i64_attr(g, "step", info->step) < 0 ||
-        put_f64_attr(g, "time", info->time) < 0 || put_i32_attr(g, "phase", info->phase) < 0 ||
-        put_f64_attr(g, "net_displacement", info->net_displacement) < 0 ||
-        put_f64_attr(g, "axial_strain", info->axial_strain) < 0 ||
-        put_f64_attr(g, "differential_stress", info->differential_stress) < 0 ||
-        put_f64_attr(g, "sea_level", info->sea_level) < 0 ||
-        put_i64_attr(g, "n", (int64_t)s->n) < 0)
-        st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot write the attributes of /increments/%s", w->path,
-                    gname);
-    for (size_t k = 0; st == CDEM_OK && k < N_ELEMENT_FIELDS; k++)
-        if (!element_fields[k].optional || s->has_stress)
-            st = write_element_dataset(w, g, gname, k, s, err);
-    H5Gclose(g);
-    if (st != CDEM_OK)
-        return st;
-    w->entries[w->n_entries++] =
-        (xmf_entry){info->number, info->time, (int64_t)s->n, s->has_stress ? 1 : 0};
+    /* The data first, then (after a flush) the index row: the index is the commit record. */
+    const hsize_t n = s->n;
+    const int stress = s->has_stress && n > 0;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+        const element_field *fd = &element_fields[k];
+        if (fd->optional && !stress)
+            continue;
+        hsize_t start = fd->optional ? w->stress_len : w->data_len;
+        if (write_rows(w->data[k], el_mem_type(fd->type), start, n, element_array(s, k)) < 0) {
+            w->failed = 1;
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot write increment %d to /increments/%s (%llu values; disk "
+                          "full?); the file keeps the %llu increments before",
+                          w->path, (int)info->number, fd->name, (unsigned long long)n,
+                          (unsigned long long)w->index_len);
+        }
+    }
     CDEM_TRY(flush_file(w, err));
+    index_row row = {
+        .number = info->number,
+        .phase = info->phase,
+        .step = info->step,
+        .time = info->time,
+        .net_displacement = info->net_displacement,
+        .axial_strain = info->axial_strain,
+        .differential_stress = info->differential_stress,
+        .sea_level = info->sea_level,
+        .offset = n ? (int64_t)w->data_len : (int64_t)w->data_ext,
+        .n = (int64_t)n,
+        .has_stress = stress,
+        .stress_offset = stress ? (int64_t)w->stress_len : -1,
+    };
+    if (write_rows(w->index, w->index_mtype, w->index_len, 1, &row) < 0) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot write the index row of increment %d (disk full?); the file "
+                      "keeps the %llu increments before",
+                      w->path, (int)info->number, (unsigned long long)w->index_len);
+    }
+    CDEM_TRY(flush_file(w, err));
+    w->index_len++;
+    if (n) {
+        w->data_ext = w->data_len + n;
+        w->data_len = chunk_end(w->data_ext);
+    }
+    if (stress) {
+        w->stress_ext = w->stress_len + n;
+        w->stress_len = chunk_end(w->stress_ext);
+    }
+    w->last_number = info->number;
+    w->last_step = info->step;
+    w->entries[w->n_entries++] =
+        (xmf_entry){info->number, info->time, (int64_t)n, stress, row.offset, row.stress_offset};
     /* Rewriting the whole sidecar costs O(increments); past XMF_EVERY_LIMIT increments it is
      * rewritten only when 5 % more have accumulated (and at close), so a run's total
      * sidecar I/O stays linear in its length. */
@@ -795,8 +1127,12 @@ cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sa
     if (!w || !sample)
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "cdem_h5_writer_append_series: writer and sample are required");
-    if (w->nbuf == SERIES_BUFFER)
+    if (w->nbuf == SERIES_BUFFER) {
+        if (w->failed)
+            return CDEM_FAIL(err, CDEM_ERR_IO, "%s: an earlier write failed; no more samples",
+                             w->path);
         CDEM_TRY(flush_series(w, err));
+    }
     w->buf[w->nbuf++] = *sample;
     return CDEM_OK;
 }
@@ -805,64 +1141,95 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
                                            const char *detail, cdem_error *err) {
     if (!w)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_writer_set_stop_reason: no writer");
-    if (put_str_attr(w->file, "stop_reason", reason) < 0 ||
-        put_str_attr(w->file, "stop_detail", detail) < 0)
+    /* Preallocated datasets: overwriting them needs no new file space (works on a full
+     * disk). The detail is cut to STOP_DETAIL_LEN - 1 bytes. */
+    if (write_fixed_string(w->stop_detail, STOP_DETAIL_LEN, detail) < 0 ||
+        write_fixed_string(w->stop_reason, STOP_REASON_LEN, reason) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write the stop reason '%s'", w->path,
                       reason ? reason : "");
-    return flush_file(w, err);
+    if (H5Dflush(w->stop_detail) < 0 || H5Dflush(w->stop_reason) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s'", w->path,
+                      reason ? reason : "");
+    return CDEM_OK;
 }
 
 cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
     if (!w)
         return CDEM_OK;
-    cdem_status st = flush_series(w, err);
+    cdem_status st = w->failed ? CDEM_OK : flush_series(w, err);
     if (st == CDEM_OK && w->xmf_written != w->n_entries)
         st = write_xmf(w, err);
-    for (size_t c = 0; c < N_SERIES; c++) {
-        if (w->series[c] >= 0 && H5Dclose(w->series[c]) < 0 && st == CDEM_OK)
-            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close /series/%s", w->path,
-                        series_columns[c].name);
-        w->series[c] = -1;
-    }
-    if (w->increments >= 0)
-        H5Gclose(w->increments);
-    w->increments = -1;
-    if (w->file >= 0 && H5Fclose(w->file) < 0 && st == CDEM_OK)
-        st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close the file", w->path);
+    hid_t file = w->file;
     w->file = -1;
+    hid_t es = -1;
+    if (file >= 0) {
+        /* Close the datasets first so that H5Fclose really closes the file. */
+        for (size_t c = 0; c < N_SERIES; c++) {
+            if (w->series[c] >= 0)
+                H5Dclose(w->series[c]);
+            w->series[c] = -1;
+        }
+        for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+            if (w->data[k] >= 0)
+                H5Dclose(w->data[k]);
+            w->data[k] = -1;
+        }
+        hid_t *rest[] = {&w->index,        &w->stop_reason,  &w->stop_detail,
+                         &w->ckpt_data[0], &w->ckpt_data[1], &w->ckpt_index};
+        for (size_t i = 0; i < sizeof rest / sizeof rest[0]; i++) {
+            if (*rest[i] >= 0)
+                H5Dclose(*rest[i]);
+            *rest[i] = -1;
+        }
+        if (H5Fclose(file) < 0 && st == CDEM_OK)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close the file (disk full?)", w->path);
+        es = keep_errors(st != CDEM_OK);
+    }
     writer_release(w);
+    restore_errors(es);
     return st;
 }
 
 /* ------------------------------------------------------------------ reader */
 
 typedef struct {
-    cdem_increment_info info; /* attributes of the group */
-    char name[32];            /* group name under /increments */
+    cdem_increment_info info; /* version 1: attributes of the group; 2: the index row */
+    char name[32];            /* version 1: group name under /increments */
+    int64_t offset;           /* version 2: first row in the element datasets */
+    int64_t stress_offset;    /* version 2: first row in sxx, syy, sxy (-1 without stress) */
 } incr_entry;
 
 struct cdem_h5_reader {
     hid_t file; /* open HDF5 file */
     char *path; /* as given */
     /* Root text attributes, malloc'd, "" when absent. */
-    char *summary;         /* model summary */
-    char *params_text;     /* original parameter-file text */
-    char *stop_reason;     /* "running", "completed", "interrupted", ... */
-    char *stop_detail;     /* free-text diagnosis */
-    char *program_version; /* version of the writing program */
-    char *source;          /* "cdem-run" or "cdem2d-import:<folder>" */
-    char *created;         /* ISO 8601 UTC creation time */
-    long seed;             /* root attribute seed */
-    int unclosed;          /* 1: the writer did not close the file (status flag set) */
-    size_t n_skipped;      /* unclosed file: increments left out as incompletely flushed */
-    incr_entry *incr;      /* increments sorted by number */
-    size_t n_incr;         /* entries in incr */
-    size_t cap_incr;       /* allocated entries */
+    char *summary;                /* model summary */
+    char *params_text;            /* original parameter-file text */
+    char *stop_reason;            /* "running", "completed", "interrupted", ... */
+    char *stop_detail;            /* free-text diagnosis */
+    char *program_version;        /* version of the writing program */
+    char *source;                 /* "cdem-run" or "cdem2d-import:<folder>" */
+    char *created;                /* ISO 8601 UTC creation time */
+    long seed;                    /* root attribute seed */
+    int unclosed;                 /* 1: the writer did not close the file (status flag set) */
+    int version;                  /* format_version of the file: 1 or 2 */
+    int swmr;                     /* 1: opened in SWMR-read mode (writer running or killed) */
+    hid_t data[N_ELEMENT_FIELDS]; /* version 2: /increments/<field>, -1 when not open */
+    hid_t index;                  /* version 2: /increments/index, -1 when not open */
+    size_t n_skipped;             /* unclosed file: increments left out as incompletely flushed */
+    incr_entry *incr;             /* increments sorted by number */
+    size_t n_incr;                /* entries in incr */
+    size_t cap_incr;              /* allocated entries */
 };
 
 void cdem_h5_reader_close(cdem_h5_reader *r) {
     if (!r)
         return;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        if (r->data[k] >= 0)
+            H5Dclose(r->data[k]);
+    if (r->index >= 0)
+        H5Dclose(r->index);
     if (r->file >= 0)
         H5Fclose(r->file);
     free(r->path);
@@ -884,10 +1251,12 @@ static uint64_t le_u64(const unsigned char *b, int size) {
     return v;
 }
 
-/* Looks at the superblock before HDF5 does. Fails on truncation (stored end-of-file beyond
- * the real size); sets *unclosed when a v3 superblock says a writer still has it open. */
-static cdem_status precheck_superblock(const char *path, int *unclosed, cdem_error *err) {
-    *unclosed = 0;
+/* Looks at the superblock before HDF5 does. *status receives the status flags of a v3
+ * superblock (bit 0: open for write, bit 2: open for SWMR write; 0 when closed). Fails on
+ * truncation (stored end-of-file beyond the real size), except for a file open for SWMR
+ * write, whose writer may have moved the end-of-file ahead of the data it is writing. */
+static cdem_status precheck_superblock(const char *path, int *status, cdem_error *err) {
+    *status = 0;
     FILE *f = fopen(path, "rb");
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
@@ -925,15 +1294,16 @@ static cdem_status precheck_superblock(const char *path, int *unclosed, cdem_err
             break;
         }
         uint64_t base = le_u64(b + 12, so), eof = le_u64(b + 12 + 2 * so, so);
-        if (base + eof > size) {
+        int swmr_writer = version == 3 && (b[11] & 0x04);
+        if (base + eof > size && !swmr_writer) {
             st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
                            "%s: truncated file: it has %llu bytes but its HDF5 superblock says "
                            "%llu (copy interrupted or disk full?)",
                            path, (unsigned long long)size, (unsigned long long)(base + eof));
             break;
         }
-        if (version == 3 && (b[11] & 0x05))
-            *unclosed = 1;
+        if (version == 3)
+            *status = b[11] & 0x05;
         break;
     }
     fclose(f);
@@ -1047,6 +1417,173 @@ static cdem_status read_root_text(cdem_h5_reader *r, const char *name, char **ou
     return CDEM_OK;
 }
 
+/* Version 2: reads a scalar fixed-length string dataset (/stop_reason, /stop_detail) into a
+ * malloc'd string (replacing *out). */
+static cdem_status read_text_dataset(cdem_h5_reader *r, const char *name, char **out,
+                                     cdem_error *err) {
+    hid_t ds = H5Dopen2(r->file, name, H5P_DEFAULT);
+    if (ds < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt", r->path, name);
+    if (r->swmr)
+        H5Drefresh(ds);
+    hid_t t = H5Dget_type(ds), sp = H5Dget_space(ds), mt = -1;
+    size_t size =
+        t >= 0 && H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) == 0 ? H5Tget_size(t) : 0;
+    char *buf = NULL;
+    int ok = size > 0 && size <= 65536 && sp >= 0 && H5Sget_simple_extent_npoints(sp) == 1 &&
+             (buf = calloc(size + 1, 1)) != NULL && (mt = H5Tcopy(H5T_C_S1)) >= 0 &&
+             H5Tset_size(mt, size + 1) >= 0 && H5Tset_cset(mt, H5Tget_cset(t)) >= 0 &&
+             H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0;
+    hid_t es = keep_errors(!ok);
+    if (mt >= 0)
+        H5Tclose(mt);
+    if (t >= 0)
+        H5Tclose(t);
+    if (sp >= 0)
+        H5Sclose(sp);
+    H5Dclose(ds);
+    restore_errors(es);
+    if (!ok) {
+        free(buf);
+        return H5FAIL(err, CDEM_ERR_FORMAT,
+                      "%s: dataset /%s is not a readable fixed-length string scalar", r->path,
+                      name);
+    }
+    free(*out);
+    *out = buf;
+    return CDEM_OK;
+}
+
+/* Version 2: (re)reads the index and the stop reason. In SWMR-read mode every dataset is
+ * refreshed first: the index before the element datasets, so that the element datasets are
+ * at least as long as the rows the index lists (the writer writes them in the other order).
+ * In a file whose writer did not close it, the list ends before the first row that is not
+ * backed by data (a kill mid-append); in a closed file such a row is an error. */
+static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
+    CDEM_TRY(read_text_dataset(r, "stop_reason", &r->stop_reason, err));
+    CDEM_TRY(read_text_dataset(r, "stop_detail", &r->stop_detail, err));
+    if (r->index < 0 && (r->index = H5Dopen2(r->file, "increments/index", H5P_DEFAULT)) < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /increments/index is missing or corrupt",
+                      r->path);
+    if (r->swmr && H5Drefresh(r->index) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /increments/index", r->path);
+    hsize_t rows = extent_of(r->index);
+    if (rows > MAX_ELEMENTS)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/index claims %llu rows", r->path,
+                         (unsigned long long)rows);
+    hsize_t data_ext = 0, stress_ext = 0;
+    int first_data = 1, first_stress = 1;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+        const element_field *fd = &element_fields[k];
+        char name[64];
+        snprintf(name, sizeof name, "increments/%s", fd->name);
+        if (r->data[k] < 0) {
+            if ((r->data[k] = H5Dopen2(r->file, name, H5P_DEFAULT)) < 0)
+                return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt",
+                              r->path, name);
+            hid_t t = H5Dget_type(r->data[k]), sp = H5Dget_space(r->data[k]);
+            H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
+            int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+            if (t >= 0)
+                H5Tclose(t);
+            if (sp >= 0)
+                H5Sclose(sp);
+            H5T_class_t want = fd->type == EL_F64 ? H5T_FLOAT : H5T_INTEGER;
+            if (cls != want || rank != 1)
+                return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                                 "%s: dataset /%s has type class %d and rank %d (expected a 1-D "
+                                 "%s dataset)",
+                                 r->path, name, (int)cls, rank,
+                                 want == H5T_FLOAT ? "float" : "integer");
+        } else if (r->swmr && H5Drefresh(r->data[k]) < 0) {
+            return H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /%s", r->path, name);
+        }
+        hsize_t e = extent_of(r->data[k]);
+        if (fd->optional) {
+            stress_ext = first_stress || e < stress_ext ? e : stress_ext;
+            first_stress = 0;
+        } else {
+            data_ext = first_data || e < data_ext ? e : data_ext;
+            first_data = 0;
+        }
+    }
+    index_row *ix = rows ? malloc(rows * sizeof *ix) : NULL;
+    hid_t mt = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
+    cdem_status st = CDEM_OK;
+    if ((rows && !ix) || mt < 0)
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", r->path);
+    else if (rows && read_all_rows(r->index, mt, rows, ix) < 0)
+        st = H5FAIL(err, CDEM_ERR_FORMAT,
+                    "%s: cannot read /increments/index (corrupt, or members missing?)", r->path);
+    if (mt >= 0)
+        H5Tclose(mt);
+    if (st == CDEM_OK && rows > r->cap_incr) {
+        incr_entry *e = realloc(r->incr, rows * sizeof *e);
+        if (!e)
+            st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory listing %llu increments",
+                           (unsigned long long)rows);
+        else {
+            r->incr = e;
+            r->cap_incr = rows;
+        }
+    }
+    r->n_incr = 0;
+    r->n_skipped = 0;
+    int32_t prev = -1;
+    for (hsize_t i = 0; st == CDEM_OK && i < rows; i++) {
+        const char *why = bad_index_row(&ix[i], prev, data_ext, stress_ext);
+        if (why) {
+            if (r->unclosed) {
+                r->n_skipped = (size_t)(rows - i);
+                break;
+            }
+            st =
+                CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/index row %llu (increment %d): %s",
+                          r->path, (unsigned long long)i, (int)ix[i].number, why);
+            break;
+        }
+        prev = ix[i].number;
+        incr_entry *e = &r->incr[r->n_incr++];
+        memset(e, 0, sizeof *e);
+        e->info.number = ix[i].number;
+        e->info.step = ix[i].step;
+        e->info.time = ix[i].time;
+        e->info.phase = ix[i].phase;
+        e->info.net_displacement = ix[i].net_displacement;
+        e->info.axial_strain = ix[i].axial_strain;
+        e->info.differential_stress = ix[i].differential_stress;
+        e->info.sea_level = ix[i].sea_level;
+        e->info.n_elements = ix[i].n;
+        e->info.has_stress = ix[i].has_stress;
+        e->offset = ix[i].offset;
+        e->stress_offset = ix[i].stress_offset;
+        snprintf(e->name, sizeof e->name, "%06d", (int)ix[i].number);
+    }
+    free(ix);
+    return st;
+}
+
+cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *err) {
+    if (!r)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_refresh: no reader");
+    if (changed)
+        *changed = 0;
+    if (!r->swmr)
+        return CDEM_OK; /* a closed file (or version 1) does not change */
+    size_t before = r->n_incr;
+    int32_t last = before ? r->incr[before - 1].info.number : -1;
+    char *reason = dup_str(r->stop_reason);
+    if (!reason)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+    cdem_status st = scan_v2(r, err);
+    if (changed && st == CDEM_OK)
+        *changed = r->n_incr != before ||
+                   (r->n_incr && r->incr[r->n_incr - 1].info.number != last) ||
+                   strcmp(reason, r->stop_reason) != 0;
+    free(reason);
+    return st;
+}
+
 static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     const char *path = r->path;
     struct stat sb;
@@ -1059,18 +1596,33 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     if (is <= 0)
         return H5FAIL(err, CDEM_ERR_FORMAT,
                       "%s: not an HDF5 file (no HDF5 signature), so not a cdem file", path);
-    CDEM_TRY(precheck_superblock(path, &r->unclosed, err));
-    /* A writer that died (or still runs) left the v3 superblock marked "open for write";
-     * HDF5 then refuses a plain open. "clear_status_flags" is the file-access property
-     * h5clear uses; on a read-only open it only skips the check (the file is not changed).
-     * File locking is off for the same case so that a live writer's lock does not block. */
+    int status = 0;
+    CDEM_TRY(precheck_superblock(path, &status, err));
+    r->unclosed = status != 0;
+    /* A writer that still runs or died leaves the v3 superblock's status flags set; HDF5
+     * then refuses a plain open. A version-2 writer runs in SWMR-write mode (flags 0x05):
+     * SWMR-read opens such a file, running or killed, and sees it grow (H5Drefresh). A
+     * version-1 writer (flags 0x01), or a version-2 writer killed before it entered SWMR
+     * mode, needs "clear_status_flags", the file-access property h5clear uses; on a
+     * read-only open it only skips the check (the file is not changed). File locking is
+     * off in both cases so that a live writer's lock does not block the reader. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    if (r->unclosed) {
-        hbool_t clear = 1;
-        H5Pset(fapl, "clear_status_flags", &clear);
-        H5Pset_file_locking(fapl, 0, 1);
+    /* Always off for readers: a process may open the same file twice (cdem-strain render
+     * --follow), and HDF5 refuses a second open whose locking setting differs. */
+    H5Pset_file_locking(fapl, 0, 1);
+    if (status & 0x04) {
+        r->file = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
+        r->swmr = r->file >= 0;
+        if (r->file < 0)
+            H5Eclear2(H5E_DEFAULT);
     }
-    r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    if (r->file < 0) {
+        if (r->unclosed) {
+            hbool_t clear = 1;
+            H5Pset(fapl, "clear_status_flags", &clear);
+        }
+        r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    }
     if (r->file < 0 && r->unclosed) {
         /* The writer may be this very process (HDF5 then shares its open file, and the
          * access properties must match the writer's). */
@@ -1106,22 +1658,25 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
         return H5FAIL(err, CDEM_ERR_FORMAT,
                       "%s: root attribute 'format_version' is %s (an integer is required)", path,
                       rc > 0 ? "missing" : "unreadable");
-    if (version != CDEM_FORMAT_VERSION)
+    if (version != CDEM_FORMAT_VERSION && version != 1)
         return CDEM_FAIL(err, CDEM_ERR_VERSION,
-                         "%s: cdem format version %d; this program reads version %d%s", path,
+                         "%s: cdem format version %d; this program reads versions 1 and %d%s", path,
                          (int)version, CDEM_FORMAT_VERSION,
                          version > CDEM_FORMAT_VERSION ? " (written by a newer cdem-c)" : "");
+    r->version = (int)version;
     int64_t seed = 0;
     if (get_num_attr(r->file, "seed", H5T_NATIVE_INT64, &seed) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: root attribute 'seed' is unreadable", path);
     r->seed = (long)seed;
     CDEM_TRY(read_root_text(r, "summary", &r->summary, err));
     CDEM_TRY(read_root_text(r, "params_text", &r->params_text, err));
-    CDEM_TRY(read_root_text(r, "stop_reason", &r->stop_reason, err));
-    CDEM_TRY(read_root_text(r, "stop_detail", &r->stop_detail, err));
     CDEM_TRY(read_root_text(r, "program_version", &r->program_version, err));
     CDEM_TRY(read_root_text(r, "source", &r->source, err));
     CDEM_TRY(read_root_text(r, "created", &r->created, err));
+    if (r->version >= 2)
+        return scan_v2(r, err);
+    CDEM_TRY(read_root_text(r, "stop_reason", &r->stop_reason, err));
+    CDEM_TRY(read_root_text(r, "stop_detail", &r->stop_detail, err));
 
     htri_t ex = H5Lexists(r->file, "increments", H5P_DEFAULT);
     if (ex <= 0)
@@ -1150,7 +1705,9 @@ cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_err
         free(r);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory opening %s", path);
     }
-    r->file = -1;
+    r->file = r->index = -1;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        r->data[k] = -1;
     cdem_status st = reader_setup(r, err);
     if (st != CDEM_OK) {
         cdem_h5_reader_close(r);
@@ -1305,6 +1862,33 @@ static cdem_status load_into(cdem_h5_reader *r, hid_t g, const incr_entry *e, cd
     return CDEM_OK;
 }
 
+/* Version 2: rows [offset, offset + n) of every element dataset. */
+static cdem_status load_v2(cdem_h5_reader *r, const incr_entry *e, cdem_state *s, cdem_error *err) {
+    const hsize_t n = (hsize_t)e->info.n_elements;
+    const int stress = e->info.has_stress != 0;
+    cdem_state_free(s);
+    CDEM_TRY(cdem_state_init(s, n ? (size_t)n : 1, stress, err));
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+        const element_field *fd = &element_fields[k];
+        if (fd->optional && !stress)
+            continue;
+        hsize_t off = (hsize_t)(fd->optional ? e->stress_offset : e->offset);
+        if (read_rows(r->data[k], el_mem_type(fd->type), off, n, element_array(s, k)) < 0)
+            return H5FAIL(err, CDEM_ERR_FORMAT,
+                          "%s: cannot read rows %llu..%llu of /increments/%s for increment %d "
+                          "(corrupt?)",
+                          r->path, (unsigned long long)off, (unsigned long long)(off + n), fd->name,
+                          (int)e->info.number);
+    }
+    s->n = (size_t)n;
+    int32_t next = 0;
+    for (size_t i = 0; i < s->n; i++)
+        if (s->id[i] >= next)
+            next = s->id[i] == INT32_MAX ? INT32_MAX : s->id[i] + 1;
+    s->next_id = next;
+    return CDEM_OK;
+}
+
 cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_state *s,
                                           cdem_increment_info *info, cdem_error *err) {
     if (!r || !s)
@@ -1313,6 +1897,16 @@ cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: increment index %zu (the file has %zu)",
                          r->path, index, r->n_incr);
     const incr_entry *e = &r->incr[index];
+    if (r->version >= 2) {
+        cdem_status st = load_v2(r, e, s, err);
+        if (st != CDEM_OK) {
+            cdem_state_free(s);
+            return st;
+        }
+        if (info)
+            *info = e->info;
+        return CDEM_OK;
+    }
     char gpath[64];
     snprintf(gpath, sizeof gpath, "increments/%s", e->name);
     hid_t g = H5Gopen2(r->file, gpath, H5P_DEFAULT);
@@ -1362,6 +1956,8 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
         char name[64];
         snprintf(name, sizeof name, "series/%s", series_columns[opened].name);
         ds[opened] = H5Dopen2(r->file, name, H5P_DEFAULT);
+        if (ds[opened] >= 0 && r->swmr)
+            H5Drefresh(ds[opened]);
         if (ds[opened] < 0) {
             st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt", r->path,
                         name);
@@ -1465,6 +2061,16 @@ long cdem_h5_reader_seed(const cdem_h5_reader *r) {
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r) {
     return r ? r->unclosed : 0;
 }
+int cdem_h5_reader_format_version(const cdem_h5_reader *r) {
+    return r ? r->version : 0;
+}
+
+double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress) {
+    /* Measured on the default run (docs/format.md): 16.1 bytes per element and increment
+     * without stress, 40.5 with; plus 64 KiB of metadata and 0.5 KB per increment. */
+    double per = with_stress ? 40.5 : 16.1;
+    return 65536.0 + n_increments * (512.0 + n_elements * per);
+}
 
 cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err) {
     if (!r || !p)
@@ -1504,29 +2110,462 @@ cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_
     return st;
 }
 
+cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err) {
+    if (!path || !*path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_check_free_space: no path");
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    struct statvfs sv;
+    if (statvfs(dir, &sv) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot examine the output directory %s: %s", path,
+                         dir, strerror(errno));
+    double avail = (double)sv.f_bavail * (double)sv.f_frsize;
+    if (avail < bytes_needed)
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: the output needs about %.1f MB but %s has %.1f MB free", path,
+                         bytes_needed / 1e6, dir, avail / 1e6);
+    return CDEM_OK;
+}
+
 /* ------------------------------------------------------------ checkpoints */
-/* Interface agreed for the checkpoint/resume work; storage lands with the SWMR layout. */
+/* A snapshot is stored as one self-describing blob (docs/format.md, "Checkpoints"):
+ *   "CDEMSNAP" | u32 version (1) | u32 array count | u64 blob length |
+ *   per array: u16 name length | name | u8 type | u64 count | count values |
+ *   u64 FNV-1a 64 of every byte before it.
+ * All integers and values little-endian. */
+#define SNAP_MAGIC      "CDEMSNAP"
+#define SNAP_VERSION    1
+#define SNAP_HEADER     24
+#define SNAP_MAX_ARRAYS 100000
+#define SNAP_MAX_BYTES  ((uint64_t)1 << 36)
+
+static int host_little_endian(void) {
+    const uint16_t one = 1;
+    unsigned char b;
+    memcpy(&b, &one, 1);
+    return b == 1;
+}
+
+static void put_le(unsigned char *p, uint64_t v, int bytes) {
+    for (int i = 0; i < bytes; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint64_t get_le(const unsigned char *p, int bytes) {
+    uint64_t v = 0;
+    for (int i = bytes - 1; i >= 0; i--)
+        v = (v << 8) | p[i];
+    return v;
+}
+
+/* Serialises snap into w->ckpt_buf; *len receives the blob length. */
+static cdem_status serialise_snapshot(cdem_h5_writer *w, const cdem_snapshot *snap, size_t *len,
+                                      cdem_error *err) {
+    size_t total = SNAP_HEADER + 8, count = cdem_snapshot_count(snap);
+    for (size_t i = 0; i < count; i++) {
+        const cdem_snapshot_array *a = cdem_snapshot_at(snap, i);
+        size_t bytes = a->count * cdem_snapshot_type_size(a->type);
+        total += 2 + strlen(a->name) + 1 + 8 + bytes;
+    }
+    if (total > w->ckpt_cap) {
+        unsigned char *b = realloc(w->ckpt_buf, total);
+        if (!b)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for a checkpoint of %zu bytes",
+                             w->path, total);
+        w->ckpt_buf = b;
+        w->ckpt_cap = total;
+    }
+    unsigned char *p = w->ckpt_buf;
+    memcpy(p, SNAP_MAGIC, 8);
+    put_le(p + 8, SNAP_VERSION, 4);
+    put_le(p + 12, count, 4);
+    put_le(p + 16, total, 8);
+    size_t at = SNAP_HEADER;
+    for (size_t i = 0; i < count; i++) {
+        const cdem_snapshot_array *a = cdem_snapshot_at(snap, i);
+        size_t nl = strlen(a->name), bytes = a->count * cdem_snapshot_type_size(a->type);
+        put_le(p + at, nl, 2);
+        memcpy(p + at + 2, a->name, nl);
+        at += 2 + nl;
+        p[at++] = (unsigned char)a->type;
+        put_le(p + at, a->count, 8);
+        at += 8;
+        if (bytes)
+            memcpy(p + at, a->data, bytes); /* little-endian host (checked by the caller) */
+        at += bytes;
+    }
+    put_le(p + at, fnv1a64(p, at), 8);
+    *len = at + 8;
+    return CDEM_OK;
+}
+
+/* Parses a blob into snap (cleared first). what names the blob in messages. */
+static cdem_status parse_snapshot(const unsigned char *p, size_t len, cdem_snapshot *snap,
+                                  const char *what, cdem_error *err) {
+    cdem_snapshot_clear(snap);
+    if (len < SNAP_HEADER + 8 || memcmp(p, SNAP_MAGIC, 8) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: not a checkpoint blob (no %s header)", what,
+                         SNAP_MAGIC);
+    uint64_t version = get_le(p + 8, 4), count = get_le(p + 12, 4), total = get_le(p + 16, 8);
+    if (version != SNAP_VERSION)
+        return CDEM_FAIL(err, CDEM_ERR_VERSION,
+                         "%s: checkpoint blob version %llu; this program reads version %d", what,
+                         (unsigned long long)version, SNAP_VERSION);
+    if (total != len)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: checkpoint blob says %llu bytes but has %zu",
+                         what, (unsigned long long)total, len);
+    if (get_le(p + len - 8, 8) != fnv1a64(p, len - 8))
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: checkpoint blob checksum mismatch (torn?)",
+                         what);
+    if (count > SNAP_MAX_ARRAYS)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: checkpoint blob claims %llu arrays", what,
+                         (unsigned long long)count);
+    size_t at = SNAP_HEADER, end = len - 8;
+    for (uint64_t i = 0; i < count; i++) {
+        char name[CDEM_SNAPSHOT_NAME_MAX];
+        if (end - at < 2)
+            goto short_blob;
+        size_t nl = (size_t)get_le(p + at, 2);
+        at += 2;
+        if (nl == 0 || nl >= sizeof name || end - at < nl + 9)
+            goto short_blob;
+        memcpy(name, p + at, nl);
+        name[nl] = '\0';
+        at += nl;
+        int type = p[at++];
+        uint64_t n = get_le(p + at, 8);
+        at += 8;
+        size_t size = cdem_snapshot_type_size((cdem_snapshot_type)type);
+        if (size == 0)
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: array \"%s\" has unknown type %d", what,
+                             name, type);
+        if (n > (end - at) / size)
+            goto short_blob;
+        cdem_status st = cdem_snapshot_put(snap, name, (cdem_snapshot_type)type, (size_t)n,
+                                           n ? p + at : NULL, err);
+        if (st != CDEM_OK) {
+            cdem_snapshot_clear(snap);
+            cdem_error_prefix(err, "%s", what);
+            return st == CDEM_ERR_INVALID ? CDEM_ERR_FORMAT : st;
+        }
+        at += (size_t)n * size;
+    }
+    if (at != end)
+        goto short_blob;
+    return CDEM_OK;
+short_blob:
+    cdem_snapshot_clear(snap);
+    return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                     "%s: checkpoint blob is inconsistent at byte %zu of %zu (array list does not "
+                     "fit its length)",
+                     what, at, len);
+}
+
 cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapshot *snap,
                                             cdem_error *err) {
-    (void)snap;
-    return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED, "%s: checkpoints are not stored by this version",
-                     w ? w->path : "(no file)");
+    if (!w || !snap)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_h5_writer_write_checkpoint: writer and snapshot are required");
+    if (!host_little_endian())
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "%s: checkpoints are stored only on little-endian hosts", w->path);
+    if (w->last_number < 0)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: a checkpoint belongs to the last increment written, and none is",
+                         w->path);
+    if (w->failed)
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: an earlier write failed; no checkpoint written",
+                         w->path);
+    size_t len = 0;
+    CDEM_TRY(serialise_snapshot(w, snap, &len, err));
+    /* Double buffering: overwrite the slot that does not hold the newest checkpoint, flush,
+     * and only then point the index at it. */
+    int slot = w->ckpt[0].sequence > w->ckpt[1].sequence ? 1 : 0;
+    int64_t seq =
+        (w->ckpt[0].sequence > w->ckpt[1].sequence ? w->ckpt[0].sequence : w->ckpt[1].sequence) + 1;
+    if (write_rows(w->ckpt_data[slot], H5T_NATIVE_UINT8, 0, len, w->ckpt_buf) < 0) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot write a checkpoint of %zu bytes to /checkpoint/slot%d (disk "
+                      "full?); the previous checkpoint stays valid",
+                      w->path, len, slot);
+    }
+    CDEM_TRY(flush_file(w, err));
+    ckpt_row row = {seq, w->last_number, w->last_step, (int64_t)len, fnv1a64(w->ckpt_buf, len)};
+    hsize_t start = (hsize_t)slot, one = 1;
+    hid_t fs = H5Dget_space(w->ckpt_index), ms = H5Screate_simple(1, &one, NULL);
+    int ok = fs >= 0 && ms >= 0 &&
+             H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &one, NULL) >= 0 &&
+             H5Dwrite(w->ckpt_index, w->ckpt_mtype, ms, fs, H5P_DEFAULT, &row) >= 0;
+    hid_t es = keep_errors(!ok);
+    if (fs >= 0)
+        H5Sclose(fs);
+    if (ms >= 0)
+        H5Sclose(ms);
+    restore_errors(es);
+    if (!ok) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write /checkpoint/index", w->path);
+    }
+    CDEM_TRY(flush_file(w, err));
+    w->ckpt[slot] = row;
+    return CDEM_OK;
+}
+
+static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t keep_step,
+                                cdem_error *err) {
+    int flags = 0;
+    CDEM_TRY(precheck_superblock(w->path, &flags, err));
+    hid_t fapl = writer_fapl();
+    hbool_t clear = 1;
+    H5Pset(fapl, "clear_status_flags", &clear); /* what h5clear -s does */
+    w->file = H5Fopen(w->path, H5F_ACC_RDWR, fapl);
+    hid_t es = keep_errors(w->file < 0);
+    H5Pclose(fapl);
+    restore_errors(es);
+    if (w->file < 0)
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot open the run file for writing (is its writer still running?)",
+                      w->path);
+    char *fmt = NULL;
+    int32_t version = 0;
+    int rc = get_str_attr(w->file, "format", &fmt);
+    int bad = rc != 0 || strcmp(fmt, CDEM_FORMAT_NAME) != 0;
+    free(fmt);
+    if (bad)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: not a cdem file (root attribute 'format')",
+                      w->path);
+    if (get_num_attr(w->file, "format_version", H5T_NATIVE_INT32, &version) != 0 ||
+        version != CDEM_FORMAT_VERSION)
+        return CDEM_FAIL(err, version == 1 ? CDEM_ERR_UNSUPPORTED : CDEM_ERR_VERSION,
+                         "%s: cdem format version %d cannot be resumed (only version %d files "
+                         "hold checkpoints)",
+                         w->path, (int)version, CDEM_FORMAT_VERSION);
+    char name[64];
+    for (size_t c = 0; c < N_SERIES; c++) {
+        snprintf(name, sizeof name, "series/%s", series_columns[c].name);
+        if ((w->series[c] = H5Dopen2(w->file, name, H5P_DEFAULT)) < 0)
+            return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing", w->path, name);
+    }
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+        snprintf(name, sizeof name, "increments/%s", element_fields[k].name);
+        if ((w->data[k] = H5Dopen2(w->file, name, H5P_DEFAULT)) < 0)
+            return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing", w->path, name);
+    }
+    if ((w->index = H5Dopen2(w->file, "increments/index", H5P_DEFAULT)) < 0 ||
+        (w->stop_reason = H5Dopen2(w->file, "stop_reason", H5P_DEFAULT)) < 0 ||
+        (w->stop_detail = H5Dopen2(w->file, "stop_detail", H5P_DEFAULT)) < 0 ||
+        (w->ckpt_index = H5Dopen2(w->file, "checkpoint/index", H5P_DEFAULT)) < 0 ||
+        (w->ckpt_data[0] = H5Dopen2(w->file, "checkpoint/slot0", H5P_DEFAULT)) < 0 ||
+        (w->ckpt_data[1] = H5Dopen2(w->file, "checkpoint/slot1", H5P_DEFAULT)) < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: a version-2 dataset is missing", w->path);
+
+    /* Increments to keep: the valid prefix of the index up to keep_inc. */
+    hsize_t rows = extent_of(w->index), data_ext = extent_of(w->data[0]),
+            stress_ext = extent_of(w->data[7]);
+    for (size_t k = 1; k < N_ELEMENT_FIELDS; k++) {
+        hsize_t e = extent_of(w->data[k]);
+        if (element_fields[k].optional)
+            stress_ext = e < stress_ext ? e : stress_ext;
+        else
+            data_ext = e < data_ext ? e : data_ext;
+    }
+    index_row *ix = rows ? malloc(rows * sizeof *ix) : NULL;
+    if (rows && !ix)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", w->path);
+    if (rows && read_all_rows(w->index, w->index_mtype, rows, ix) < 0) {
+        free(ix);
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /increments/index", w->path);
+    }
+    hsize_t keep = 0;
+    int32_t prev = -1;
+    while (keep < rows && ix[keep].number <= keep_inc &&
+           !bad_index_row(&ix[keep], prev, data_ext, stress_ext))
+        prev = ix[keep++].number;
+    cdem_status st = CDEM_OK;
+    w->data_len = w->stress_len = 0;
+    for (hsize_t i = 0; i < keep && st == CDEM_OK; i++) {
+        w->data_len = (hsize_t)(ix[i].offset + ix[i].n);
+        if (ix[i].has_stress)
+            w->stress_len = (hsize_t)(ix[i].stress_offset + ix[i].n);
+        st = grow_entries(w, err);
+        if (st == CDEM_OK)
+            w->entries[w->n_entries++] =
+                (xmf_entry){ix[i].number,     ix[i].time,   ix[i].n,
+                            ix[i].has_stress, ix[i].offset, ix[i].stress_offset};
+    }
+    w->index_len = keep;
+    w->last_number = keep ? ix[keep - 1].number : -1;
+    w->last_step = keep ? ix[keep - 1].step : 0;
+    free(ix);
+    CDEM_TRY(st);
+    /* Series samples to keep: the leading ones with step <= keep_step. */
+    hsize_t slen = extent_of(w->series[0]);
+    for (size_t c = 1; c < N_SERIES; c++) {
+        hsize_t e = extent_of(w->series[c]);
+        slen = e < slen ? e : slen;
+    }
+    int64_t *steps = slen ? malloc(slen * sizeof *steps) : NULL;
+    if (slen && !steps)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the series of %s", w->path);
+    if (slen && read_rows(w->series[0], H5T_NATIVE_INT64, 0, slen, steps) < 0) {
+        free(steps);
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /series/step", w->path);
+    }
+    hsize_t skeep = 0;
+    while (skeep < slen && steps[skeep] <= keep_step)
+        skeep++;
+    free(steps);
+    w->series_len = skeep;
+    /* Shrink everything to what is kept. */
+    int ok = 1;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        ok = ok && H5Dset_extent(w->data[k],
+                                 element_fields[k].optional ? &w->stress_len : &w->data_len) >= 0;
+    for (size_t c = 0; c < N_SERIES; c++)
+        ok = ok && H5Dset_extent(w->series[c], &w->series_len) >= 0;
+    ok = ok && H5Dset_extent(w->index, &w->index_len) >= 0;
+    if (!ok)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot truncate the datasets to increment %d", w->path,
+                      (int)keep_inc);
+    w->data_ext = w->data_len;
+    w->stress_ext = w->stress_len;
+    w->data_len = chunk_end(w->data_len);
+    w->stress_len = chunk_end(w->stress_len);
+    /* Checkpoints of dropped increments are invalidated. */
+    if (read_all_rows(w->ckpt_index, w->ckpt_mtype, 2, w->ckpt) < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /checkpoint/index", w->path);
+    for (int s = 0; s < 2; s++)
+        if (w->ckpt[s].sequence > 0 && w->ckpt[s].increment > w->last_number) {
+            int64_t seq = w->ckpt[s].sequence;
+            memset(&w->ckpt[s], 0, sizeof w->ckpt[s]);
+            w->ckpt[s].sequence = -seq; /* keeps sequence numbers increasing */
+        }
+    if (write_rows(w->ckpt_index, w->ckpt_mtype, 0, 2, w->ckpt) < 0 ||
+        write_fixed_string(w->stop_reason, STOP_REASON_LEN, "running") < 0 ||
+        write_fixed_string(w->stop_detail, STOP_DETAIL_LEN, "") < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot reset the checkpoint index and stop reason",
+                      w->path);
+    for (int s = 0; s < 2; s++)
+        if (w->ckpt[s].sequence < 0)
+            w->ckpt[s].sequence = 0;
+    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(start_swmr(w, err));
+    CDEM_TRY(write_xmf(w, err));
+    return CDEM_OK;
 }
 
 cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increment,
                                   int64_t keep_through_step, cdem_h5_writer **out,
                                   cdem_error *err) {
-    (void)keep_through_increment;
-    (void)keep_through_step;
-    *out = NULL;
-    return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
-                     "%s: resuming a run is not supported by this version", path);
+    if (out)
+        *out = NULL;
+    if (!path || !*path || !out)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_writer_reopen: path and out are required");
+    quiet_hdf5();
+    cdem_h5_writer *w = NULL;
+    CDEM_TRY(writer_alloc(path, &w, err));
+    cdem_status st = reopen_setup(w, keep_through_increment, keep_through_step, err);
+    if (st != CDEM_OK) {
+        writer_release(w);
+        return st;
+    }
+    *out = w;
+    return CDEM_OK;
 }
 
 cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *snap,
                                            int32_t *increment_number, cdem_error *err) {
-    (void)snap;
+    if (!r || !snap || !increment_number)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_read_checkpoint: bad arguments");
     *increment_number = -1;
-    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: the file holds no checkpoint",
-                     r ? r->path : "(no file)");
+    cdem_snapshot_clear(snap);
+    if (r->version < 2)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "%s: the file holds no checkpoint (format version %d has none)", r->path,
+                         r->version);
+    if (!host_little_endian())
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "%s: checkpoints are read only on little-endian hosts", r->path);
+    hid_t ix = H5Dopen2(r->file, "checkpoint/index", H5P_DEFAULT);
+    hid_t slot[2] = {H5Dopen2(r->file, "checkpoint/slot0", H5P_DEFAULT),
+                     H5Dopen2(r->file, "checkpoint/slot1", H5P_DEFAULT)};
+    hid_t mt = make_compound(ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 0);
+    ckpt_row rows[2];
+    memset(rows, 0, sizeof rows);
+    cdem_status st = CDEM_OK;
+    if (ix < 0 || slot[0] < 0 || slot[1] < 0 || mt < 0)
+        st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: the /checkpoint datasets are missing or corrupt",
+                    r->path);
+    if (st == CDEM_OK && r->swmr)
+        for (int s = 0; s < 2; s++)
+            H5Drefresh(slot[s]);
+    if (st == CDEM_OK && r->swmr)
+        H5Drefresh(ix);
+    if (st == CDEM_OK && (extent_of(ix) != 2 || read_all_rows(ix, mt, 2, rows) < 0))
+        st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: /checkpoint/index is unreadable (2 rows expected)",
+                    r->path);
+    char why[2][CDEM_ERROR_MSG_MAX / 2];
+    why[0][0] = why[1][0] = '\0';
+    int tried = 0, found = 0;
+    int order[2] = {rows[0].sequence >= rows[1].sequence ? 0 : 1,
+                    rows[0].sequence >= rows[1].sequence ? 1 : 0};
+    for (int o = 0; st == CDEM_OK && o < 2 && !found; o++) {
+        int s = order[o];
+        if (rows[s].sequence <= 0)
+            continue;
+        tried++;
+        hsize_t ext = extent_of(slot[s]);
+        if (rows[s].length < SNAP_HEADER + 8 || (uint64_t)rows[s].length > SNAP_MAX_BYTES ||
+            (hsize_t)rows[s].length > ext) {
+            snprintf(why[o], sizeof why[o], "slot%d: length %lld does not fit (slot has %llu)", s,
+                     (long long)rows[s].length, (unsigned long long)ext);
+            continue;
+        }
+        size_t len = (size_t)rows[s].length;
+        unsigned char *buf = malloc(len);
+        if (!buf) {
+            st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading a checkpoint of %zu bytes",
+                           len);
+            break;
+        }
+        if (read_rows(slot[s], H5T_NATIVE_UINT8, 0, len, buf) < 0) {
+            H5Eclear2(H5E_DEFAULT);
+            snprintf(why[o], sizeof why[o], "slot%d: unreadable", s);
+        } else if (fnv1a64(buf, len) != rows[s].checksum) {
+            snprintf(why[o], sizeof why[o], "slot%d (sequence %lld): checksum mismatch", s,
+                     (long long)rows[s].sequence);
+        } else {
+            char what[1200];
+            snprintf(what, sizeof what, "%s: /checkpoint/slot%d", r->path, s);
+            cdem_error e2;
+            cdem_error_clear(&e2);
+            if (parse_snapshot(buf, len, snap, what, &e2) == CDEM_OK) {
+                found = 1;
+                *increment_number = rows[s].increment;
+            } else {
+                snprintf(why[o], sizeof why[o], "%.400s", e2.msg);
+            }
+        }
+        free(buf);
+    }
+    if (mt >= 0)
+        H5Tclose(mt);
+    for (int s = 0; s < 2; s++)
+        if (slot[s] >= 0)
+            H5Dclose(slot[s]);
+    if (ix >= 0)
+        H5Dclose(ix);
+    if (st != CDEM_OK || found)
+        return st;
+    if (tried == 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: the file holds no checkpoint", r->path);
+    return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: no valid checkpoint (%s%s%s)", r->path, why[0],
+                     why[0][0] && why[1][0] ? "; " : "", why[1]);
 }

@@ -28,7 +28,7 @@
 #include <stdint.h>
 
 #define CDEM_FORMAT_NAME    "cdem-c"
-#define CDEM_FORMAT_VERSION 1
+#define CDEM_FORMAT_VERSION 2
 
 typedef enum {
     CDEM_PHASE_EQUILIBRATION = 0, /* walls still, assembly settling */
@@ -155,6 +155,25 @@ const char *cdem_h5_reader_stop_detail(const cdem_h5_reader *r);
 const char *cdem_h5_reader_source(const cdem_h5_reader *r);
 const char *cdem_h5_reader_created(const cdem_h5_reader *r);
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r);
+
+/* Added with format version 2: re-reads the increment list and the stop reason of a file
+ * that is being written (SWMR-read mode); *changed (may be NULL) becomes 1 when the list or
+ * the stop reason changed. For a closed file or a version-1 file it changes nothing.
+ * Increment indices of earlier increments stay valid (increments are only appended). */
+cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *err);
+
+/* The file format version of the open file (1 or CDEM_FORMAT_VERSION). */
+int cdem_h5_reader_format_version(const cdem_h5_reader *r);
+
+/* Estimated size in bytes of a run file with n_elements elements in each of n_increments
+ * increments (stress stored when with_stress), from the measured compression of the
+ * default run (docs/format.md, "Size"); for the free-space check before a run. */
+double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress);
+
+/* Checks, before a run starts, that the directory of path has at least bytes_needed bytes
+ * free for an unprivileged user (statvfs). Fails with CDEM_ERR_IO naming the directory, the
+ * estimate and the free space when it has not (or when it cannot be examined). */
+cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */
 /* Loads the newest complete checkpoint into snap (cleared first) and the number of the

@@ -37,6 +37,7 @@ static void on_signal(int sig) {
 static const char usage_text[] =
     "usage: cdem-run [MODEL.ini] [-o OUT.h5] [-s section.key=value]... [-q] [--summary]\n"
     "                [--dry-run] [--print-defaults] [--params-markdown] [--max-steps N]\n"
+    "                [--ignore-free-space]\n"
     "                [--version] [-h|--help]\n"
     "       cdem-run --resume RUN.h5 [-q] [--max-steps N]\n"
     "\n"
@@ -60,6 +61,8 @@ static const char usage_text[] =
     "                       bit-identical to an uninterrupted run\n"
     "  --par-min N          run loops of N or more items on several threads (default\n"
     "                       16384; results are identical for any N and thread count)\n"
+    "  --ignore-free-space  run even when the output directory has less free space than\n"
+    "                       the estimated file size\n"
     "  --version            print the version and exit\n"
     "  -h, --help           print this help and exit\n"
     "\n"
@@ -100,6 +103,7 @@ typedef struct {
     long max_steps;          /* --max-steps, 0 = no limit */
     const char *resume_path; /* --resume RUN.h5, or NULL */
     long par_min;            /* --par-min, 0 = default */
+    int ignore_free_space;   /* --ignore-free-space */
 } cli_args;
 
 /* Returns EXIT_OK or EXIT_USAGE (message already printed). */
@@ -130,6 +134,8 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->overrides[a->n_overrides++] = argv[++i];
         } else if (strncmp(arg, "-s", 2) == 0 && strchr(arg, '=')) {
             a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
+        } else if (strcmp(arg, "--ignore-free-space") == 0) {
+            a->ignore_free_space = 1;
         } else if (strcmp(arg, "--max-steps") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a number of time steps", arg);
@@ -348,6 +354,7 @@ int main(int argc, char **argv) {
         .stop_requested = &stop_requested,
         .max_steps = a.max_steps,
         .par_min = a.par_min,
+        .ignore_free_space = a.ignore_free_space,
     };
     cdem_status st = cdem_run(&p, &opt, &err);
     free(params_text);

@@ -346,6 +346,19 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
         .program_version = CDEM_VERSION,
         .source = "cdem-run",
     };
+    if (r->opt->output_path && !r->opt->ignore_free_space) {
+        /* A full disk is reported now, not hours into the run. */
+        const double need = cdem_h5_estimate_file_size(
+            (double)r->s.n, (double)r->m.n_increments_total + 1.0, r->p->calculate_stress);
+        if (cdem_h5_check_free_space(r->opt->output_path, need, err) != CDEM_OK) {
+            char msg[CDEM_ERROR_MSG_MAX];
+            snprintf(msg, sizeof msg, "%s", err ? err->msg : "not enough free space");
+            return CDEM_FAIL(err, CDEM_ERR_IO,
+                             "%.400s (estimated from %zu elements x %d increments); free some "
+                             "space, write elsewhere (-o) or run anyway with --ignore-free-space",
+                             msg, r->s.n, r->m.n_increments_total + 1);
+        }
+    }
     if (r->opt->output_path)
         CDEM_TRY(cdem_h5_writer_create(r->opt->output_path, &meta, &r->w, err));
     r->step = 0;
@@ -656,9 +669,11 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
             /* record the diagnosis in the file; keep the original error */
             cdem_error e2;
             cdem_error_clear(&e2);
-            (void)cdem_h5_writer_set_stop_reason(
-                r->w, st == CDEM_ERR_NUMERIC ? "numerical-failure" : "error",
-                err ? err->msg : cdem_status_str(st), &e2);
+            (void)cdem_h5_writer_set_stop_reason(r->w,
+                                                 st == CDEM_ERR_NUMERIC ? "numerical-failure"
+                                                 : st == CDEM_ERR_IO    ? "write-failure"
+                                                                        : "error",
+                                                 err ? err->msg : cdem_status_str(st), &e2);
         }
         cdem_error e3;
         cdem_error_clear(&e3);

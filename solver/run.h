@@ -24,6 +24,7 @@ typedef struct {
     long max_steps;                        /* > 0: stop after this many steps (tests, benchmarks) */
     long par_min;                          /* > 0: the integrator's par_min (loops shorter than this
                                               run on one thread; determinism tests); 0: default */
+    int ignore_free_space;                 /* 1: skip the free-space check before the run */
 } cdem_run_options;
 
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was

@@ -318,7 +318,9 @@ static void test_format_roundtrip_all_fields(void **state) {
                  "p=f['parameters']; v=p.attrs['time.runtime']; "
                  "v=v.decode() if isinstance(v,bytes) else v; "
                  "assert float(v)==5000.0, v; assert f.attrs['format'] in (b'cdem-c','cdem-c'); "
-                 "assert f['increments/000003/x'].shape==(40,); "
+                 "ix=f['increments/index'][:]; assert len(ix)==4; r=ix[3]; "
+                 "x=f['increments/x'][r['offset']:r['offset']+r['n']]; assert x.shape==(60,); "
+                 "assert f['stop_reason'][()]==b'interrupted'; "
                  "assert f['series/step'].shape==(700,)\" '%s' 2>/dev/null",
                  path);
         int rc = system(cmd);
@@ -414,19 +416,15 @@ static void test_format_missing_optional_stress(void **state) {
     assert_int_equal(s.has_stress, 1);
     cdem_h5_reader_close(r);
 
-    /* Delete syy of increment 1 and x of increment 2 with the HDF5 API. */
+    /* Delete /increments/syy with the HDF5 API: the file is refused, naming it. */
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
-    assert_true(H5Ldelete(f, "increments/000001/syy", H5P_DEFAULT) >= 0);
-    assert_true(H5Ldelete(f, "increments/000002/x", H5P_DEFAULT) >= 0);
+    assert_true(H5Ldelete(f, "increments/syy", H5P_DEFAULT) >= 0);
     H5Fclose(f);
-    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
-    assert_int_equal(cdem_h5_reader_load_increment(r, 1, &s, &in, &err), CDEM_ERR_FORMAT);
-    assert_non_null(strstr(err.msg, "/increments/000001 has 2 of the 3 stress datasets"));
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "dataset /increments/syy is missing"));
     assert_non_null(strstr(err.msg, path));
-    assert_int_equal(cdem_h5_reader_load_increment(r, 2, &s, &in, &err), CDEM_ERR_FORMAT);
-    assert_non_null(strstr(err.msg, "/increments/000002/x is missing"));
-    cdem_h5_reader_close(r);
+    assert_null(r);
     cdem_state_free(&s);
     remove_pair(path);
 }
@@ -437,37 +435,39 @@ static void test_format_inconsistent_datasets(void **state) {
     char path[1024];
     tmp_file(path, sizeof path, "inconsistent.h5");
     write_small(path, 2, 1);
+    /* radius one row short: the index row of increment 1 points beyond it. */
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
-    assert_true(H5Ldelete(f, "increments/000000/radius", H5P_DEFAULT) >= 0);
-    assert_true(H5Ldelete(f, "increments/000001/layer", H5P_DEFAULT) >= 0);
-    hsize_t n = 39;
-    hid_t sp = H5Screate_simple(1, &n, NULL);
-    double zeros[40] = {0};
-    hid_t ds = H5Dcreate2(f, "increments/000000/radius", H5T_IEEE_F64LE, sp, H5P_DEFAULT,
-                          H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, zeros);
-    H5Dclose(ds);
+    hid_t ds = H5Dopen2(f, "increments/radius", H5P_DEFAULT);
+    hsize_t n = 0;
+    hid_t sp = H5Dget_space(ds);
+    H5Sget_simple_extent_dims(sp, &n, NULL);
     H5Sclose(sp);
-    n = 40;
+    n -= 1;
+    assert_true(H5Dset_extent(ds, &n) >= 0);
+    H5Dclose(ds);
+    H5Fclose(f);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "/increments/index row 1 (increment 1)"));
+    assert_non_null(strstr(err.msg, "beyond the element datasets"));
+    /* layer replaced by a float dataset: refused, naming it. */
+    write_small(path, 2, 1);
+    f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(H5Ldelete(f, "increments/layer", H5P_DEFAULT) >= 0);
+    n = 80;
     sp = H5Screate_simple(1, &n, NULL);
-    ds = H5Dcreate2(f, "increments/000001/layer", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+    double zeros[80] = {0};
+    ds = H5Dcreate2(f, "increments/layer", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT,
                     H5P_DEFAULT);
     H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, zeros);
     H5Dclose(ds);
     H5Sclose(sp);
     H5Fclose(f);
-    cdem_error err;
-    cdem_h5_reader *r = NULL;
-    cdem_state s = {0};
-    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
-    assert_int_equal(cdem_h5_reader_load_increment(r, 0, &s, NULL, &err), CDEM_ERR_FORMAT);
-    assert_non_null(strstr(err.msg, "/increments/000000/radius has rank 1 and length 39"));
-    assert_int_equal(cdem_h5_reader_load_increment(r, 1, &s, NULL, &err), CDEM_ERR_FORMAT);
-    assert_non_null(strstr(err.msg, "/increments/000001/layer has type class"));
-    assert_non_null(strstr(err.msg, "expected integer"));
-    cdem_h5_reader_close(r);
-    cdem_state_free(&s);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "/increments/layer has type class"));
+    assert_non_null(strstr(err.msg, "integer"));
     remove_pair(path);
 }
 
@@ -618,7 +618,7 @@ static void test_format_version_mismatch(void **state) {
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_VERSION);
     assert_null(r);
     assert_non_null(strstr(err.msg, "format version 7"));
-    assert_non_null(strstr(err.msg, "reads version 1"));
+    assert_non_null(strstr(err.msg, "reads versions 1 and 2"));
     assert_non_null(strstr(err.msg, path));
     remove_pair(path);
 }
@@ -783,15 +783,20 @@ static void test_format_find_increment_specs(void **state) {
     cdem_h5_writer *w = NULL;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
-    /* Written out of order, with numbers >= 1000000 (group name longer than 6 digits):
-     * the reader sorts by the number attribute, not the name. */
-    const int numbers[] = {12, 3, 1000001, 0, 7, 56};
-    const int phases[] = {1, 0, 2, 0, 0, 1};
+    /* Numbers with gaps, one >= 1000000. Numbers must increase: an older or repeated
+     * number is refused. */
+    const int numbers[] = {0, 3, 7, 12, 56, 1000001};
+    const int phases[] = {0, 0, 0, 1, 1, 2};
     for (size_t i = 0; i < 6; i++) {
         cdem_state s;
         make_state(&s, 5, i, 0);
         cdem_increment_info info = make_info(numbers[i], phases[i]);
         assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+        if (i == 3) {
+            info.number = 7;
+            assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_ERR_INVALID);
+            assert_non_null(strstr(err.msg, "increment 7 was already written or is out of order"));
+        }
         cdem_state_free(&s);
     }
     assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
@@ -1143,8 +1148,13 @@ static void test_format_xmf_sidecar(void **state) {
     assert_non_null(strstr(text, "CollectionType=\"Temporal\""));
     assert_non_null(strstr(text, "GeometryType=\"X_Y\""));
     assert_non_null(strstr(text, "TopologyType=\"Polyvertex\""));
-    assert_null(strstr(text, "/increments/000000/sxx")); /* increment 0 has no stress */
-    assert_non_null(strstr(text, "/increments/000001/sxx"));
+    assert_non_null(strstr(text, "ItemType=\"HyperSlab\""));
+    /* increment 0 has no stress, increment 1 has */
+    char *g0 = strstr(text, "increment_000000"), *g1 = strstr(text, "increment_000001");
+    char *g2 = strstr(text, "increment_000002");
+    assert_true(g0 && g1 && g2 && g0 < g1 && g1 < g2);
+    char *sxx = strstr(text, ":/increments/sxx");
+    assert_true(sxx && sxx > g1 && sxx < g2);
 
     hid_t h5 = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     assert_true(h5 >= 0);
@@ -1152,11 +1162,24 @@ static void test_format_xmf_sidecar(void **state) {
     char escaped[1100] = "";
     for (const char *c = base; *c; c++)
         strcat(escaped, *c == '&' ? "&amp;" : (char[2]){*c, 0});
+    /* Every hyperslab (start 1 count) selects rows of the referenced dataset that exist,
+     * and the rows it selects hold the increment's values. */
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
     int items = 0;
-    for (char *p = strstr(text, "<DataItem"); p; p = strstr(p + 1, "<DataItem")) {
-        char *open_end = strchr(p, '>'), *close = strstr(p, "</DataItem>");
-        assert_non_null(open_end);
-        assert_non_null(close);
+    for (char *p = strstr(text, "<DataItem ItemType=\"HyperSlab\""); p;
+         p = strstr(p + 1, "<DataItem ItemType=\"HyperSlab\"")) {
+        long long start = -1, stride = -1, count = -1;
+        char *sel = strstr(p, "Format=\"XML\">");
+        assert_non_null(sel);
+        assert_int_equal(sscanf(sel + 13, "%lld %lld %lld", &start, &stride, &count), 3);
+        assert_int_equal(stride, 1);
+        assert_int_equal(strtol(strstr(p, "Dimensions=\"") + 12, NULL, 10), count);
+        char *hdf = strstr(sel, "Format=\"HDF\">");
+        assert_non_null(hdf);
+        long total = strtol(strstr(sel + 20, "Dimensions=\"") + 12, NULL, 10);
+        char *open_end = strchr(hdf, '>'), *close = strstr(hdf, "</DataItem>");
         char ref[512];
         snprintf(ref, sizeof ref, "%.*s", (int)(close - open_end - 1), open_end + 1);
         char *colon = strstr(ref, ":/");
@@ -1164,19 +1187,42 @@ static void test_format_xmf_sidecar(void **state) {
         *colon = '\0';
         assert_string_equal(ref, escaped); /* relative reference to the .h5 next to it */
         const char *obj = colon + 1;
-        long dims = strtol(strstr(p, "Dimensions=\"") + 12, NULL, 10);
-        assert_true(H5Lexists(h5, "/increments", H5P_DEFAULT) > 0);
         hid_t ds = H5Dopen2(h5, obj, H5P_DEFAULT);
         if (ds < 0)
             fail_msg("%s references %s, which %s lacks", xmf, obj, path);
         hid_t sp = H5Dget_space(ds);
         hsize_t n = 0;
         H5Sget_simple_extent_dims(sp, &n, NULL);
-        assert_int_equal((long)n, dims);
+        assert_int_equal((long)n, total);
+        assert_true(start + count <= (long long)n);
+        if (!strcmp(obj, "/increments/x")) {
+            /* the grid's increment: the number in the enclosing Grid name */
+            char *g = p;
+            while (g > text && strncmp(g, "increment_", 10) != 0)
+                g--;
+            int number = atoi(g + 10);
+            size_t idx = 0;
+            char spec[16];
+            snprintf(spec, sizeof spec, "%d", number);
+            assert_int_equal(cdem_h5_reader_find_increment(r, spec, &idx, &err), CDEM_OK);
+            cdem_state st = {0};
+            assert_int_equal(cdem_h5_reader_load_increment(r, idx, &st, NULL, &err), CDEM_OK);
+            double *vals = malloc((size_t)count * sizeof *vals);
+            hsize_t hs = (hsize_t)start, hc = (hsize_t)count;
+            hid_t ms = H5Screate_simple(1, &hc, NULL);
+            H5Sselect_hyperslab(sp, H5S_SELECT_SET, &hs, NULL, &hc, NULL);
+            assert_true(H5Dread(ds, H5T_NATIVE_DOUBLE, ms, sp, H5P_DEFAULT, vals) >= 0);
+            for (long long i = 0; i < count; i++)
+                assert_true(vals[i] == st.x[i]);
+            H5Sclose(ms);
+            free(vals);
+            cdem_state_free(&st);
+        }
         H5Sclose(sp);
         H5Dclose(ds);
         items++;
     }
+    cdem_h5_reader_close(r);
     /* 3 increments x (x, y, radius, layer, id, flags, born) + stress in increment 1. */
     assert_int_equal(items, 3 * 7 + 3);
     H5Fclose(h5);
@@ -1185,6 +1231,415 @@ static void test_format_xmf_sidecar(void **state) {
     char tmp[1200];
     snprintf(tmp, sizeof tmp, "%s.tmp", xmf);
     assert_int_equal(access(tmp, F_OK), -1);
+    remove_pair(path);
+}
+
+/* ------------------------------------------------------------------ version 1 files */
+
+/* tests/data/format_v1.h5 was written by the version-1 writer (one group per increment):
+ * 4 increments of 20 + 3k elements, x = 100 i + 0.5 k, stress in odd increments. */
+static void test_format_reads_version_1(void **state) {
+    (void)state;
+    const char *dir = getenv("CDEM_TEST_DATA");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/format_v1.h5", dir && *dir ? dir : "tests/data");
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(cdem_h5_reader_format_version(r), 1);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "completed");
+    assert_string_equal(cdem_h5_reader_stop_detail(r), "fixture for the version-1 reader");
+    assert_int_equal(cdem_h5_reader_increment_count(r), 4);
+    cdem_state s = {0};
+    for (size_t k = 0; k < 4; k++) {
+        cdem_increment_info in;
+        assert_int_equal(cdem_h5_reader_load_increment(r, k, &s, &in, &err), CDEM_OK);
+        assert_int_equal(in.number, (int)k);
+        assert_int_equal(in.step, 1000 * (int)k + 7);
+        assert_int_equal(s.n, 20 + 3 * k);
+        assert_int_equal(s.has_stress, (int)(k % 2));
+        for (size_t i = 0; i < s.n; i++) {
+            assert_true(s.x[i] == 100.0 * (double)i + 0.5 * (double)k);
+            assert_int_equal(s.born[i], (int)k);
+            if (k % 2)
+                assert_true(s.sxx[i] == 1e6 * (double)i);
+        }
+    }
+    cdem_series_sample *smp = NULL;
+    size_t ns = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);
+    assert_int_equal(ns, 12);
+    assert_int_equal(smp[11].step, 1100);
+    free(smp);
+    int changed = 1;
+    assert_int_equal(cdem_h5_reader_refresh(r, &changed, &err), CDEM_OK);
+    assert_int_equal(changed, 0);
+    cdem_snapshot *snap = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    int32_t inc = 7;
+    assert_int_equal(cdem_h5_reader_read_checkpoint(r, snap, &inc, &err), CDEM_ERR_NOTFOUND);
+    assert_non_null(strstr(err.msg, "no checkpoint (format version 1"));
+    assert_int_equal(inc, -1);
+    cdem_snapshot_free(snap);
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    /* A version-1 file cannot be resumed. */
+    cdem_h5_writer *w = NULL;
+    char copy[1100];
+    tmp_file(copy, sizeof copy, "v1copy.h5");
+    copy_truncated(path, copy, file_size(path));
+    assert_int_equal(cdem_h5_writer_reopen(copy, 3, 10000, &w, &err), CDEM_ERR_UNSUPPORTED);
+    assert_non_null(strstr(err.msg, "version 1 cannot be resumed"));
+    assert_null(w);
+    remove_pair(copy);
+}
+
+/* ------------------------------------------------------------------ checkpoints */
+
+/* A snapshot with every type, a 0-count array and values derived from tag. */
+static cdem_snapshot *make_snapshot(int tag) {
+    cdem_error err;
+    cdem_snapshot *s = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&s, &err), CDEM_OK);
+    double f[300];
+    int64_t i64[5];
+    int32_t i32[7];
+    uint32_t u32[3];
+    uint8_t u8[11];
+    for (int i = 0; i < 300; i++)
+        f[i] = 1.0 / (i + 1) + tag;
+    for (int i = 0; i < 5; i++)
+        i64[i] = (int64_t)1 << (40 + i + tag % 3);
+    for (int i = 0; i < 7; i++)
+        i32[i] = -i * tag;
+    for (int i = 0; i < 3; i++)
+        u32[i] = 0xdeadbeefu + (uint32_t)(i + tag);
+    for (int i = 0; i < 11; i++)
+        u8[i] = (uint8_t)(i * 23 + tag);
+    assert_int_equal(cdem_snapshot_put(s, "state.x", CDEM_SNAP_F64, 300, f, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_put(s, "counters", CDEM_SNAP_I64, 5, i64, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_put(s, "contact.i", CDEM_SNAP_I32, 7, i32, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_put(s, "rng.state", CDEM_SNAP_U32, 3, u32, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_put(s, "bytes", CDEM_SNAP_U8, 11, u8, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_put(s, "empty", CDEM_SNAP_F64, 0, NULL, &err), CDEM_OK);
+    return s;
+}
+
+/* Writes increments 0..n_inc-1 (with 3 samples each) and a checkpoint after every
+ * increment listed in ckpt_after (tag = increment number). */
+static void write_with_checkpoints(cdem_h5_writer *w, int from, int n_inc, const int *ckpt_after,
+                                   size_t n_ckpt) {
+    cdem_error err;
+    for (int k = from; k < n_inc; k++) {
+        cdem_state s;
+        make_state(&s, 50 + (size_t)k, 500 + (uint64_t)k, k % 2);
+        for (int j = 0; j < 3; j++) {
+            cdem_series_sample smp = make_sample((size_t)(3 * k + j));
+            assert_int_equal(cdem_h5_writer_append_series(w, &smp, &err), CDEM_OK);
+        }
+        cdem_increment_info info = make_info(k, CDEM_PHASE_DEFORMATION);
+        info.step = 300 * k + 200; /* after its 3 samples (steps 300k .. 300k + 200) */
+        assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+        cdem_state_free(&s);
+        for (size_t c = 0; c < n_ckpt; c++)
+            if (ckpt_after[c] == k) {
+                cdem_snapshot *snap = make_snapshot(k);
+                if (cdem_h5_writer_write_checkpoint(w, snap, &err) != CDEM_OK)
+                    fail_msg("checkpoint after %d: %s", k, err.msg);
+                cdem_snapshot_free(snap);
+            }
+    }
+}
+
+static void assert_checkpoint(const char *path, int expected_inc) {
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_snapshot *got = NULL, *want = make_snapshot(expected_inc);
+    assert_int_equal(cdem_snapshot_alloc(&got, &err), CDEM_OK);
+    int32_t inc = -5;
+    if (cdem_h5_reader_read_checkpoint(r, got, &inc, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(inc, expected_inc);
+    const char *diff = NULL;
+    if (!cdem_snapshot_equal(got, want, &diff))
+        fail_msg("checkpoint differs in array %s", diff ? diff : "?");
+    cdem_snapshot_free(got);
+    cdem_snapshot_free(want);
+    cdem_h5_reader_close(r);
+}
+
+static void test_format_checkpoint_roundtrip(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "ckpt.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_h5_writer *w = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    /* Before any increment there is nothing to belong to. */
+    cdem_snapshot *snap = make_snapshot(0);
+    assert_int_equal(cdem_h5_writer_write_checkpoint(w, snap, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "none is"));
+    cdem_snapshot_free(snap);
+    const int after[] = {1, 2, 4};
+    write_with_checkpoints(w, 0, 6, after, 3);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    assert_checkpoint(path, 4); /* the newest */
+
+    /* A file without checkpoints. */
+    write_small(path, 2, 0);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    int32_t inc = 0;
+    assert_int_equal(cdem_h5_reader_read_checkpoint(r, snap, &inc, &err), CDEM_ERR_NOTFOUND);
+    assert_non_null(strstr(err.msg, "holds no checkpoint"));
+    assert_non_null(strstr(err.msg, path));
+    cdem_snapshot_free(snap);
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* Overwrites bytes [at, at + n) of /checkpoint/slot<slot> with pattern (HDF5 API). */
+static void scribble_slot(const char *path, int slot, hsize_t at, hsize_t n,
+                          unsigned char pattern) {
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    char name[32];
+    snprintf(name, sizeof name, "checkpoint/slot%d", slot);
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    assert_true(ds >= 0);
+    unsigned char *buf = malloc(n);
+    memset(buf, pattern, n);
+    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(1, &n, NULL);
+    assert_true(H5Sselect_hyperslab(fs, H5S_SELECT_SET, &at, NULL, &n, NULL) >= 0);
+    assert_true(H5Dwrite(ds, H5T_NATIVE_UINT8, ms, fs, H5P_DEFAULT, buf) >= 0);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(ds);
+    H5Fclose(f);
+    free(buf);
+}
+
+/* A checkpoint torn by a partial write (its slot overwritten without the index being
+ * updated, or one byte corrupted) is rejected, and the older one is used. */
+static void test_format_checkpoint_torn(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "torn.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_error err;
+    for (int variant = 0; variant < 3; variant++) {
+        cdem_h5_writer *w = NULL;
+        assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+        const int after[] = {1, 2}; /* checkpoint 1 -> slot0, checkpoint 2 -> slot1 */
+        write_with_checkpoints(w, 0, 3, after, 2);
+        assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+        assert_checkpoint(path, 2);
+        if (variant == 0)
+            scribble_slot(path, 1, 100, 1, 0x5a); /* one corrupt byte in the newest */
+        else if (variant == 1)
+            scribble_slot(path, 1, 0, 2000, 0xff); /* a new blob half-written over it */
+        else
+            scribble_slot(path, 1, 30, 8, 0x00); /* zeros in an array name/length */
+        assert_checkpoint(path, 1);
+    }
+    /* Both slots bad: an error naming both, not a crash. */
+    scribble_slot(path, 0, 40, 2, 0x11);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_snapshot *snap = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    int32_t inc = 0;
+    assert_int_equal(cdem_h5_reader_read_checkpoint(r, snap, &inc, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "no valid checkpoint"));
+    assert_non_null(strstr(err.msg, "slot1 (sequence 2): checksum mismatch"));
+    assert_non_null(strstr(err.msg, "slot0 (sequence 1): checksum mismatch"));
+    assert_int_equal(cdem_snapshot_count(snap), 0);
+    assert_int_equal(inc, -1);
+    cdem_snapshot_free(snap);
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* Reads a whole 1-D dataset as bytes of mtype (malloc'd), with its length. */
+static unsigned char *read_whole(hid_t f, const char *name, hid_t mtype, hsize_t *n) {
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    assert_true(ds >= 0);
+    hid_t sp = H5Dget_space(ds);
+    H5Sget_simple_extent_dims(sp, n, NULL);
+    size_t size = H5Tget_size(mtype);
+    unsigned char *buf = calloc(*n ? *n : 1, size);
+    if (*n)
+        assert_true(H5Dread(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) >= 0);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    return buf;
+}
+
+/* Writing 0..5 straight through, and writing 0..4, dying, reopening to keep increments
+ * 0..3 and appending 4..5 again, give the same datasets. */
+static void test_format_reopen_truncate_append(void **state) {
+    (void)state;
+    char straight[1024], resumed[1024];
+    tmp_file(straight, sizeof straight, "straight.h5");
+    tmp_file(resumed, sizeof resumed, "resumed.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_error err;
+    cdem_h5_writer *w = NULL;
+    const int after[] = {1, 3, 5};
+    assert_int_equal(cdem_h5_writer_create(straight, &meta, &w, &err), CDEM_OK);
+    write_with_checkpoints(w, 0, 6, after, 3);
+    assert_int_equal(cdem_h5_writer_set_stop_reason(w, "completed", "done", &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        cdem_h5_writer *cw = NULL;
+        if (cdem_h5_writer_create(resumed, &meta, &cw, &err) != CDEM_OK)
+            _exit(2);
+        write_with_checkpoints(cw, 0, 5, after, 3); /* 0..4, checkpoints after 1 and 3 */
+        cdem_series_sample smp = make_sample(15);
+        cdem_h5_writer_append_series(cw, &smp, &err);
+        _exit(0); /* dies without closing */
+    }
+    int status = 0;
+    assert_true(waitpid(pid, &status, 0) == pid);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    assert_checkpoint(resumed, 3);
+    /* Resume from the checkpoint of increment 3 (step 1100). */
+    if (cdem_h5_writer_reopen(resumed, 3, 1100, &w, &err) != CDEM_OK)
+        fail_msg("reopen: %s", err.msg);
+    write_with_checkpoints(w, 4, 6, after, 3);
+    assert_int_equal(cdem_h5_writer_set_stop_reason(w, "completed", "done", &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    assert_checkpoint(resumed, 5);
+
+    hid_t fa = H5Fopen(straight, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t fb = H5Fopen(resumed, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(fa >= 0 && fb >= 0);
+    static const char *const names[] = {
+        "increments/id",    "increments/x",     "increments/y",     "increments/radius",
+        "increments/layer", "increments/flags", "increments/born",  "increments/sxx",
+        "increments/syy",   "increments/sxy",   "series/step",      "series/time",
+        "series/sea_level", "series/contacts",  "increments/index", "stop_reason",
+    };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        hid_t ds = H5Dopen2(fa, names[i], H5P_DEFAULT);
+        hid_t t = H5Dget_type(ds), mt = H5Tget_native_type(t, H5T_DIR_ASCEND);
+        H5Tclose(t);
+        H5Dclose(ds);
+        hsize_t na = 0, nb = 0;
+        unsigned char *a = read_whole(fa, names[i], mt, &na);
+        unsigned char *b = read_whole(fb, names[i], mt, &nb);
+        if (!strcmp(names[i], "stop_reason"))
+            na = nb = 1;
+        if (na != nb)
+            fail_msg("%s: %llu rows straight, %llu resumed", names[i], (unsigned long long)na,
+                     (unsigned long long)nb);
+        if (memcmp(a, b, na * H5Tget_size(mt)) != 0)
+            fail_msg("%s differs between the straight and the resumed file", names[i]);
+        free(a);
+        free(b);
+        H5Tclose(mt);
+    }
+    H5Fclose(fa);
+    H5Fclose(fb);
+    remove_pair(straight);
+    remove_pair(resumed);
+}
+
+/* A reader in SWMR-read mode sees increments appear (refresh) and the stop reason change,
+ * while another process writes. */
+static void test_format_swmr_live_refresh(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "swmr.h5");
+    int to_child[2], to_parent[2];
+    assert_int_equal(pipe(to_child), 0);
+    assert_int_equal(pipe(to_parent), 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        close(to_child[1]);
+        close(to_parent[0]);
+        cdem_params p;
+        cdem_params_defaults(&p);
+        cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+        cdem_h5_writer *w = NULL;
+        cdem_error err;
+        char c = 0;
+        if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
+            _exit(2);
+        for (int k = 0; k < 3; k++) {
+            cdem_state s;
+            make_state(&s, 100 + 10 * (size_t)k, (uint64_t)k, k == 1);
+            cdem_increment_info info = make_info(k, CDEM_PHASE_DEFORMATION);
+            if (cdem_h5_writer_write_increment(w, &info, &s, &err) != CDEM_OK)
+                _exit(3);
+            cdem_state_free(&s);
+            if (write(to_parent[1], "i", 1) != 1 || read(to_child[0], &c, 1) != 1)
+                _exit(4);
+        }
+        cdem_h5_writer_set_stop_reason(w, "completed", "all", &err);
+        if (cdem_h5_writer_close(w, &err) != CDEM_OK)
+            _exit(5);
+        if (write(to_parent[1], "c", 1) != 1)
+            _exit(6);
+        _exit(0);
+    }
+    close(to_child[0]);
+    close(to_parent[1]);
+    char c = 0;
+    assert_int_equal(read(to_parent[0], &c, 1), 1); /* increment 0 written */
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("open while writing: %s", err.msg);
+    assert_int_equal(cdem_h5_reader_unclosed(r), 1);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "running");
+    assert_int_equal(cdem_h5_reader_increment_count(r), 1);
+    cdem_state s = {0};
+    for (int k = 1; k < 3; k++) {
+        assert_int_equal(write(to_child[1], "g", 1), 1);
+        assert_int_equal(read(to_parent[0], &c, 1), 1); /* increment k written */
+        int changed = 0;
+        if (cdem_h5_reader_refresh(r, &changed, &err) != CDEM_OK)
+            fail_msg("refresh: %s", err.msg);
+        assert_int_equal(changed, 1);
+        assert_int_equal(cdem_h5_reader_increment_count(r), (size_t)k + 1);
+        cdem_increment_info in;
+        assert_int_equal(cdem_h5_reader_load_increment(r, (size_t)k, &s, &in, &err), CDEM_OK);
+        cdem_state want;
+        make_state(&want, 100 + 10 * (size_t)k, (uint64_t)k, k == 1);
+        assert_same_elements(&want, &s);
+        cdem_state_free(&want);
+    }
+    assert_int_equal(write(to_child[1], "g", 1), 1);
+    assert_int_equal(read(to_parent[0], &c, 1), 1); /* closed */
+    int changed = 0;
+    assert_int_equal(cdem_h5_reader_refresh(r, &changed, &err), CDEM_OK);
+    assert_int_equal(changed, 1);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "completed");
+    assert_int_equal(cdem_h5_reader_increment_count(r), 3);
+    int status = 0;
+    assert_true(waitpid(pid, &status, 0) == pid);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    close(to_child[1]);
+    close(to_parent[0]);
     remove_pair(path);
 }
 
@@ -1235,6 +1690,11 @@ int main(void) {
         cmocka_unit_test(test_format_size_of_default_run),
         cmocka_unit_test(test_format_xmf_sidecar),
         cmocka_unit_test(test_format_deterministic_bytes),
+        cmocka_unit_test(test_format_reads_version_1),
+        cmocka_unit_test(test_format_checkpoint_roundtrip),
+        cmocka_unit_test(test_format_checkpoint_torn),
+        cmocka_unit_test(test_format_reopen_truncate_append),
+        cmocka_unit_test(test_format_swmr_live_refresh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

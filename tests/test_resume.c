@@ -1,11 +1,13 @@
-/* Tests of cdem-run --resume and of determinism, with the program ($CDEM_BUILD/cdem-run):
- *  - the same small run with OMP_NUM_THREADS = 1, 2 and 3 and --par-min 64 (so the threaded
- *    loops really run threaded) gives identical files: every increment's attributes and
- *    datasets, the series, the texts (compared through the reader; the creation time is the
- *    only attribute left out);
- *  - a run SIGKILLed after a checkpoint and resumed gives the file of an uninterrupted run;
- *  - refused resumes: a completed run, -s overrides, a model file, a missing file, a file
- *    without checkpoint, each with its message and exit status.
+/* Tests of cdem-run --resume and of determinism, with the program
+ * ($CDEM_BUILD/cdem-run):
+ *  - the same small run with OMP_NUM_THREADS = 1, 2 and 3 and --par-min 64 (so
+ * the threaded loops really run threaded) gives identical files: every
+ * increment's attributes and datasets, the series, the texts (compared through
+ * the reader; the creation time is the only attribute left out);
+ *  - a run SIGKILLed after a checkpoint and resumed gives the file of an
+ * uninterrupted run;
+ *  - refused resumes: a completed run, -s overrides, a model file, a missing
+ * file, a file without checkpoint, each with its message and exit status.
  * Scratch files go to a private directory under $CDEM_TEST_TMP. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -15,6 +17,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "snapshot.h"
 
 #include <limits.h>
 #include <signal.h>
@@ -30,10 +33,12 @@ typedef struct {
     char tmp[1024]; /* private scratch directory */
 } rs_ctx;
 
-/* The small model every test runs (about 1400 elements, 5300 steps, 13 increments). */
+/* The small model every test runs (about 1400 elements, 5300 steps, 13
+ * increments). */
 #define SMALL                                                                                      \
     "-s assembly.width=10 -s assembly.height=2.5 -s time.equilibration=100 "                       \
-    "-s time.runtime=150 -s output.series_interval=50 -s physics.calculate_stress=on"
+    "-s time.runtime=150 -s output.series_interval=50 -s "                                         \
+    "physics.calculate_stress=on"
 
 static int setup(void **state) {
     rs_ctx *c = calloc(1, sizeof *c);
@@ -63,7 +68,8 @@ static int teardown(void **state) {
     return rc == 0 ? 0 : -1;
 }
 
-/* Runs "env ENV cdem-run ARGS" (shell syntax) with stderr to tmp/err.txt; the exit status. */
+/* Runs "env ENV cdem-run ARGS" (shell syntax) with stderr to tmp/err.txt; the
+ * exit status. */
 static int run(const rs_ctx *c, const char *env, const char *args) {
     if (access(c->bin, X_OK) != 0) {
         print_error("%s is missing: build it first (make build/cdem-run)\n", c->bin);
@@ -117,8 +123,8 @@ static void same_array(const void *a, const void *b, size_t n, size_t size, cons
         fail_msg("increment %d: dataset %s differs", inc, what);
 }
 
-/* Every increment (attributes and datasets), the series and the texts of two files are
- * identical bit for bit; only the creation time may differ. */
+/* Every increment (attributes and datasets), the series and the texts of two
+ * files are identical bit for bit; only the creation time may differ. */
 static void compare_files(const char *pa, const char *pb) {
     cdem_error err;
     cdem_h5_reader *a = NULL, *b = NULL;
@@ -213,6 +219,119 @@ static void test_resume_determinism_threads_1_2_3(void **state) {
     compare_files(p1, p3);
 }
 
+/* The newest checkpoints of two files are identical (and exist). */
+static void compare_checkpoints(const char *pa, const char *pb) {
+    cdem_error err;
+    cdem_h5_reader *a = NULL, *b = NULL;
+    cdem_snapshot *sa = NULL, *sb = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&sa, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_alloc(&sb, &err), CDEM_OK);
+    if (cdem_h5_reader_open(pa, &a, &err) != CDEM_OK ||
+        cdem_h5_reader_open(pb, &b, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    int32_t ia = -1, ib = -2;
+    if (cdem_h5_reader_read_checkpoint(a, sa, &ia, &err) != CDEM_OK ||
+        cdem_h5_reader_read_checkpoint(b, sb, &ib, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(ia, ib);
+    const char *diff = NULL;
+    if (!cdem_snapshot_equal(sa, sb, &diff))
+        fail_msg("checkpoints of increment %d differ in %s", (int)ia, diff ? diff : "?");
+    cdem_snapshot_free(sa);
+    cdem_snapshot_free(sb);
+    cdem_h5_reader_close(a);
+    cdem_h5_reader_close(b);
+}
+
+/* 1 when the file contains needle. */
+static int file_has(const char *path, const char *needle) {
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    const size_t cap = 1 << 16;
+    char *buf = calloc(1, cap);
+    assert_non_null(buf);
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    const int has = strstr(buf, needle) != NULL;
+    free(buf);
+    return has;
+}
+
+/* The run straight; the same run SIGKILLed after the end of equilibration
+ * (after at least one checkpoint: one every 2 increments) and resumed:
+ * identical files and checkpoints. */
+static void test_resume_after_sigkill_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
+    char log[1200], out[1200];
+    path_of(c, "killed.log", log, sizeof log);
+    path_of(c, "killed.h5", out, sizeof out);
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        FILE *f = freopen(log, "wb", stderr);
+        if (!f || chdir(c->tmp) != 0)
+            _exit(99);
+        execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
+              "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",
+              "-s", "time.runtime=150", "-s", "output.series_interval=50", "-s",
+              "physics.calculate_stress=on", (char *)NULL);
+        _exit(98);
+    }
+    /* kill it as soon as it reports the end of equilibration (several increments
+     * and at least one checkpoint are in the file by then; about a third of the
+     * run is left) */
+    int killed = 0;
+    for (int i = 0; i < 60000 && !killed; i++) {
+        int st = 0;
+        if (waitpid(pid, &st, WNOHANG) == pid)
+            fail_msg("cdem-run ended (status %d) before it could be killed", st);
+        if (file_has(log, "end of equilibration")) {
+            assert_int_equal(kill(pid, SIGKILL), 0);
+            killed = 1;
+        } else {
+            const struct timespec ts = {0, 5000000};
+            nanosleep(&ts, NULL);
+        }
+    }
+    assert_true(killed);
+    int st = 0;
+    assert_int_equal(waitpid(pid, &st, 0), pid);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    assert_int_equal(run(c, NULL, "-q --resume killed.h5"), 0);
+    char ps[1200];
+    path_of(c, "straight.h5", ps, sizeof ps);
+    compare_files(ps, out);
+    compare_checkpoints(ps, out);
+    /* and now it is complete */
+    assert_int_equal(run(c, NULL, "--resume killed.h5"), 1);
+    expect_err(c, "already completed");
+}
+
+/* Stopped by --max-steps between checkpoints (its stop checkpoint is the
+ * newest) and resumed: the uninterrupted run's file and newest checkpoint. */
+static void test_resume_after_max_steps_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o straight3.h5 -s output.checkpoint_interval=3 " SMALL), 0);
+    assert_int_equal(run(c, NULL,
+                         "-q -o early.h5 --max-steps 4321 -s "
+                         "output.checkpoint_interval=3 " SMALL),
+                     0);
+    char pe[1200], ps[1200];
+    path_of(c, "early.h5", pe, sizeof pe);
+    path_of(c, "straight3.h5", ps, sizeof ps);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(pe, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
+    cdem_h5_reader_close(r);
+    assert_int_equal(run(c, NULL, "-q --resume early.h5"), 0);
+    compare_files(ps, pe);
+    compare_checkpoints(ps, pe);
+}
+
 static void test_resume_refusals(void **state) {
     const rs_ctx *c = *state;
     /* a completed run */
@@ -238,7 +357,8 @@ static void test_resume_refusals(void **state) {
     expect_err(c, "missing.h5");
     assert_int_equal(run(c, NULL, "--resume err.txt"), 1);
     expect_err(c, "err.txt");
-    /* written without checkpoints (and stopped after 1 step): nothing to resume from */
+    /* written without checkpoints (and stopped after 1 step): nothing to resume
+     * from */
     assert_int_equal(run(c, NULL, "--resume done.h5"), 1);
     expect_err(c, "has no checkpoint to resume from");
     /* the refused resume left the file as it was */
@@ -255,6 +375,8 @@ static void test_resume_refusals(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resume_determinism_threads_1_2_3),
+        cmocka_unit_test(test_resume_after_sigkill_is_bit_identical),
+        cmocka_unit_test(test_resume_after_max_steps_is_bit_identical),
         cmocka_unit_test(test_resume_refusals),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
