@@ -138,7 +138,18 @@ static void *field_ptr(const cdem_state *st, const state_field *f) {
     return p;
 }
 
-cdem_status cdem_ckpt_state_put(const cdem_state *st, cdem_snapshot *s, cdem_error *err) {
+/* fx or fy with the boundary elements' values replaced by 0 (malloc'd; NULL: no memory). */
+static double *free_forces_only(const cdem_state *st, const double *f) {
+    double *c = malloc((st->n ? st->n : 1) * sizeof *c);
+    if (!c)
+        return NULL;
+    for (size_t i = 0; i < st->n; i++)
+        c[i] = (st->flags[i] & CDEM_FLAGS_BOUNDARY) ? 0.0 : f[i];
+    return c;
+}
+
+cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_snapshot *s,
+                                cdem_error *err) {
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "n", (int64_t)st->n, err));
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "next_id", st->next_id, err));
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "has_stress", st->has_stress, err));
@@ -146,7 +157,18 @@ cdem_status cdem_ckpt_state_put(const cdem_state *st, cdem_snapshot *s, cdem_err
         const state_field *f = &state_fields[k];
         if (f->stress && !st->has_stress)
             continue;
-        CDEM_TRY(cdem_ckpt_put_array(s, "state", f->name, f->type, st->n, field_ptr(st, f), err));
+        const void *data = field_ptr(st, f);
+        double *copy = NULL;
+        if (!boundary_forces && (data == st->fx || data == st->fy)) {
+            copy = free_forces_only(st, data);
+            if (!copy)
+                return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                                 "checkpoint: out of memory copying %zu forces", st->n);
+            data = copy;
+        }
+        cdem_status rc = cdem_ckpt_put_array(s, "state", f->name, f->type, st->n, data, err);
+        free(copy);
+        CDEM_TRY(rc);
     }
     return CDEM_OK;
 }

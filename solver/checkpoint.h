@@ -48,8 +48,13 @@ cdem_status cdem_ckpt_check_f64(const cdem_snapshot *s, const char *prefix, cons
                                 double expected, cdem_error *err);
 
 /* The element state: every array (id, x, y, vx, vy, fx, fy, radius, mass, layer, flags, born
- * and, when has_stress, sxx, syy, sxy) plus n, next_id and has_stress, under "state.". */
-cdem_status cdem_ckpt_state_put(const cdem_state *st, cdem_snapshot *s, cdem_error *err);
+ * and, when has_stress, sxx, syy, sxy) plus n, next_id and has_stress, under "state.".
+ * boundary_forces = 0 (the last step did not sum the forces on boundary elements, so theirs
+ * are left over from an earlier step, and how old depends on the thread count): their fx, fy
+ * are stored as 0. They are read only on steps that sum them again, so results are the same,
+ * and the checkpoint is the same for any thread count. */
+cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_snapshot *s,
+                                cdem_error *err);
 /* Replaces the contents of st (initialised) with the stored state (grown as needed; the
  * stress arrays enabled when they were stored). */
 cdem_status cdem_ckpt_state_get(cdem_state *st, const cdem_snapshot *s, cdem_error *err);

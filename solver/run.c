@@ -388,7 +388,7 @@ cdem_status cdem_run_capture(const cdem_run_ctx *r, cdem_snapshot *snap, cdem_er
     CDEM_TRY(cdem_ckpt_put_i64(snap, P, "eroded", r->eroded, err));
     CDEM_TRY(cdem_ckpt_put_i64(snap, P, "k_def", r->k_def, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "erosion_y", r->erosion_y, err));
-    CDEM_TRY(cdem_ckpt_state_put(&r->s, snap, err));
+    CDEM_TRY(cdem_ckpt_state_put(&r->s, r->it.boundary_forces, snap, err));
     CDEM_TRY(cdem_integrator_snapshot_put(&r->it, snap, err));
     CDEM_TRY(cdem_bc_snapshot_put(&r->bc, snap, err));
     return cdem_sediment_snapshot_put(&r->sed, snap, err);

@@ -1,13 +1,12 @@
-/* Tests of cdem-run --resume and of determinism, with the program
- * ($CDEM_BUILD/cdem-run):
- *  - the same small run with OMP_NUM_THREADS = 1, 2 and 3 and --par-min 64 (so
- * the threaded loops really run threaded) gives identical files: every
- * increment's attributes and datasets, the series, the texts (compared through
- * the reader; the creation time is the only attribute left out);
- *  - a run SIGKILLed after a checkpoint and resumed gives the file of an
- * uninterrupted run;
- *  - refused resumes: a completed run, -s overrides, a model file, a missing
- * file, a file without checkpoint, each with its message and exit status.
+/* Tests of cdem-run --resume and of determinism, with the program ($CDEM_BUILD/cdem-run):
+ *  - the same small run with OMP_NUM_THREADS = 1, 2 and 3 and --par-min 64 (so the threaded
+ *    loops really run threaded) gives identical files: every increment's attributes and
+ *    datasets, the series, the texts and the newest checkpoint (compared through the reader;
+ *    the creation time is the only attribute left out);
+ *  - a run SIGKILLed after a checkpoint, or stopped by --max-steps, and resumed gives the
+ *    file (and newest checkpoint) of an uninterrupted run;
+ *  - refused resumes: a completed run, -s overrides, a model file, -o, a missing file, a
+ *    non-HDF5 file, a file without checkpoint, each with its message and exit status.
  * Scratch files go to a private directory under $CDEM_TEST_TMP. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -33,8 +32,7 @@ typedef struct {
     char tmp[1024]; /* private scratch directory */
 } rs_ctx;
 
-/* The small model every test runs (about 1400 elements, 5300 steps, 13
- * increments). */
+/* The small model every test runs (1370 elements, 5322 steps, 22 increments). */
 #define SMALL                                                                                      \
     "-s assembly.width=10 -s assembly.height=2.5 -s time.equilibration=100 "                       \
     "-s time.runtime=150 -s output.series_interval=50 -s "                                         \
@@ -206,6 +204,8 @@ static void compare_files(const char *pa, const char *pb) {
     cdem_h5_reader_close(b);
 }
 
+static void compare_checkpoints(const char *pa, const char *pb);
+
 static void test_resume_determinism_threads_1_2_3(void **state) {
     const rs_ctx *c = *state;
     char p1[1200], p2[1200], p3[1200];
@@ -217,6 +217,10 @@ static void test_resume_determinism_threads_1_2_3(void **state) {
     path_of(c, "t3.h5", p3, sizeof p3);
     compare_files(p1, p2);
     compare_files(p1, p3);
+    /* the newest checkpoints (default: every 10 increments) hold velocities, forces and the
+     * contact histories: identical too */
+    compare_checkpoints(p1, p2);
+    compare_checkpoints(p1, p3);
 }
 
 /* The newest checkpoints of two files are identical (and exist). */
