@@ -74,7 +74,7 @@ test: tests-build
 asan:
 	$(MAKE) BUILD=build-asan OPT="-O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined" test
 
-validate: all
+validate: all $(BUILD)/tests/test_kill_survival
 	@sh tests/validate/run_validate.sh $(BUILD)
 
 bench: all

@@ -5,14 +5,14 @@
  *    checksum, so flipped bytes fail a checksum instead of being parsed. Raw chunks carry
  *    Fletcher-32. Strings are fixed-length: variable-length ones live in the global heap,
  *    which has no checksum, and HDF5 1.10 crashes on a corrupt one.
- *  - A v3 superblock is marked "open for write" while the writer runs; a writer killed
- *    before close leaves the mark and a plain H5Fopen refuses the file. The reader reads
- *    the superblock itself first (also comparing its end-of-file address with the real
- *    size, which catches truncation before HDF5 parses anything) and opens a marked file
- *    with the "clear_status_flags" property h5clear uses (read-only: nothing is written).
- *  - Crash consistency between flushes: no metadata cache evictions (metadata is written
- *    only by the flush after each increment), compact links in /increments and unfiltered
- *    series chunks (nothing the last flushed metadata points to is freed and reused).
+ *  - Version 2 is SWMR: all objects are created first (HDF5 1.10 forbids creating objects in
+ *    SWMR-write mode), then the file is only appended to. The index row of an increment is
+ *    written and flushed after its data: the commit record.
+ *  - Each increment starts at a chunk boundary, so compressed chunks are written once.
+ *  - The reader reads the superblock's status flags itself: SWMR-read for a running or
+ *    killed version-2 writer, "clear_status_flags" (read-only, what h5clear uses) for an
+ *    unclosed version-1 file. It also compares the superblock's end-of-file with the real
+ *    size, which catches truncation before HDF5 parses anything.
  *  - Object time stamps are off: same input, same bytes except the attribute "created".
  *  - HDF5's error printing is off; its error stack becomes part of cdem_error messages.
  *  - append_series is called from the time-step loop: it never allocates (fixed buffer). */
@@ -99,6 +99,16 @@ static void restore_errors(hid_t saved) {
 
 static void quiet_hdf5(void) {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+/* Called by the writer before its first HDF5 call: HDF5 1.10.8 crashes (SIGSEGV in
+ * H5F__close_cb) in its atexit clean-up when a file whose H5Fclose failed (disk full,
+ * file size limit) is still registered. The writer closes every file it opens itself, so
+ * the clean-up is not needed; this has an effect only when HDF5 is not yet initialised. */
+static void writer_hdf5_init(void) {
+    if (H5dont_atexit() < 0)
+        H5Eclear2(H5E_DEFAULT);
+    quiet_hdf5();
 }
 
 static char *dup_str(const char *s) {
@@ -489,7 +499,10 @@ struct cdem_h5_writer {
 static cdem_status flush_file(cdem_h5_writer *w, cdem_error *err) {
     if (H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0) {
         w->failed = 1;
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the file (disk full?)", w->path);
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot flush the file (disk full?); the file keeps the %llu "
+                      "increments completed before",
+                      w->path, (unsigned long long)w->index_len);
     }
     return CDEM_OK;
 }
@@ -1002,7 +1015,7 @@ cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, c
     if (!path || !*path || !meta || !meta->params || !out)
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "cdem_h5_writer_create: path, meta, meta->params and out are required");
-    quiet_hdf5();
+    writer_hdf5_init();
     cdem_h5_writer *w = NULL;
     CDEM_TRY(writer_alloc(path, &w, err));
     size_t n = strlen(path) + 10;
@@ -1162,6 +1175,25 @@ cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
     hid_t file = w->file;
     w->file = -1;
     hid_t es = -1;
+    if (file >= 0 && w->failed) {
+        /* After a failed write (disk full) the file is left as a killed writer leaves it:
+         * closing would rewrite the superblock with an end-of-file the disk cannot hold
+         * (the file then reads as truncated) and HDF5 1.10.8 crashes later on the
+         * half-closed file. Its handles are abandoned (this process is about to stop);
+         * every committed increment and the stop reason are already on disk. */
+        for (size_t c = 0; c < N_SERIES; c++)
+            w->series[c] = -1;
+        for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+            w->data[k] = -1;
+        w->index = w->stop_reason = w->stop_detail = w->ckpt_index = -1;
+        w->ckpt_data[0] = w->ckpt_data[1] = -1;
+        if (st == CDEM_OK)
+            st = CDEM_FAIL(err, CDEM_ERR_IO,
+                           "%s: left unfinished after a failed write; it keeps its %llu "
+                           "complete increments (readable like the file of a killed run)",
+                           w->path, (unsigned long long)w->index_len);
+        file = -1;
+    }
     if (file >= 0) {
         /* Close the datasets first so that H5Fclose really closes the file. */
         for (size_t c = 0; c < N_SERIES; c++) {
@@ -1623,9 +1655,9 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
         }
         r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     }
-    if (r->file < 0 && r->unclosed) {
-        /* The writer may be this very process (HDF5 then shares its open file, and the
-         * access properties must match the writer's). */
+    if (r->file < 0) {
+        /* The file may already be open in this process (its writer, or a caller's own
+         * H5Fopen): HDF5 then shares it, and the access properties must match. */
         H5Eclear2(H5E_DEFAULT);
         r->file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     }
@@ -2468,7 +2500,7 @@ cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increme
         *out = NULL;
     if (!path || !*path || !out)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_writer_reopen: path and out are required");
-    quiet_hdf5();
+    writer_hdf5_init();
     cdem_h5_writer *w = NULL;
     CDEM_TRY(writer_alloc(path, &w, err));
     cdem_status st = reopen_setup(w, keep_through_increment, keep_through_step, err);

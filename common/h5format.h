@@ -1,21 +1,16 @@
 /* h5format: the element-state file (one HDF5 file per simulation), written by cdem-run and
- * read by cdem-strain, h5py and ParaView (through the .xmf sidecar). docs/format.md is the
- * authority on the layout; this header is its C interface.
- *
- * Layout (format version CDEM_FORMAT_VERSION):
- *   /                      attrs: format ("cdem-c"), format_version, program_version, seed,
- *                                 created, summary, params_text, stop_reason, stop_detail
- *   /parameters            one attribute per parameter "section.key" (value as text) plus
- *                          a table dataset (name, value, unit)
- *   /increments/NNNNNN     one group per display increment (6-digit number), attrs: number,
- *                          step, time, phase, net_displacement, axial_strain, sea_level, n;
- *                          datasets: id, x, y, radius, layer, flags, born [, sxx, syy, sxy]
- *   /series/<column>       extendible 1-D datasets sampled during the run (full list:
- *                          docs/format.md; it also has source and differential_stress)
- * Every dataset is chunked and compressed (shuffle + deflate). The writer flushes after
- * every increment, so a file whose writer died keeps every increment completed before.
- * Ownership: writer and reader are opaque handles; _close/_free release them.
- * Thread safety: one handle per thread; HDF5 itself is not called concurrently. */
+ * read by cdem-strain, h5py and ParaView (.xmf sidecar). docs/format.md is the authority on
+ * the layout (version 2; version 1 files are still read); this header is its C interface.
+ * Layout: root attributes (format, version, seed, texts); /stop_reason, /stop_detail;
+ * /parameters; /increments/index (one row per increment, written after its data: the commit
+ * record) and ragged extendible element datasets /increments/{id,x,y,...}; /series/<column>;
+ * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs).
+ * Every object is created with the file; the writer then runs in HDF5 SWMR-write mode, so a
+ * writer killed at any moment leaves every completed increment readable and a reader can
+ * follow a running simulation (cdem_h5_reader_refresh).
+ * Ownership: writer and reader are opaque handles; _close releases them (NULL allowed).
+ * Thread safety: one handle per thread; HDF5 itself is not called concurrently.
+ * Units: SI (m, s, N/m) as documented per field. */
 #ifndef CDEM_H5FORMAT_H
 #define CDEM_H5FORMAT_H
 

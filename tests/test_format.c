@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -1643,6 +1644,107 @@ static void test_format_swmr_live_refresh(void **state) {
     remove_pair(path);
 }
 
+/* ------------------------------------------------------------------ full disk */
+
+/* A write that fails for lack of space (RLIMIT_FSIZE in a forked child, SIGXFSZ ignored:
+ * write() then fails with EFBIG as on a full disk) is reported naming the path, and the
+ * file keeps every increment written before, with the stop reason recorded. */
+static void test_format_write_failure_keeps_increments(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "fsize.h5");
+    int fds[2];
+    assert_int_equal(pipe(fds), 0);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        close(fds[0]);
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit rl = {600 * 1024, 600 * 1024};
+        if (setrlimit(RLIMIT_FSIZE, &rl) != 0)
+            _exit(2);
+        cdem_params p;
+        cdem_params_defaults(&p);
+        cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+        cdem_h5_writer *w = NULL;
+        cdem_error err;
+        if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
+            _exit(3);
+        int k = 0, ok = 0;
+        for (; k < 100; k++) {
+            cdem_state s;
+            make_state(&s, 3000, 900 + (uint64_t)k, 1); /* random doubles: incompressible */
+            cdem_increment_info info = make_info(k, CDEM_PHASE_DEFORMATION);
+            cdem_status st = cdem_h5_writer_write_increment(w, &info, &s, &err);
+            cdem_state_free(&s);
+            if (st != CDEM_OK) {
+                ok = st == CDEM_ERR_IO && strstr(err.msg, path) && strstr(err.msg, "disk full?") &&
+                     strstr(err.msg, "keeps the");
+                break;
+            }
+        }
+        /* a later write is refused at once, not attempted */
+        cdem_state s;
+        make_state(&s, 10, 1, 0);
+        cdem_increment_info info = make_info(500, CDEM_PHASE_DEFORMATION);
+        ok = ok && cdem_h5_writer_write_increment(w, &info, &s, &err) == CDEM_ERR_IO &&
+             strstr(err.msg, "an earlier write failed");
+        cdem_state_free(&s);
+        int stop_ok =
+            cdem_h5_writer_set_stop_reason(w, "write-failure", "disk full", &err) == CDEM_OK;
+        cdem_h5_writer_close(w, &err); /* may fail: the file cannot grow */
+        int msg[3] = {k, ok, stop_ok};
+        if (write(fds[1], msg, sizeof msg) != (ssize_t)sizeof msg)
+            _exit(4);
+        _exit(0);
+    }
+    close(fds[1]);
+    int msg[3] = {0, 0, 0};
+    assert_int_equal(read(fds[0], msg, sizeof msg), (ssize_t)sizeof msg);
+    close(fds[0]);
+    int status = 0;
+    assert_true(waitpid(pid, &status, 0) == pid);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    printf("write failure: %d increments written before the file size limit\n", msg[0]);
+    assert_true(msg[0] >= 1 && msg[0] < 100);
+    assert_int_equal(msg[1], 1); /* the message named the path and what is kept */
+    assert_int_equal(msg[2], 1); /* the stop reason fits in preallocated space */
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("the file of a failed write does not open: %s", err.msg);
+    assert_int_equal(cdem_h5_reader_increment_count(r), (size_t)msg[0]);
+    cdem_state s = {0};
+    for (int k = 0; k < msg[0]; k++) {
+        assert_int_equal(cdem_h5_reader_load_increment(r, (size_t)k, &s, NULL, &err), CDEM_OK);
+        cdem_state want;
+        make_state(&want, 3000, 900 + (uint64_t)k, 1);
+        assert_same_elements(&want, &s);
+        cdem_state_free(&want);
+    }
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "write-failure");
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+static void test_format_free_space_check(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "space.h5");
+    cdem_error err;
+    assert_int_equal(cdem_h5_check_free_space(path, 1.0, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_check_free_space(path, 1e18, &err), CDEM_ERR_IO);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, "needs about 1000000000000.0 MB but"));
+    assert_int_equal(cdem_h5_check_free_space("/nonexistent-dir/x/run.h5", 1.0, &err), CDEM_ERR_IO);
+    assert_non_null(strstr(err.msg, "cannot examine the output directory /nonexistent-dir/x"));
+    /* The estimate is within 15 % of the measured default-size run (9.27 MB, no stress). */
+    double est = cdem_h5_estimate_file_size(2271, 283, 0);
+    assert_true(est > 0.85 * 9.27e6 && est < 1.15 * 9.27e6);
+}
+
 /* Same input, same bytes: only the "created" attribute may differ. */
 static void test_format_deterministic_bytes(void **state) {
     (void)state;
@@ -1695,6 +1797,8 @@ int main(void) {
         cmocka_unit_test(test_format_checkpoint_torn),
         cmocka_unit_test(test_format_reopen_truncate_append),
         cmocka_unit_test(test_format_swmr_live_refresh),
+        cmocka_unit_test(test_format_write_failure_keeps_increments),
+        cmocka_unit_test(test_format_free_space_check),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -143,9 +144,57 @@ static void test_kill_survival_random_moments(void **state) {
     remove(xmf);
 }
 
+/* A full disk during the run (RLIMIT_FSIZE in the child, SIGXFSZ ignored: writes fail with
+ * EFBIG): cdem-run stops with exit status 1 and a message naming the file, and the file
+ * keeps every increment written before, with stop reason "write-failure". */
+static void test_kill_survival_file_size_limit(void **state) {
+    (void)state;
+    const char *tmp = getenv("CDEM_TEST_TMP");
+    char out[1024], errf[1100];
+    snprintf(out, sizeof out, "%s/limit_%d.h5", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    snprintf(errf, sizeof errf, "%s.err", out);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGXFSZ, SIG_IGN);
+        struct rlimit rl = {400 * 1024, 400 * 1024};
+        if (setrlimit(RLIMIT_FSIZE, &rl) != 0 || !freopen(errf, "w", stderr))
+            _exit(126);
+        char exe[1024];
+        snprintf(exe, sizeof exe, "%s/cdem-run", build_dir());
+        execl(exe, exe, "-q", "-s", "assembly.height=2.5", "-s", "time.equilibration=150", "-s",
+              "time.runtime=220", "-s", "time.display_interval=4", "-o", out, (char *)NULL);
+        _exit(127);
+    }
+    int status = 0;
+    assert_true(waitpid(pid, &status, 0) == pid);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 1);
+    FILE *f = fopen(errf, "r");
+    assert_non_null(f);
+    char msg[4096] = "";
+    size_t got = fread(msg, 1, sizeof msg - 1, f);
+    msg[got] = '\0';
+    fclose(f);
+    assert_non_null(strstr(msg, out));
+    assert_non_null(strstr(msg, "disk full?"));
+    char stop[64];
+    size_t n = check_file(out, stop, sizeof stop);
+    assert_string_equal(stop, "write-failure");
+    printf("file size limit: cdem-run stopped after %zu increments: %.120s...\n", n, msg);
+    assert_true(n >= 1);
+    remove(out);
+    remove(errf);
+    char xmf[1100];
+    snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(out) - 3), out);
+    remove(xmf);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kill_survival_random_moments),
+        cmocka_unit_test(test_kill_survival_file_size_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

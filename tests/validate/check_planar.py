@@ -14,6 +14,9 @@ import sys
 import h5py
 import numpy as np
 
+sys.path.insert(0, __import__('os').path.dirname(__file__))
+import cdemfile  # noqa: E402
+
 FLAG_WALL, FLAG_FAULT, FLAG_MOVING = 1, 2, 4
 
 
@@ -32,12 +35,10 @@ def main():
     ap.add_argument("--net-fraction", type=float, default=1.0)
     a = ap.parse_args()
     f = h5py.File(a.file, "r")
-    stop = f.attrs.get("stop_reason", b"")
-    stop = stop.decode() if isinstance(stop, bytes) else str(stop)
+    stop = cdemfile.stop_reason(f)
     if stop != "completed":
         fail("stop_reason = %r, expected 'completed'" % stop)
-    names = sorted(f["increments"].keys())
-    incs = [f["increments"][k] for k in names]
+    incs = cdemfile.increments(f)
     numbers = [int(g.attrs["number"]) for g in incs]
     if numbers != list(range(a.total + 1)):
         fail("increments %s..%s (%d), expected 0..%d" % (numbers[0], numbers[-1], len(numbers), a.total))

@@ -11,16 +11,19 @@ Usage: /usr/bin/python3 check_stress_column.py RUN.h5 [DENSITY] [GRAVITY]
 """
 import sys
 
+import os
+
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+import cdemfile  # noqa: E402
 
 path = sys.argv[1]
 rho = float(sys.argv[2]) if len(sys.argv) > 2 else 2500.0
 g = float(sys.argv[3]) if len(sys.argv) > 3 else 9.81
 with h5py.File(path, "r") as f:
-    incs = sorted(f["increments"], key=lambda k: int(f["increments"][k].attrs["number"]))
-    equil = [k for k in incs if int(f["increments"][k].attrs["phase"]) == 0][-1]
-    inc = f["increments"][equil]
+    inc = [i for i in cdemfile.increments(f) if int(i.attrs["phase"]) == 0][-1]
     x, y, syy, flags = (np.asarray(inc[n][:]) for n in ("x", "y", "syy", "flags"))
 free = (flags & (1 | 2 | 64 | 128)) == 0  # not wall, fault, footwall or mylar
 top = np.percentile(y[free], 99.5)

@@ -12,7 +12,8 @@
 #     softens, and the confined peak is above the unconfined one;
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
-#  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth.
+#  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
+#  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c).
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -36,12 +37,12 @@ check default-kinematics $CHECK "$TMP/default.h5" --equil 56 --total 282 --dip 3
 
 check reverse-run "$RUN" -q -o "$TMP/reverse.h5" -s boundary.fault_sense=reverse \
     -s boundary.fault_dip=50 -s time.runtime=1000 -s time.display_interval=10
-EQ=$(/usr/bin/python3 -c "import h5py,sys; f=h5py.File('$TMP/reverse.h5','r'); g=[f['increments'][k] for k in sorted(f['increments'])]; print(max(int(x.attrs['number']) for x in g if int(x.attrs['phase'])==0), len(g)-1)" 2>/dev/null)
+EQ=$(/usr/bin/python3 -c "import sys; sys.path.insert(0,'tests/validate'); import h5py,cdemfile; f=h5py.File('$TMP/reverse.h5','r'); g=cdemfile.increments(f); print(max(int(x.attrs['number']) for x in g if int(x.attrs['phase'])==0), len(g)-1)" 2>/dev/null)
 check reverse-kinematics $CHECK "$TMP/reverse.h5" --equil ${EQ% *} --total ${EQ#* } --dip 50 --sense reverse
 
 check inversion-run "$RUN" -q -o "$TMP/inversion.h5" -s boundary.inversion=on \
     -s boundary.inversion_percent=50 -s time.runtime=1000 -s time.display_interval=10
-EQ=$(/usr/bin/python3 -c "import h5py,sys; f=h5py.File('$TMP/inversion.h5','r'); g=[f['increments'][k] for k in sorted(f['increments'])]; print(max(int(x.attrs['number']) for x in g if int(x.attrs['phase'])==0), len(g)-1)" 2>/dev/null)
+EQ=$(/usr/bin/python3 -c "import sys; sys.path.insert(0,'tests/validate'); import h5py,cdemfile; f=h5py.File('$TMP/inversion.h5','r'); g=cdemfile.increments(f); print(max(int(x.attrs['number']) for x in g if int(x.attrs['phase'])==0), len(g)-1)" 2>/dev/null)
 check inversion-kinematics $CHECK "$TMP/inversion.h5" --equil ${EQ% *} --total ${EQ#* } --dip 30 --sense normal --net-fraction 0
 
 STRAIN="$BUILD/cdem-strain"
@@ -81,17 +82,24 @@ check growth-run "$RUN" -q -o "$TMP/growth.h5" -s surface.sedimentation=on \
     -s surface.sea_level_rise=null -s material.first_slip=off
 check growth-strata $PY - "$TMP/growth.h5" <<'PYEOF'
 import sys, h5py, numpy as np
+sys.path.insert(0, "tests/validate")
+import cdemfile
 with h5py.File(sys.argv[1], "r") as f:
-    last = max(f["increments"], key=lambda k: int(f["increments"][k].attrs["number"]))
-    g = f["increments"][last]
-    flags = np.asarray(g["flags"][:])
+    g = cdemfile.increments(f)[-1]
+    last = int(g.attrs["number"])
+    flags = np.asarray(g["flags"])
     n = int(np.count_nonzero(flags & (1 << 3)))
-    print(f"increment {last}: {n} growth elements, stop reason {f.attrs['stop_reason']}")
+    print(f"increment {last}: {n} growth elements, stop reason {cdemfile.stop_reason(f)}")
     assert n > 0
 PYEOF
 
 check stress-run "$RUN" -q -o "$TMP/stress.h5" -s physics.calculate_stress=on -s time.runtime=410
 check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
+
+# 8. kill survival: 200 SIGKILLs of a short cdem-run at seeded random moments; every file
+#    left behind opens and every increment it lists loads (docs/reliability.md).
+check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
+    "$BUILD/tests/test_kill_survival"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
