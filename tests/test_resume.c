@@ -263,15 +263,16 @@ static int file_has(const char *path, const char *needle) {
     return has;
 }
 
-/* The run straight; the same run SIGKILLed after the end of equilibration
- * (after at least one checkpoint: one every 2 increments) and resumed:
- * identical files and checkpoints. */
-static void test_resume_after_sigkill_is_bit_identical(void **state) {
-    const rs_ctx *c = *state;
-    assert_int_equal(run(c, NULL, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
-    char log[1200], out[1200];
-    path_of(c, "killed.log", log, sizeof log);
-    path_of(c, "killed.h5", out, sizeof out);
+/* Starts cdem-run on the small model (checkpoint every 2 increments) writing name.h5, its
+ * log to name.log, sends sig as soon as the log reports the end of equilibration (several
+ * increments and at least one checkpoint are in the file by then; a third of the run is
+ * left) and returns its wait status. */
+static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
+    char log[1200], out[1200], base[64];
+    snprintf(base, sizeof base, "%s.log", name);
+    path_of(c, base, log, sizeof log);
+    snprintf(base, sizeof base, "%s.h5", name);
+    path_of(c, base, out, sizeof out);
     const pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -284,34 +285,55 @@ static void test_resume_after_sigkill_is_bit_identical(void **state) {
               "physics.calculate_stress=on", (char *)NULL);
         _exit(98);
     }
-    /* kill it as soon as it reports the end of equilibration (several increments
-     * and at least one checkpoint are in the file by then; about a third of the
-     * run is left) */
-    int killed = 0;
-    for (int i = 0; i < 60000 && !killed; i++) {
+    int sent = 0;
+    for (int i = 0; i < 60000 && !sent; i++) {
         int st = 0;
         if (waitpid(pid, &st, WNOHANG) == pid)
-            fail_msg("cdem-run ended (status %d) before it could be killed", st);
+            fail_msg("cdem-run ended (status %d) before it could be signalled", st);
         if (file_has(log, "end of equilibration")) {
-            assert_int_equal(kill(pid, SIGKILL), 0);
-            killed = 1;
+            assert_int_equal(kill(pid, sig), 0);
+            sent = 1;
         } else {
             const struct timespec ts = {0, 5000000};
             nanosleep(&ts, NULL);
         }
     }
-    assert_true(killed);
+    assert_true(sent);
     int st = 0;
     assert_int_equal(waitpid(pid, &st, 0), pid);
+    return st;
+}
+
+/* The run straight; the same run SIGKILLed mid-run (after at least one checkpoint) and
+ * resumed, and SIGINTed (stop reason "interrupted", exit 3) and resumed: each gives the
+ * straight run's increments, series and newest checkpoint. */
+static void test_resume_after_sigkill_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
+    char ps[1200], pk[1200], pi[1200];
+    path_of(c, "straight.h5", ps, sizeof ps);
+    path_of(c, "killed.h5", pk, sizeof pk);
+    path_of(c, "stopped.h5", pi, sizeof pi);
+
+    int st = start_and_signal(c, "killed", SIGKILL);
     assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
     assert_int_equal(run(c, NULL, "-q --resume killed.h5"), 0);
-    char ps[1200];
-    path_of(c, "straight.h5", ps, sizeof ps);
-    compare_files(ps, out);
-    compare_checkpoints(ps, out);
+    compare_files(ps, pk);
+    compare_checkpoints(ps, pk);
     /* and now it is complete */
     assert_int_equal(run(c, NULL, "--resume killed.h5"), 1);
     expect_err(c, "already completed");
+
+    st = start_and_signal(c, "stopped", SIGINT);
+    assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 3);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(pi, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "interrupted");
+    cdem_h5_reader_close(r);
+    assert_int_equal(run(c, NULL, "-q --resume stopped.h5"), 0);
+    compare_files(ps, pi);
+    compare_checkpoints(ps, pi);
 }
 
 /* Stopped by --max-steps between checkpoints (its stop checkpoint is the
