@@ -10,8 +10,11 @@
  * is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop reason
  * "numerical-failure" with the diagnosis, file closed (every increment written so far stays
  * readable), CDEM_ERR_NUMERIC returned. opt->max_steps > 0 ends the run early
- * ("stopped-early", CDEM_OK). Progress goes to opt->log only (never stdout); the wall clock
- * is read only for the progress display, never for results. */
+ * ("stopped-early", CDEM_OK). Checkpoints: after the step of every checkpoint_interval-th
+ * increment and at a stop, cdem_run_capture (every module under its own prefix) ->
+ * cdem_h5_writer_write_checkpoint; a resume re-runs the set-up, restores, reopens the file.
+ * Progress goes to opt->log only (never stdout); the wall clock is read only for the progress
+ * display, never for results. */
 #include "run.h"
 
 #include "assembly.h"

@@ -1,7 +1,9 @@
 /* run: drives one simulation from parameters to a finished HDF5 file: builds the assembly,
- * equilibrates, applies the boundary mode, writes every display increment and the time
- * series, shows progress, and stops cleanly on SIGINT/SIGTERM (finishing the current step,
- * writing a final increment and a stop reason).
+ * equilibrates, applies the boundary mode, writes every display increment, the time series
+ * and periodic checkpoints (output.checkpoint_interval), shows progress, and stops cleanly
+ * on SIGINT/SIGTERM (finishing the current step, writing a checkpoint, a final increment and
+ * a stop reason); cdem_run_resume continues a stored run bit-identically from its newest
+ * checkpoint (docs/reliability.md).
  * Ownership: the caller owns params and options. Thread safety: one run per process (the
  * signal flag is the only process-wide state and is owned by main, passed in as a pointer). */
 #ifndef CDEM_RUN_H
