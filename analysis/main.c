@@ -84,7 +84,31 @@ static const char *phase_name(int phase) {
 }
 
 /* ---------------------------------------------------------------- info */
+/* info on a file without increments yet (a run that has just started, or was killed
+ * before its first increment): the stored texts and "increments: 0". -1 when it has some. */
+static int info_without_increments(const char *path) {
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        return -1; /* open_run reports the problem */
+    if (cdem_h5_reader_increment_count(r) > 0) {
+        cdem_h5_reader_close(r);
+        return -1;
+    }
+    const char *sum = cdem_h5_reader_summary(r);
+    printf("%s%s", sum, sum[0] && sum[strlen(sum) - 1] != '\n' ? "\n" : "");
+    const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
+    printf("\nstop reason: %s%s%s\n", reason[0] ? reason : "(none recorded)", detail[0] ? ": " : "",
+           detail);
+    printf("increments: 0 (none written yet)\n");
+    cdem_h5_reader_close(r);
+    return EXIT_OK;
+}
+
 static int cmd_info(const options *o) {
+    int none = o->file ? info_without_increments(o->file) : -1;
+    if (none >= 0)
+        return none;
     cdem_analysis *a;
     int rc = open_run(o, &a);
     if (rc)

@@ -79,10 +79,23 @@ static size_t check_file(const char *path, char *stop, size_t stop_len) {
     snprintf(stop, stop_len, "%s", cdem_h5_reader_stop_reason(r));
     cdem_state_free(&s);
     cdem_h5_reader_close(r);
-    char cmd[2400];
-    snprintf(cmd, sizeof cmd, "'%s/cdem-strain' info '%s' >/dev/null 2>&1", build_dir(), path);
-    if (system(cmd) != 0)
-        fail_msg("cdem-strain info fails on %s", path);
+    char cmd[4800], log[1100];
+    snprintf(log, sizeof log, "%s.info", path);
+    snprintf(cmd, sizeof cmd, "'%s/cdem-strain' info '%s' >'%s' 2>&1", build_dir(), path, log);
+    if (system(cmd) != 0) {
+        char text[2048] = "";
+        FILE *f = fopen(log, "r");
+        if (f) {
+            size_t got = fread(text, 1, sizeof text - 1, f);
+            text[got] = '\0';
+            fclose(f);
+        }
+        snprintf(cmd, sizeof cmd, "cp '%s' '%s.failed.h5'", path, path);
+        if (system(cmd) != 0)
+            text[0] = text[0];
+        fail_msg("cdem-strain info fails on %s (kept as %s.failed.h5): %s", path, path, text);
+    }
+    remove(log);
     return n;
 }
 
