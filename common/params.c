@@ -166,6 +166,8 @@ static const cdem_param_def param_table[] = {
      "colour-bar maximum for total strain"},
     {"output", "series_interval", CDEM_PTYPE_INT, P_OFF(series_interval), 0, "steps", "100", 1, 1000000, 0, 0, NULL,
      "time steps between time-series samples"},
+    {"output", "checkpoint_interval", CDEM_PTYPE_INT, P_OFF(checkpoint_interval), 0, "increments", "10", 0, 1000000, 0, 0, NULL,
+     "display increments between checkpoints that cdem-run --resume continues from (0 = none)"},
 };
 /* clang-format on */
 

@@ -119,6 +119,7 @@ typedef struct {
     char prefix[64];         /* prefix for per-increment exports (cdem282.txt) */
     double total_strain_max; /* colour-bar maximum for total strain, 0.1-5.0 */
     int series_interval;     /* time steps between time-series samples, >= 1 */
+    int checkpoint_interval; /* display increments between checkpoints (resume), 0 = off */
 } cdem_params;
 
 typedef enum {

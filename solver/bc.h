@@ -18,6 +18,7 @@
 #include "cdem_error.h"
 #include "model.h"
 #include "params.h"
+#include "snapshot.h"
 #include "state.h"
 
 #include <stdio.h>
@@ -41,6 +42,12 @@ typedef struct {
      * values from what was recorded, forces not read); step = completed time steps */
     void (*measure)(void *ctx, const cdem_state *s, long step, int sample, double *axial_strain,
                     double *differential_stress);
+    /* checkpoints (may be NULL: the mode cannot be checkpointed, CDEM_ERR_UNSUPPORTED): save
+     * puts the context's evolving fields under "bc." (checkpoint.h); restore reads them back
+     * into a context freshly init'ed on the same assembly (configuration fields are set by
+     * init; a stored one that differs fails with CDEM_ERR_CONFLICT) */
+    cdem_status (*save)(const void *ctx, cdem_snapshot *snap, cdem_error *err);
+    cdem_status (*restore)(void *ctx, const cdem_snapshot *snap, cdem_error *err);
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
@@ -80,6 +87,10 @@ static inline double cdem_bc_confining_ramp(long step, long equil) {
     const double f = ((double)step - h) / ((double)equil - h);
     return f <= 0.0 ? 0.0 : (f >= 1.0 ? 1.0 : f);
 }
+/* Checkpoints: the mode's name ("bc.mode") and its save/restore hooks; CDEM_ERR_UNSUPPORTED
+ * naming the mode when it has none, CDEM_ERR_CONFLICT when the stored mode is another. */
+cdem_status cdem_bc_snapshot_put(const cdem_bc *bc, cdem_snapshot *snap, cdem_error *err);
+cdem_status cdem_bc_snapshot_get(cdem_bc *bc, const cdem_snapshot *snap, cdem_error *err);
 /* Releases the context; bc may be NULL or never initialised. */
 void cdem_bc_free(cdem_bc *bc);
 

@@ -14,6 +14,7 @@
  * samples of the last 5 increments (v3.1), minus the value at the end of equilibration (v2.6)
  * from then on (during equilibration the uncorrected value is reported). Units: m, N, N/m. */
 #include "bc.h"
+#include "checkpoint.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -217,6 +218,56 @@ static void biaxial_free(void *vctx) {
     c->ring_f = c->ring_l = NULL;
 }
 
+/* Checkpoint: the platen heights and closure, the averaging window (ring buffers, fill,
+ * head), the end-of-equilibration reference and the last sample evolve; the window length
+ * and the initial gap are set by init (checked). */
+static cdem_status biaxial_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const biaxial_ctx *c = vctx;
+    const char *P = "bc";
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "h0", c->h0, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "window", (int64_t)c->window, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "y_bottom", c->y_bottom, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "y_top", c->y_top, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "closure", c->closure, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "ring_f", CDEM_SNAP_F64, c->window, c->ring_f, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "ring_l", CDEM_SNAP_F64, c->window, c->ring_l, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_ring", (int64_t)c->n_ring, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "head", (int64_t)c->head, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "have_ref", c->have_ref, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "ref", c->ref, err));
+    return cdem_ckpt_put_f64(snap, P, "last", c->last, err);
+}
+
+static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    biaxial_ctx *c = vctx;
+    const char *P = "bc";
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "h0", c->h0, err));
+    int64_t window = 0, n_ring = 0, head = 0, have_ref = 0;
+    CDEM_TRY(cdem_ckpt_get_i64(snap, P, "window", &window, err));
+    if (window != (int64_t)c->window)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint bc.window = %lld samples but this run averages over %zu: the "
+                         "checkpoint belongs to another model",
+                         (long long)window, c->window);
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_ring", 0, window, &n_ring, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "head", 0, window - 1, &head, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "have_ref", 0, 1, &have_ref, err));
+    const cdem_snapshot_array *rf = NULL, *rl = NULL;
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "ring_f", CDEM_SNAP_F64, c->window, &rf, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "ring_l", CDEM_SNAP_F64, c->window, &rl, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "y_bottom", &c->y_bottom, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "y_top", &c->y_top, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "closure", &c->closure, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "ref", &c->ref, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "last", &c->last, err));
+    memcpy(c->ring_f, rf->data, c->window * sizeof *c->ring_f);
+    memcpy(c->ring_l, rl->data, c->window * sizeof *c->ring_l);
+    c->n_ring = (size_t)n_ring;
+    c->head = (size_t)head;
+    c->have_ref = (int)have_ref;
+    return CDEM_OK;
+}
+
 static const cdem_bc_ops biaxial_ops = {
     .name = "biaxial",                    /* name */
     .state_size = sizeof(biaxial_ctx),    /* state_size */
@@ -228,6 +279,8 @@ static const cdem_bc_ops biaxial_ops = {
     .begin_deformation = biaxial_begin,   /* removes the lateral walls */
     .lateral_pressure = biaxial_pressure, /* confining pressure */
     .measure = biaxial_measure,           /* axial strain, differential stress */
+    .save = biaxial_save,                 /* checkpoint: platens, window, reference */
+    .restore = biaxial_restore,           /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

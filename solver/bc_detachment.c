@@ -9,6 +9,7 @@
  * wall's displacement for "right" and the sum of both walls' displacements (2 k du) for
  * "both", as in version 2.6 of the original program. */
 #include "bc.h"
+#include "checkpoint.h"
 
 #include <math.h>
 #include <string.h>
@@ -96,6 +97,19 @@ static void detach_view(const void *vctx, FILE *out) {
                 c->n_right);
 }
 
+/* Checkpoint: the shortening evolves; the walls are set by init (x_mid checked). */
+static cdem_status detach_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const detach_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_mid", c->x_mid, err));
+    return cdem_ckpt_put_f64(snap, "bc", "net", c->net, err);
+}
+
+static cdem_status detach_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    detach_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x_mid", c->x_mid, err));
+    return cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err);
+}
+
 static const cdem_bc_ops detach_ops = {
     .name = "detachment",             /* name */
     .state_size = sizeof(detach_ctx), /* state_size */
@@ -105,6 +119,8 @@ static const cdem_bc_ops detach_ops = {
     .view = detach_view,              /* view */
     .free = NULL,                     /* free: the context owns no memory */
     .begin_deformation = NULL,        /* nothing to remove */
+    .save = detach_save,              /* checkpoint: net */
+    .restore = detach_restore,        /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_detachment = &detach_ops;

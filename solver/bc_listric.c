@@ -22,6 +22,7 @@
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
  * right wall move du along the basal segment. */
 #include "bc.h"
+#include "checkpoint.h"
 #include "fault_file.h"
 
 #include <math.h>
@@ -326,6 +327,43 @@ static void listric_free(void *vctx) {
     c->path_x = c->path_y = c->path_s = NULL;
 }
 
+/* Checkpoint: the net displacement and (CD) the sheet offset evolve; the curve, the path and
+ * the fault elements are set by init on the same assembly (x_fault, first_id checked). */
+static cdem_status listric_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const listric_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_fault", c->x_fault, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, "bc", "first_id", c->first_id, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, "bc", "line_x", CDEM_SNAP_F64, c->line.n, c->line.x, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, "bc", "line_y", CDEM_SNAP_F64, c->line.n, c->line.y, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "net", c->net, err));
+    return cdem_ckpt_put_f64(snap, "bc", "sheet", c->sheet, err);
+}
+
+static cdem_status listric_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    listric_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x_fault", c->x_fault, err));
+    int64_t first = 0;
+    CDEM_TRY(cdem_ckpt_get_i64(snap, "bc", "first_id", &first, err));
+    if (first != c->first_id)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint bc.first_id = %lld but this run's first fault element has id "
+                         "%d: the checkpoint belongs to another model",
+                         (long long)first, (int)c->first_id);
+    /* the fault curve (for irregular faults re-read from the vertex file) must be the same */
+    const cdem_snapshot_array *lx = NULL, *ly = NULL;
+    CDEM_TRY(cdem_ckpt_get_array(snap, "bc", "line_x", CDEM_SNAP_F64, SIZE_MAX, &lx, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, "bc", "line_y", CDEM_SNAP_F64, lx->count, &ly, err));
+    if (lx->count != c->line.n || memcmp(lx->data, c->line.x, c->line.n * sizeof(double)) != 0 ||
+        memcmp(ly->data, c->line.y, c->line.n * sizeof(double)) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "%s: the fault curve of the checkpoint (%zu vertices) differs from this "
+                         "run's (%zu vertices%s): the checkpoint belongs to another fault",
+                         mode_name(c), lx->count, c->line.n,
+                         c->irregular ? ", read again from boundary.fault_file" : "");
+    CDEM_TRY(cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err));
+    return cdem_ckpt_get_f64(snap, "bc", "sheet", &c->sheet, err);
+}
+
 static const cdem_bc_ops listric_ops = {
     .name = "listric-fault",
     .state_size = sizeof(listric_ctx),
@@ -334,6 +372,8 @@ static const cdem_bc_ops listric_ops = {
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
+    .save = listric_save,
+    .restore = listric_restore,
 };
 
 static const cdem_bc_ops irregular_ops = {
@@ -344,6 +384,8 @@ static const cdem_bc_ops irregular_ops = {
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
+    .save = listric_save,
+    .restore = listric_restore,
 };
 
 const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;

@@ -13,6 +13,7 @@
  * becomes the exposed fault face as the block rises. Ramps and walls never interact with
  * each other (boundary-boundary pairs are skipped). */
 #include "bc.h"
+#include "checkpoint.h"
 
 #include <math.h>
 #include <string.h>
@@ -159,6 +160,26 @@ static void planar_view(const void *vctx, FILE *out) {
     fprintf(out, "\n");
 }
 
+/* Checkpoint: net and gross displacement evolve; the geometry is set by init on the same
+ * assembly (x_fault and the direction are checked). */
+static cdem_status planar_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const planar_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_fault", c->x_fault, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "dir_x", c->dir_x, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "dir_y", c->dir_y, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "net", c->net, err));
+    return cdem_ckpt_put_f64(snap, "bc", "gross", c->gross, err);
+}
+
+static cdem_status planar_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    planar_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x_fault", c->x_fault, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "dir_x", c->dir_x, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "dir_y", c->dir_y, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err));
+    return cdem_ckpt_get_f64(snap, "bc", "gross", &c->gross, err);
+}
+
 static const cdem_bc_ops planar_ops = {
     .name = "planar-fault",           /* name */
     .state_size = sizeof(planar_ctx), /* state_size */
@@ -167,6 +188,8 @@ static const cdem_bc_ops planar_ops = {
     .net_displacement = planar_net,   /* net_displacement */
     .view = planar_view,              /* view */
     .free = NULL,                     /* free: the context owns no memory */
+    .save = planar_save,              /* checkpoint: net, gross */
+    .restore = planar_restore,        /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_planar_fault = &planar_ops;

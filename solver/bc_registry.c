@@ -2,6 +2,8 @@
  * one new bc_<name>.c plus one row here; modes without a row fail with a clear message. */
 #include "bc.h"
 
+#include "checkpoint.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,4 +140,29 @@ cdem_status cdem_bc_find_walls(const cdem_state *s, const cdem_model *m, const c
                          rb);
     w->r_base = rb;
     return CDEM_OK;
+}
+
+cdem_status cdem_bc_snapshot_put(const cdem_bc *bc, cdem_snapshot *snap, cdem_error *err) {
+    if (!bc || !bc->ops)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_bc_snapshot_put: boundary mode not initialised");
+    if (!bc->ops->save)
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "boundary mode %s cannot write checkpoints in this build (set "
+                         "output.checkpoint_interval = 0)",
+                         bc->ops->name);
+    CDEM_TRY(cdem_ckpt_put_text(snap, "bc", "mode", bc->ops->name, err));
+    return bc->ops->save(bc->ctx, snap, err);
+}
+
+cdem_status cdem_bc_snapshot_get(cdem_bc *bc, const cdem_snapshot *snap, cdem_error *err) {
+    if (!bc || !bc->ops)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_bc_snapshot_get: boundary mode not initialised");
+    if (!bc->ops->restore)
+        return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                         "boundary mode %s cannot resume from a checkpoint in this build",
+                         bc->ops->name);
+    CDEM_TRY(cdem_ckpt_check_text(snap, "bc", "mode", bc->ops->name, "boundary mode", err));
+    return bc->ops->restore(bc->ctx, snap, err);
 }

@@ -7,6 +7,7 @@
  * escape rule. Net displacement is always 0; the display interval is in seconds
  * (common/model.c). */
 #include "bc.h"
+#include "checkpoint.h"
 
 #include <string.h>
 
@@ -85,6 +86,23 @@ static void repose_view(const void *vctx, FILE *out) {
             c->walls == CDEM_WALLS_BOTH ? "both lateral walls" : "the right wall", c->n_walls);
 }
 
+/* Checkpoint: only the count of removed walls evolves (the walls themselves are gone from
+ * the stored state once begin_deformation has run). */
+static cdem_status repose_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const repose_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x_mid", c->x_mid, err));
+    return cdem_ckpt_put_i64(snap, "bc", "n_removed", c->n_removed, err);
+}
+
+static cdem_status repose_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    repose_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x_mid", c->x_mid, err));
+    int64_t n = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, "bc", "n_removed", 0, INT32_MAX, &n, err));
+    c->n_removed = (long)n;
+    return CDEM_OK;
+}
+
 static const cdem_bc_ops repose_ops = {
     .name = "repose",                  /* name */
     .state_size = sizeof(repose_ctx),  /* state_size */
@@ -94,6 +112,8 @@ static const cdem_bc_ops repose_ops = {
     .view = repose_view,               /* view */
     .free = NULL,                      /* free: the context owns no memory */
     .begin_deformation = repose_begin, /* removes the walls */
+    .save = repose_save,               /* checkpoint: n_removed */
+    .restore = repose_restore,         /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_repose = &repose_ops;

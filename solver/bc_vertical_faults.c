@@ -12,6 +12,7 @@
  * fixed for caldera (the pit's side walls), moving with the block for piston (the block's
  * faces as it rises). Net displacement = the block's displacement along its sense (>= 0). */
 #include "bc.h"
+#include "checkpoint.h"
 
 #include <math.h>
 #include <string.h>
@@ -121,6 +122,21 @@ static void vert_view(const void *vctx, FILE *out) {
             c->sense == CDEM_VERT_CALDERA ? "fixed" : "moving", c->col_length);
 }
 
+/* Checkpoint: the block's displacement evolves; the faults are set by init (x1, x2 checked). */
+static cdem_status vert_save(const void *vctx, cdem_snapshot *snap, cdem_error *err) {
+    const vert_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x1", c->x1, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, "bc", "x2", c->x2, err));
+    return cdem_ckpt_put_f64(snap, "bc", "net", c->net, err);
+}
+
+static cdem_status vert_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
+    vert_ctx *c = vctx;
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x1", c->x1, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, "bc", "x2", c->x2, err));
+    return cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err);
+}
+
 static const cdem_bc_ops vert_ops = {
     .name = "vertical-faults",      /* name */
     .state_size = sizeof(vert_ctx), /* state_size */
@@ -130,6 +146,8 @@ static const cdem_bc_ops vert_ops = {
     .view = vert_view,              /* view */
     .free = NULL,                   /* free: the context owns no memory */
     .begin_deformation = NULL,      /* nothing to remove */
+    .save = vert_save,              /* checkpoint: net */
+    .restore = vert_restore,        /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_vertical_faults = &vert_ops;

@@ -2,8 +2,11 @@
  * header so the force loop in integrate.c can inline it. */
 #include "contact.h"
 
+#include "checkpoint.h"
 #include "model.h"
 #include "state.h"
+
+#include <string.h>
 
 static const char *const class_names[CDEM_CLASS_TOTAL] = {"element",
                                                           "wall",
@@ -162,5 +165,50 @@ cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *
     }
     if (marked)
         *marked = count;
+    return CDEM_OK;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+/* The law as a flat array of doubles, in a fixed order (the check compares bits). */
+static size_t law_values(const cdem_contact_law *law, double *v) {
+    size_t k = 0;
+    v[k++] = (double)law->model;
+    v[k++] = (double)law->first_slip;
+    v[k++] = law->kn;
+    v[k++] = law->ks;
+    for (int c = 0; c < CDEM_CLASS_TOTAL; c++) {
+        v[k++] = law->friction[c];
+        v[k++] = law->cohesion[c];
+        v[k++] = law->breaking_strain[c];
+    }
+    v[k++] = law->max_breaking_strain;
+    v[k++] = (double)law->flexural_slip;
+    v[k++] = (double)law->layered_friction;
+    return k;
+}
+
+#define LAW_VALUES (4 + 3 * CDEM_CLASS_TOTAL + 3)
+
+cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot *snap,
+                                      cdem_error *err) {
+    double v[LAW_VALUES];
+    const size_t n = law_values(law, v);
+    return cdem_ckpt_put_array(snap, "contact", "law", CDEM_SNAP_F64, n, v, err);
+}
+
+cdem_status cdem_contact_snapshot_check(const cdem_contact_law *law, const cdem_snapshot *snap,
+                                        cdem_error *err) {
+    double v[LAW_VALUES];
+    const size_t n = law_values(law, v);
+    const cdem_snapshot_array *a = NULL;
+    CDEM_TRY(cdem_ckpt_get_array(snap, "contact", "law", CDEM_SNAP_F64, n, &a, err));
+    const double *stored = a->data;
+    for (size_t k = 0; k < n; k++)
+        if (memcmp(&stored[k], &v[k], sizeof v[k]) != 0)
+            return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                             "checkpoint contact.law value %zu = %.17g but this run's contact law "
+                             "has %.17g: the checkpoint belongs to another material",
+                             k, stored[k], v[k]);
     return CDEM_OK;
 }

@@ -21,6 +21,7 @@
 
 #include "cdem_error.h"
 #include "params.h"
+#include "snapshot.h"
 #include "state.h"
 
 #include <math.h>
@@ -93,6 +94,16 @@ int cdem_contact_layered_layer(int32_t layer);
  * CDEM_ERR_RANGE naming the key when a percentage is outside 0..100. */
 cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *marked,
                                      cdem_error *err);
+
+/* Checkpoints (checkpoint.h): the law's values under "contact." (model, first_slip, kn, ks,
+ * per-class friction, cohesion, breaking strain, heterogeneity switches). The contact
+ * histories themselves (flags, tangential displacement) belong to the pair list and are
+ * stored with it (cdem_neighbour_snapshot_put). _check fails with CDEM_ERR_CONFLICT naming
+ * the value when the law of the run being resumed differs from the stored one. */
+cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot *snap,
+                                      cdem_error *err);
+cdem_status cdem_contact_snapshot_check(const cdem_contact_law *law, const cdem_snapshot *snap,
+                                        cdem_error *err);
 
 /* Evaluates one pair. dx, dy = xj - xi; R = ri + rj; dvx, dvy = vj - vi (mid-step velocities,
  * so dv * dt is the relative displacement of the step). Updates *xs and *hist; writes the

@@ -6,6 +6,8 @@
  * per output slot, so any thread count gives identical bits. */
 #include "integrate.h"
 
+#include "checkpoint.h"
+
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -591,4 +593,68 @@ void cdem_integrator_count(const cdem_integrator *it, long *contacts, long *bond
         *contacts = c;
     if (bonds)
         *bonds = b;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+cdem_status cdem_integrator_snapshot_put(const cdem_integrator *it, cdem_snapshot *snap,
+                                         cdem_error *err) {
+    const char *P = "it";
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "dt", it->dt, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "damping", it->damping, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "gravity", it->gravity, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "overburden_force", it->overburden_force, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "confining_pressure", it->confining_pressure, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "step", it->step, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "boundary_forces", it->boundary_forces, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "bounds_set", it->bounds_set, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "escape_xmin", it->escape_xmin, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "escape_xmax", it->escape_xmax, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "escape_ymin", it->escape_ymin, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_removed", it->n_removed, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_surface", it->n_surface, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_edge", it->n_edge, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "confining_factor", it->confining_factor, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "edge_x_mid", it->edge_x_mid, err));
+    CDEM_TRY(cdem_contact_snapshot_put(&it->law, snap, err));
+    return cdem_neighbour_snapshot_put(&it->nb, snap, err);
+}
+
+cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapshot *snap,
+                                         const cdem_state *s, cdem_error *err) {
+    const char *P = "it";
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "dt", it->dt, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "damping", it->damping, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "gravity", it->gravity, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "overburden_force", it->overburden_force, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "confining_pressure", it->confining_pressure, err));
+    CDEM_TRY(cdem_contact_snapshot_check(&it->law, snap, err));
+    int64_t step = 0, bf = 0, bounds = 0, n_removed = 0, n_surface = 0, n_edge = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "step", 0, INT64_MAX, &step, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "boundary_forces", 0, 1, &bf, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "bounds_set", 0, 1, &bounds, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_removed", 0, INT64_MAX, &n_removed, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_surface", 0, INT64_MAX, &n_surface, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_edge", 0, INT64_MAX, &n_edge, err));
+    double exmin = 0.0, exmax = 0.0, eymin = 0.0, cf = 0.0, exmid = 0.0;
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "escape_xmin", &exmin, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "escape_xmax", &exmax, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "escape_ymin", &eymin, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "confining_factor", &cf, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "edge_x_mid", &exmid, err));
+    CDEM_TRY(cdem_neighbour_snapshot_get(&it->nb, snap, s, err));
+    CDEM_TRY(reserve_keep(it, s->n, err));
+    it->step = (long)step;
+    it->boundary_forces = (int)bf;
+    it->bounds_set = (int)bounds;
+    it->escape_xmin = exmin;
+    it->escape_xmax = exmax;
+    it->escape_ymin = eymin;
+    it->n_removed = (long)n_removed;
+    it->n_surface = (long)n_surface;
+    it->n_edge = (long)n_edge;
+    it->confining_factor = cf;
+    it->edge_x_mid = exmid;
+    it->n_removed_last = 0;
+    return CDEM_OK;
 }

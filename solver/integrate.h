@@ -141,4 +141,18 @@ long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s);
 /* Counts touching pairs and intact bonds / cohesive contacts. */
 void cdem_integrator_count(const cdem_integrator *it, long *contacts, long *bonds);
 
+/* Checkpoints (checkpoint.h): the stepper's evolving fields under "it." (step, escape
+ * bounds, removal count, surface/edge counts, confining ramp factor and edge midpoint,
+ * boundary_forces), its configuration (dt, damping, gravity, overburden, confining pressure;
+ * checked on restore), the contact law (cdem_contact_snapshot_put) and the pair list with
+ * the contact histories (cdem_neighbour_snapshot_put). Scratch (keep, removed_ids, col_top,
+ * band_lo/hi) is not stored. */
+cdem_status cdem_integrator_snapshot_put(const cdem_integrator *it, cdem_snapshot *snap,
+                                         cdem_error *err);
+/* Restores into it, set up as for the original run (init, set_overburden, set_confining,
+ * enable_escape): CDEM_ERR_CONFLICT when its configuration differs from the stored one. s is
+ * the already restored state. */
+cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapshot *snap,
+                                         const cdem_state *s, cdem_error *err);
+
 #endif

@@ -39,6 +39,7 @@ static const char usage_text[] =
     "                [--dry-run] [--print-defaults] [--params-markdown] [--max-steps N]\n"
     "                [--ignore-free-space]\n"
     "                [--version] [-h|--help]\n"
+    "       cdem-run --resume RUN.h5 [-q] [--max-steps N]\n"
     "\n"
     "Simulates a 2-D discrete element model and writes every display increment to an HDF5\n"
     "file. Without MODEL.ini the built-in default model is used (the paper's Figure 7A:\n"
@@ -54,6 +55,12 @@ static const char usage_text[] =
     "                       values (defaults + file + overrides) and exit\n"
     "  --params-markdown    print the parameter table in markdown (docs/parameters.md)\n"
     "  --max-steps N        stop after N time steps (tests, benchmarks)\n"
+    "  --resume RUN.h5      continue a stopped or killed run from its newest checkpoint\n"
+    "                       (output.checkpoint_interval); the parameters come from the\n"
+    "                       file, so MODEL.ini, -s and -o are refused; the result is\n"
+    "                       bit-identical to an uninterrupted run\n"
+    "  --par-min N          run loops of N or more items on several threads (default\n"
+    "                       16384; results are identical for any N and thread count)\n"
     "  --ignore-free-space  run even when the output directory has less free space than\n"
     "                       the estimated file size\n"
     "  --version            print the version and exit\n"
@@ -94,6 +101,8 @@ typedef struct {
     int params_markdown;     /* --params-markdown */
     int help, version;       /* -h/--help, --version */
     long max_steps;          /* --max-steps, 0 = no limit */
+    const char *resume_path; /* --resume RUN.h5, or NULL */
+    long par_min;            /* --par-min, 0 = default */
     int ignore_free_space;   /* --ignore-free-space */
 } cli_args;
 
@@ -135,6 +144,18 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             if (end == argv[i] || *end != '\0' || n <= 0)
                 return usage_error("--max-steps %s: expected a whole number > 0", argv[i]);
             a->max_steps = n;
+        } else if (strcmp(arg, "--resume") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs the run file to continue", arg);
+            a->resume_path = argv[++i];
+        } else if (strcmp(arg, "--par-min") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs a number of items", arg);
+            char *end = NULL;
+            long n = strtol(argv[++i], &end, 10);
+            if (end == argv[i] || *end != '\0' || n <= 0)
+                return usage_error("--par-min %s: expected a whole number > 0", argv[i]);
+            a->par_min = n;
         } else if (arg[0] == '-' && arg[1] != '\0') {
             return usage_error("unknown option %s", arg);
         } else if (!a->model_path) {
@@ -183,6 +204,49 @@ static char *stored_params_text(const cdem_params *p, const cli_args *a, char *f
     return buf;
 }
 
+static void install_handlers(void) {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+/* --resume: the parameters are those stored in the file; anything that could change the
+ * physics (a model file, -s overrides) is refused, as is -o (the file itself continues). */
+static int resume(const cli_args *a, cdem_error *err) {
+    if (a->model_path || a->n_overrides > 0 || a->output_path || a->summary_only || a->dry_run ||
+        a->print_defaults) {
+        fprintf(stderr,
+                "cdem-run: --resume %s continues the run with the parameters stored in the file; "
+                "it cannot be combined with %s (they could change the results; a resumed run is "
+                "bit-identical to an uninterrupted one)\n",
+                a->resume_path,
+                a->model_path        ? "a model file"
+                : a->n_overrides > 0 ? "-s overrides"
+                : a->output_path     ? "-o (the run file itself is continued)"
+                                     : "--summary/--dry-run/--print-defaults");
+        return EXIT_USAGE;
+    }
+    install_handlers();
+    cdem_run_options opt = {
+        .output_path = a->resume_path,
+        .params_text = NULL,
+        .quiet = a->quiet,
+        .progress_is_tty = isatty(STDERR_FILENO),
+        .log = stderr,
+        .stop_requested = &stop_requested,
+        .max_steps = a->max_steps,
+        .par_min = a->par_min,
+    };
+    cdem_status st = cdem_run_resume(a->resume_path, &opt, err);
+    if (st == CDEM_OK)
+        return EXIT_OK;
+    print_error(err->msg[0] ? err->msg : cdem_status_str(st));
+    return st == CDEM_ERR_INTERRUPTED ? EXIT_INTERRUPTED : EXIT_ERROR;
+}
+
 int main(int argc, char **argv) {
     cli_args a;
     memset(&a, 0, sizeof a);
@@ -214,6 +278,11 @@ int main(int argc, char **argv) {
 
     cdem_error err;
     cdem_error_clear(&err);
+    if (a.resume_path) {
+        rc = resume(&a, &err);
+        free(a.overrides);
+        return rc;
+    }
     cdem_params p;
     cdem_params_defaults(&p);
     char *file_text = NULL;
@@ -274,12 +343,7 @@ int main(int argc, char **argv) {
         goto done;
     }
 
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    install_handlers();
 
     cdem_run_options opt = {
         .output_path = out_path,
@@ -289,6 +353,7 @@ int main(int argc, char **argv) {
         .log = stderr,
         .stop_requested = &stop_requested,
         .max_steps = a.max_steps,
+        .par_min = a.par_min,
         .ignore_free_space = a.ignore_free_space,
     };
     cdem_status st = cdem_run(&p, &opt, &err);

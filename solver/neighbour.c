@@ -6,6 +6,7 @@
  * All of it is serial and ordered, so the list is the same for any thread count. */
 #include "neighbour.h"
 
+#include "checkpoint.h"
 #include "contact.h"
 
 #include <math.h>
@@ -372,5 +373,107 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     memcpy(nb->y0, s->y, n * sizeof(double));
     nb->n = n;
     nb->n_builds++;
+    return CDEM_OK;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+cdem_status cdem_neighbour_snapshot_put(const cdem_neighbour *nb, cdem_snapshot *snap,
+                                        cdem_error *err) {
+    const char *P = "nb";
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "skin", nb->skin, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "reach_factor", nb->reach_factor, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "resort_every", nb->resort_every, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "np", (int64_t)nb->np, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n", (int64_t)nb->n, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_builds", nb->n_builds, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_sorts", nb->n_sorts, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "pi", CDEM_SNAP_I32, nb->np, nb->pi, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "pj", CDEM_SNAP_I32, nb->np, nb->pj, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "R", CDEM_SNAP_F64, nb->np, nb->R, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "cls", CDEM_SNAP_U8, nb->np, nb->cls, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "hist", CDEM_SNAP_U8, nb->np, nb->hist, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "xs", CDEM_SNAP_F64, nb->np, nb->xs, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "pfx", CDEM_SNAP_F64, nb->np, nb->pfx, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "pfy", CDEM_SNAP_F64, nb->np, nb->pfy, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "x0", CDEM_SNAP_F64, nb->n, nb->x0, err));
+    CDEM_TRY(cdem_ckpt_put_array(snap, P, "y0", CDEM_SNAP_F64, nb->n, nb->y0, err));
+    return CDEM_OK;
+}
+
+cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot *snap,
+                                        const cdem_state *s, cdem_error *err) {
+    const char *P = "nb";
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "skin", nb->skin, err));
+    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "reach_factor", nb->reach_factor, err));
+    int64_t resort_every = 0, np = 0, n = 0, n_builds = 0, n_sorts = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "resort_every", 1, INT32_MAX, &resort_every, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "np", 0, INT32_MAX, &np, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n", 0, INT32_MAX, &n, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_builds", 0, INT64_MAX, &n_builds, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_sorts", 0, INT64_MAX, &n_sorts, err));
+    if ((size_t)n != s->n)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "checkpoint nb.n = %lld elements but the state has %zu (corrupt "
+                         "checkpoint)",
+                         (long long)n, s->n);
+    const size_t P_ = (size_t)np, N_ = (size_t)n;
+    const cdem_snapshot_array *pi, *pj, *R, *cls, *hist, *xs, *pfx, *pfy, *x0, *y0;
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "pi", CDEM_SNAP_I32, P_, &pi, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "pj", CDEM_SNAP_I32, P_, &pj, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "R", CDEM_SNAP_F64, P_, &R, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "cls", CDEM_SNAP_U8, P_, &cls, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "hist", CDEM_SNAP_U8, P_, &hist, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "xs", CDEM_SNAP_F64, P_, &xs, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "pfx", CDEM_SNAP_F64, P_, &pfx, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "pfy", CDEM_SNAP_F64, P_, &pfy, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "x0", CDEM_SNAP_F64, N_, &x0, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "y0", CDEM_SNAP_F64, N_, &y0, err));
+    /* pairs must be ordered as a build makes them: ascending pi, pi < pj < n */
+    const int32_t *a = pi->data, *b = pj->data;
+    for (size_t p = 0; p < P_; p++)
+        if (a[p] < 0 || a[p] >= b[p] || (size_t)b[p] >= N_ || (p > 0 && a[p] < a[p - 1]))
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                             "checkpoint nb.pi/nb.pj: pair %zu = (%d, %d) is not a valid pair of "
+                             "%zu elements in list order (corrupt checkpoint)",
+                             p, (int)a[p], (int)b[p], N_);
+    CDEM_TRY(reserve_elements(nb, N_ + 1, err));
+    CDEM_TRY(reserve_pairs(nb, P_, err));
+    if (P_ > 0) {
+        memcpy(nb->pi, pi->data, P_ * sizeof *nb->pi);
+        memcpy(nb->pj, pj->data, P_ * sizeof *nb->pj);
+        memcpy(nb->R, R->data, P_ * sizeof *nb->R);
+        memcpy(nb->cls, cls->data, P_ * sizeof *nb->cls);
+        memcpy(nb->hist, hist->data, P_ * sizeof *nb->hist);
+        memcpy(nb->xs, xs->data, P_ * sizeof *nb->xs);
+        memcpy(nb->pfx, pfx->data, P_ * sizeof *nb->pfx);
+        memcpy(nb->pfy, pfy->data, P_ * sizeof *nb->pfy);
+    }
+    if (N_ > 0) {
+        memcpy(nb->x0, x0->data, N_ * sizeof *nb->x0);
+        memcpy(nb->y0, y0->data, N_ * sizeof *nb->y0);
+    }
+    nb->np = P_;
+    nb->n = N_;
+    nb->resort_every = (int)resort_every;
+    nb->n_builds = (long)n_builds;
+    nb->n_sorts = (long)n_sorts;
+    nb->ncarry = 0;
+    /* the CSR exactly as cdem_neighbour_build derives it from pi, pj */
+    memset(nb->istart, 0, (N_ + 1) * sizeof(int32_t));
+    memset(nb->jstart, 0, (N_ + 1) * sizeof(int32_t));
+    for (size_t p = 0; p < P_; p++) {
+        nb->istart[nb->pi[p] + 1]++;
+        nb->jstart[nb->pj[p] + 1]++;
+    }
+    for (size_t i = 0; i < N_; i++) {
+        nb->istart[i + 1] += nb->istart[i];
+        nb->jstart[i + 1] += nb->jstart[i];
+    }
+    int32_t *cursor = (int32_t *)nb->scratch;
+    if (N_ > 0)
+        memcpy(cursor, nb->jstart, N_ * sizeof(int32_t));
+    for (size_t p = 0; p < P_; p++)
+        nb->jslot[cursor[nb->pj[p]]++] = (int32_t)p;
     return CDEM_OK;
 }

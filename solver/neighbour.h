@@ -15,6 +15,7 @@
 #define CDEM_NEIGHBOUR_H
 
 #include "cdem_error.h"
+#include "snapshot.h"
 #include "state.h"
 
 #include <stddef.h>
@@ -87,6 +88,18 @@ int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s);
  * element id when a position is not finite. */
 cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
                                  int resort, cdem_error *err);
+
+/* Checkpoints (checkpoint.h): the whole list under "nb." — pairs in their order (pi, pj, R,
+ * cls), the contact histories (hist, xs), the last pair forces (pfx, pfy), the reference
+ * positions of the last build (x0, y0), n, n_builds, n_sorts — so a resumed run rebuilds at
+ * the same steps, re-sorts at the same builds and sums forces in the same pair order. The
+ * CSR (istart, jstart, jslot) is derived from pi, pj exactly as a build derives it. */
+cdem_status cdem_neighbour_snapshot_put(const cdem_neighbour *nb, cdem_snapshot *snap,
+                                        cdem_error *err);
+/* Restores into nb (initialised with the same skin and reach factor, else CDEM_ERR_CONFLICT)
+ * for the state s already restored (s->n must equal the stored n). */
+cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot *snap,
+                                        const cdem_state *s, cdem_error *err);
 
 /* Key of a pair of ids (order-independent). */
 static inline uint64_t cdem_pair_key(int32_t a, int32_t b) {

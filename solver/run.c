@@ -10,12 +10,16 @@
  * is recorded, the file closed, CDEM_ERR_INTERRUPTED returned. NaN/Inf: stop reason
  * "numerical-failure" with the diagnosis, file closed (every increment written so far stays
  * readable), CDEM_ERR_NUMERIC returned. opt->max_steps > 0 ends the run early
- * ("stopped-early", CDEM_OK). Progress goes to opt->log only (never stdout); the wall clock
- * is read only for the progress display, never for results. */
+ * ("stopped-early", CDEM_OK). Checkpoints: after the step of every checkpoint_interval-th
+ * increment and at a stop, cdem_run_capture (every module under its own prefix) ->
+ * cdem_h5_writer_write_checkpoint; a resume re-runs the set-up, restores, reopens the file.
+ * Progress goes to opt->log only (never stdout); the wall clock is read only for the progress
+ * display, never for results. */
 #include "run.h"
 
 #include "assembly.h"
 #include "bc.h"
+#include "checkpoint.h"
 #include "h5format.h"
 #include "integrate.h"
 #include "model.h"
@@ -23,6 +27,7 @@
 #include "stress.h"
 #include "summary.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,8 +37,12 @@
 #define CDEM_VERSION "0.0.0"
 #endif
 
-/* Everything a run owns, released by run_free. */
-typedef struct {
+/* Layout of the solver's checkpoint arrays (docs/reliability.md); bumped when a module stores
+ * something new or changes a meaning, so a checkpoint of another layout is refused. */
+#define CKPT_LAYOUT 1
+
+/* Everything a run owns, released by cdem_run_close. */
+struct cdem_run_ctx {
     const cdem_params *p;        /* parameters (caller's) */
     const cdem_run_options *opt; /* options (caller's) */
     cdem_model m;                /* derived constants */
@@ -41,21 +50,29 @@ typedef struct {
     cdem_assembly_info info;     /* what the assembly generator built */
     cdem_bc bc;                  /* boundary mode */
     cdem_integrator it;          /* time stepper */
-    cdem_h5_writer *w;           /* output file */
+    cdem_h5_writer *w;           /* output file (NULL: none, staged runs of tests) */
     char *summary;               /* summary + mode view, malloc'd */
-    long step;                   /* last completed step */
-    int next_inc;                /* number of the next increment to write */
-    long last_written_step;      /* step of the last increment written (-1: none) */
-    double base_tol_y;           /* m, wall elements with y below this are the base */
-    long removed;                /* escaped elements removed */
-    long eroded;                 /* elements removed by erosion, whole run */
-    double erosion_y;            /* m, erosion level (INFINITY until the end of equilibration) */
-    double t_start, t_last_log;  /* s, monotonic clock (progress display only) */
-    long last_log_step;          /* step of the last progress output */
-    int tty_line_open;           /* 1 when a progress line is drawn without newline */
-    cdem_sediment sed;           /* syn-tectonic sedimentation (disabled when off) */
-    long k_def;                  /* deformation steps applied by the mode (settling excluded) */
-} run_ctx;
+    char *params_eff;           /* the effective parameter file text (checkpoint check), malloc'd */
+    cdem_snapshot *snap;        /* checkpoint buffer (NULL until the first checkpoint) */
+    long step;                  /* last completed step */
+    long step0;                 /* step at which this process started (progress rate only) */
+    int next_inc;               /* number of the next increment to write */
+    long next_inc_step;         /* step of increment next_inc on the model schedule */
+    long last_written_step;     /* step of the last increment written (-1: none) */
+    int last_ckpt_inc;          /* increment of the last checkpoint (0: none yet) */
+    double base_tol_y;          /* m, wall elements with y below this are the base */
+    long removed;               /* escaped elements removed */
+    long eroded;                /* elements removed by erosion, whole run */
+    double erosion_y;           /* m, erosion level (INFINITY until the end of equilibration) */
+    double t_start, t_last_log; /* s, monotonic clock (progress display only) */
+    long last_log_step;         /* step of the last progress output */
+    int tty_line_open;          /* 1 when a progress line is drawn without newline */
+    cdem_sediment sed;          /* syn-tectonic sedimentation (disabled when off) */
+    long k_def;                 /* deformation steps applied by the mode (settling excluded) */
+    int finished;               /* 1 once the stop reason is recorded (completed/stopped-early) */
+    int ckpt_off;               /* 1 when the file layer cannot store checkpoints */
+};
+typedef struct cdem_run_ctx run_ctx;
 
 static double now_s(void) {
     struct timespec ts;
@@ -92,7 +109,7 @@ static void progress(run_ctx *r, int force) {
     const double t = now_s();
     const long total = r->m.total_steps;
     const double elapsed = t - r->t_start;
-    const double rate = elapsed > 0.0 ? (double)r->step / elapsed : 0.0;
+    const double rate = elapsed > 0.0 ? (double)(r->step - r->step0) / elapsed : 0.0;
     const double left = rate > 0.0 ? (double)(total - r->step) / rate : 0.0;
     const double net = cdem_bc_net_displacement(&r->bc);
     const int inc_done = r->next_inc - 1;
@@ -199,7 +216,8 @@ static cdem_status write_increment(run_ctx *r, cdem_error *err) {
     inf.n_elements = (int64_t)r->s.n;
     inf.has_stress = r->s.has_stress;
     cdem_bc_measure(&r->bc, &r->s, r->step, 0, &inf.axial_strain, &inf.differential_stress);
-    CDEM_TRY(cdem_h5_writer_write_increment(r->w, &inf, &r->s, err));
+    if (r->w)
+        CDEM_TRY(cdem_h5_writer_write_increment(r->w, &inf, &r->s, err));
     r->next_inc++;
     r->last_written_step = r->step;
     return CDEM_OK;
@@ -237,7 +255,7 @@ static cdem_status write_sample(run_ctx *r, cdem_error *err) {
     q.base_force_y = gfy;
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
     cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
-    return cdem_h5_writer_append_series(r->w, &q, err);
+    return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;
 }
 
 static cdem_status make_summary(run_ctx *r, cdem_error *err) {
@@ -283,7 +301,9 @@ static void log_removed(run_ctx *r) {
                 (int)r->it.removed_ids[k], r->step, r->removed);
 }
 
-static cdem_status run_body(run_ctx *r, cdem_error *err) {
+/* Everything before the first step, for a fresh run and a resumed one alike: the model, the
+ * assembly (regenerated from the seed), the mode, the stepper and the summary. No file yet. */
+static cdem_status setup(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
     CDEM_TRY(cdem_model_derive(p, &r->m, err));
@@ -302,23 +322,38 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     r->base_tol_y = ywall + 0.5 * r->m.radius[0];
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
+    if (opt->par_min > 0)
+        r->it.par_min = opt->par_min;
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
                                            r->m.equil_steps, err));
     CDEM_TRY(make_summary(r, err));
+    size_t len = 0;
+    FILE *f = open_memstream(&r->params_eff, &len);
+    if (!f)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the parameter text");
+    cdem_params_write(p, f);
+    fclose(f);
+    r->t_start = r->t_last_log = now_s();
+    r->last_written_step = -1;
+    return CDEM_OK;
+}
+
+/* A fresh run: creates the file, computes the first forces, writes increment 0. */
+static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
     const cdem_run_meta meta = {
-        .params = p,
-        .params_text = opt->params_text,
+        .params = r->p,
+        .params_text = r->opt->params_text,
         .summary = r->summary,
         .program_version = CDEM_VERSION,
         .source = "cdem-run",
     };
-    if (!opt->ignore_free_space) {
+    if (r->opt->output_path && !r->opt->ignore_free_space) {
         /* A full disk is reported now, not hours into the run. */
         const double need = cdem_h5_estimate_file_size(
-            (double)r->s.n, (double)r->m.n_increments_total + 1.0, p->calculate_stress);
-        if (cdem_h5_check_free_space(opt->output_path, need, err) != CDEM_OK) {
+            (double)r->s.n, (double)r->m.n_increments_total + 1.0, r->p->calculate_stress);
+        if (cdem_h5_check_free_space(r->opt->output_path, need, err) != CDEM_OK) {
             char msg[CDEM_ERROR_MSG_MAX];
             snprintf(msg, sizeof msg, "%s", err ? err->msg : "not enough free space");
             return CDEM_FAIL(err, CDEM_ERR_IO,
@@ -327,22 +362,131 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
                              msg, r->s.n, r->m.n_increments_total + 1);
         }
     }
-    CDEM_TRY(cdem_h5_writer_create(opt->output_path, &meta, &r->w, err));
-
-    r->t_start = r->t_last_log = now_s();
+    if (r->opt->output_path)
+        CDEM_TRY(cdem_h5_writer_create(r->opt->output_path, &meta, &r->w, err));
     r->step = 0;
     r->next_inc = 0;
-    r->last_written_step = -1;
     CDEM_TRY(cdem_integrator_prime(&r->it, &r->s, err));
     log_removed(r);
     CDEM_TRY(write_increment(r, err));
     CDEM_TRY(write_sample(r, err));
+    r->next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
+    return CDEM_OK;
+}
 
+cdem_status cdem_run_capture(const cdem_run_ctx *r, cdem_snapshot *snap, cdem_error *err) {
+    if (!r || !snap)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_capture: NULL argument");
+    cdem_snapshot_clear(snap);
+    const char *P = "run";
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "layout", CKPT_LAYOUT, err));
+    CDEM_TRY(cdem_ckpt_put_text(snap, P, "version", CDEM_VERSION, err));
+    CDEM_TRY(cdem_ckpt_put_text(snap, P, "params", r->params_eff, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "step", r->step, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "next_inc", r->next_inc, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "next_inc_step", r->next_inc_step, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "last_written_step", r->last_written_step, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "last_ckpt_inc", r->last_ckpt_inc, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "removed", r->removed, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "eroded", r->eroded, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "k_def", r->k_def, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "erosion_y", r->erosion_y, err));
+    CDEM_TRY(cdem_ckpt_state_put(&r->s, r->it.boundary_forces, snap, err));
+    CDEM_TRY(cdem_integrator_snapshot_put(&r->it, snap, err));
+    CDEM_TRY(cdem_bc_snapshot_put(&r->bc, snap, err));
+    return cdem_sediment_snapshot_put(&r->sed, snap, err);
+}
+
+/* Replaces the state of a set-up run by the checkpoint's. */
+static cdem_status restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *err) {
+    const char *P = "run";
+    int64_t layout = 0;
+    CDEM_TRY(cdem_ckpt_get_i64(snap, P, "layout", &layout, err));
+    if (layout != CKPT_LAYOUT)
+        return CDEM_FAIL(err, CDEM_ERR_VERSION,
+                         "checkpoint layout %lld: this cdem-run (%s) reads layout %d only; resume "
+                         "with the version that wrote the file",
+                         (long long)layout, CDEM_VERSION, CKPT_LAYOUT);
+    const cdem_snapshot_array *ver = NULL;
+    CDEM_TRY(cdem_ckpt_get_array(snap, P, "version", CDEM_SNAP_U8, SIZE_MAX, &ver, err));
+    if (ver->count != strlen(CDEM_VERSION) || memcmp(ver->data, CDEM_VERSION, ver->count) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_VERSION,
+                         "the checkpoint was written by cdem-run %.*s, this is cdem-run %s: a run "
+                         "resumes bit-identically only with the version that started it",
+                         (int)(ver->count > 64 ? 64 : ver->count), (const char *)ver->data,
+                         CDEM_VERSION);
+    CDEM_TRY(cdem_ckpt_check_text(snap, P, "params", r->params_eff, "parameter set", err));
+    const long total = r->m.total_steps;
+    int64_t step = 0, next_inc = 0, next_inc_step = 0, lws = 0, lci = 0, removed = 0, eroded = 0,
+            k_def = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "step", 0, total, &step, err));
+    CDEM_TRY(
+        cdem_ckpt_get_range(snap, P, "next_inc", 1, r->m.n_increments_total + 1, &next_inc, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "next_inc_step", 0, INT64_MAX, &next_inc_step, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "last_written_step", -1, step, &lws, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "last_ckpt_inc", 0, next_inc, &lci, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "removed", 0, INT64_MAX, &removed, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "eroded", 0, INT64_MAX, &eroded, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "k_def", 0, step, &k_def, err));
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "erosion_y", &r->erosion_y, err));
+    CDEM_TRY(cdem_ckpt_state_get(&r->s, snap, err));
+    CDEM_TRY(cdem_integrator_snapshot_get(&r->it, snap, &r->s, err));
+    if (r->it.step != (long)step)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "checkpoint run.step = %lld but it.step = %ld (corrupt checkpoint)",
+                         (long long)step, r->it.step);
+    CDEM_TRY(cdem_bc_snapshot_get(&r->bc, snap, err));
+    CDEM_TRY(cdem_sediment_snapshot_get(&r->sed, snap, err));
+    r->step = r->step0 = (long)step;
+    r->next_inc = (int)next_inc;
+    r->next_inc_step = (long)next_inc_step;
+    r->last_written_step = (long)lws;
+    r->last_ckpt_inc = (int)lci;
+    r->removed = (long)removed;
+    r->eroded = (long)eroded;
+    r->k_def = (long)k_def;
+    return CDEM_OK;
+}
+
+/* Captures the run and stores it in the file as the checkpoint of the increment written last.
+ * scheduled = 1: a periodic checkpoint (it records itself in last_ckpt_inc, which sets the
+ * schedule of the next); 0: the checkpoint of a stop (signal, max_steps), which leaves the
+ * schedule as it is so a resumed run writes the same periodic checkpoints. */
+static cdem_status write_checkpoint(run_ctx *r, int scheduled, cdem_error *err) {
+    if (!r->snap)
+        CDEM_TRY(cdem_snapshot_alloc(&r->snap, err));
+    const int saved = r->last_ckpt_inc;
+    if (scheduled)
+        r->last_ckpt_inc = r->next_inc - 1; /* the checkpoint records itself */
+    cdem_status st = cdem_run_capture(r, r->snap, err);
+    if (st == CDEM_OK)
+        st = cdem_h5_writer_write_checkpoint(r->w, r->snap, err);
+    if (st == CDEM_ERR_UNSUPPORTED) {
+        /* a file layer without checkpoints: say so once and run on without them */
+        r->ckpt_off = 1;
+        if (logging(r)) {
+            end_progress_line(r);
+            fprintf(r->opt->log, "cdem-run: no checkpoints will be written: %s\n",
+                    err ? err->msg : "unsupported");
+        }
+        if (err)
+            cdem_error_clear(err);
+        st = CDEM_OK;
+    }
+    if (st != CDEM_OK) {
+        r->last_ckpt_inc = saved;
+        return st;
+    }
+    return CDEM_OK;
+}
+
+static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
+    const cdem_params *p = r->p;
+    const cdem_run_options *opt = r->opt;
     const long total = r->m.total_steps;
     const long equil = r->m.equil_steps;
     const long interval = p->series_interval > 0 ? p->series_interval : 1;
-    long next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
-    while (r->step < total) {
+    while (r->step < total && r->step < until && !r->finished) {
         const long step = r->step + 1;
         /* settling after a sediment deposit: boundaries still, not a deformation step */
         const int deforming = step > equil && !cdem_sediment_settling(&r->sed, step);
@@ -385,9 +529,9 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
                     settled, p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
         if (step % interval == 0)
             CDEM_TRY(write_sample(r, err));
-        while (r->next_inc <= r->m.n_increments_total && step >= next_inc_step) {
+        while (r->next_inc <= r->m.n_increments_total && step >= r->next_inc_step) {
             CDEM_TRY(write_increment(r, err));
-            next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
+            r->next_inc_step = cdem_model_increment_step(&r->m, r->next_inc);
         }
         if (cdem_sediment_due(&r->sed, step)) {
             long added = 0;
@@ -401,8 +545,20 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
                         cdem_sediment_sea_level(&r->sed, step), r->sed.settling_steps);
             }
         }
+        /* checkpoint: after the whole step (deposit included) that wrote an increment, every
+         * checkpoint_interval increments; reading the state only, it never changes results */
+        if (r->w && !r->ckpt_off && p->checkpoint_interval > 0 && r->last_written_step == step &&
+            step < total && r->next_inc - 1 - r->last_ckpt_inc >= p->checkpoint_interval)
+            CDEM_TRY(write_checkpoint(r, 1, err));
         if (step % 64 == 0)
             progress(r, 0);
+        /* a stop (signal, max_steps) first checkpoints the state of this step, before the
+         * final increment (whose erosion would change it): a resume continues from here and
+         * drops that unscheduled increment */
+        const int stopping = (opt->stop_requested && *opt->stop_requested) ||
+                             (opt->max_steps > 0 && step >= opt->max_steps && step < total);
+        if (stopping && r->w && !r->ckpt_off && p->checkpoint_interval > 0 && step < total)
+            CDEM_TRY(write_checkpoint(r, 0, err));
         if (opt->stop_requested && *opt->stop_requested) {
             if (r->last_written_step != step)
                 CDEM_TRY(write_increment(r, err));
@@ -410,9 +566,10 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
             snprintf(detail, sizeof detail,
                      "stopped by a signal after step %ld of %ld (%s), last increment %d", step,
                      total, phase_name(phase_of(r, step)), r->next_inc - 1);
-            CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "interrupted", detail, err));
+            if (r->w)
+                CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "interrupted", detail, err));
             return CDEM_FAIL(err, CDEM_ERR_INTERRUPTED, "%s; the file %s is valid", detail,
-                             opt->output_path);
+                             opt->output_path ? opt->output_path : "(none)");
         }
         if (opt->max_steps > 0 && step >= opt->max_steps && step < total) {
             if (r->last_written_step != step)
@@ -420,38 +577,102 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
             char detail[256];
             snprintf(detail, sizeof detail, "max_steps = %ld reached at step %ld of %ld",
                      opt->max_steps, step, total);
-            CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "stopped-early", detail, err));
+            if (r->w)
+                CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "stopped-early", detail, err));
+            r->finished = 1;
             return CDEM_OK;
         }
     }
+    if (r->finished || r->step < total)
+        return CDEM_OK;
     if (r->last_written_step != r->step)
         CDEM_TRY(write_increment(r, err));
     char detail[256];
     snprintf(detail, sizeof detail,
              "%ld steps, %d increments, %ld escaping elements removed, %ld eroded", r->step,
              r->next_inc - 1, r->removed, r->eroded);
-    return cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err);
+    r->finished = 1;
+    return r->w ? cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err) : CDEM_OK;
 }
 
-cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_error *err) {
-    if (!p || !opt || !opt->output_path)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID,
-                         "cdem_run: parameters, options and an output path are required");
-    run_ctx r;
-    memset(&r, 0, sizeof r);
-    r.p = p;
-    r.opt = opt;
-    cdem_status st = run_body(&r, err);
-    if (logging(&r)) {
-        progress(&r, 1);
-        end_progress_line(&r);
+static void run_release(run_ctx *r) {
+    cdem_integrator_free(&r->it);
+    cdem_sediment_free(&r->sed);
+    cdem_bc_free(&r->bc);
+    cdem_state_free(&r->s);
+    cdem_snapshot_free(r->snap);
+    free(r->summary);
+    free(r->params_eff);
+    free(r);
+}
+
+static cdem_status open_body(run_ctx *r, const cdem_snapshot *resume, cdem_error *err) {
+    CDEM_TRY(setup(r, err));
+    if (!resume)
+        return start_fresh(r, err);
+    CDEM_TRY(restore(r, resume, err));
+    if (r->opt->output_path)
+        CDEM_TRY(cdem_h5_writer_reopen(r->opt->output_path, r->next_inc - 1, r->step, &r->w, err));
+    if (logging(r))
+        fprintf(r->opt->log, "cdem-run: resumed %s at step %ld of %ld, after increment %d\n",
+                r->opt->output_path ? r->opt->output_path : "a run", r->step, r->m.total_steps,
+                r->next_inc - 1);
+    return CDEM_OK;
+}
+
+cdem_status cdem_run_open(const cdem_params *p, const cdem_run_options *opt,
+                          const cdem_snapshot *resume, cdem_run_ctx **out, cdem_error *err) {
+    if (!out)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_open: NULL output pointer");
+    *out = NULL;
+    if (!p || !opt)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_open: parameters and options required");
+    run_ctx *r = calloc(1, sizeof *r);
+    if (!r)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for a run");
+    r->p = p;
+    r->opt = opt;
+    cdem_status st = open_body(r, resume, err);
+    if (st != CDEM_OK) {
+        if (r->w) {
+            cdem_error e2;
+            cdem_error_clear(&e2);
+            (void)cdem_h5_writer_close(r->w, &e2);
+        }
+        run_release(r);
+        return st;
     }
-    if (r.w) {
+    *out = r;
+    return CDEM_OK;
+}
+
+cdem_status cdem_run_advance(cdem_run_ctx *r, long until_step, cdem_error *err) {
+    if (!r)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_advance: NULL run");
+    return run_loop(r, until_step, err);
+}
+
+long cdem_run_current_step(const cdem_run_ctx *r) {
+    return r ? r->step : 0;
+}
+
+long cdem_run_total_steps(const cdem_run_ctx *r) {
+    return r ? r->m.total_steps : 0;
+}
+
+cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
+    if (!r)
+        return st;
+    if (logging(r)) {
+        progress(r, 1);
+        end_progress_line(r);
+    }
+    if (r->w) {
         if (st != CDEM_OK && st != CDEM_ERR_INTERRUPTED) {
             /* record the diagnosis in the file; keep the original error */
             cdem_error e2;
             cdem_error_clear(&e2);
-            (void)cdem_h5_writer_set_stop_reason(r.w,
+            (void)cdem_h5_writer_set_stop_reason(r->w,
                                                  st == CDEM_ERR_NUMERIC ? "numerical-failure"
                                                  : st == CDEM_ERR_IO    ? "write-failure"
                                                                         : "error",
@@ -459,16 +680,82 @@ cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_err
         }
         cdem_error e3;
         cdem_error_clear(&e3);
-        cdem_status cst = cdem_h5_writer_close(r.w, st == CDEM_OK ? err : &e3);
+        cdem_status cst = cdem_h5_writer_close(r->w, st == CDEM_OK ? err : &e3);
         if (st == CDEM_OK)
             st = cst;
     }
-    cdem_integrator_free(&r.it);
-    cdem_sediment_free(&r.sed);
-    cdem_bc_free(&r.bc);
-    cdem_state_free(&r.s);
-    free(r.summary);
+    run_release(r);
     return st;
+}
+
+cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_error *err) {
+    if (!p || !opt || !opt->output_path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_run: parameters, options and an output path are required");
+    cdem_run_ctx *r = NULL;
+    CDEM_TRY(cdem_run_open(p, opt, NULL, &r, err));
+    cdem_status st = cdem_run_advance(r, LONG_MAX, err);
+    return cdem_run_close(r, st, err);
+}
+
+cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_error *err) {
+    if (!path || !opt)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_resume: a file and options are required");
+    cdem_h5_reader *rd = NULL;
+    CDEM_TRY(cdem_h5_reader_open(path, &rd, err));
+    cdem_params p;
+    cdem_snapshot *snap = NULL;
+    int32_t inc = 0;
+    cdem_status st = CDEM_OK;
+    const char *stop = cdem_h5_reader_stop_reason(rd);
+    if (strcmp(stop, "completed") == 0)
+        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                       "%s: the run already completed (stop reason \"completed\"): there is "
+                       "nothing to resume",
+                       path);
+    if (st == CDEM_OK && strcmp(cdem_h5_reader_source(rd), "cdem-run") != 0)
+        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                       "%s: written by \"%s\", not by cdem-run: only cdem-run files can be resumed",
+                       path, cdem_h5_reader_source(rd));
+    if (st == CDEM_OK)
+        st = cdem_h5_reader_params(rd, &p, err);
+    if (st == CDEM_OK)
+        st = cdem_params_validate(&p, err);
+    if (st == CDEM_OK)
+        st = cdem_snapshot_alloc(&snap, err);
+    if (st == CDEM_OK) {
+        st = cdem_h5_reader_read_checkpoint(rd, snap, &inc, err);
+        if (st == CDEM_ERR_NOTFOUND)
+            st = CDEM_FAIL(
+                err, CDEM_ERR_NOTFOUND,
+                "%s has no checkpoint to resume from (its output.checkpoint_interval is %d "
+                "increments, 0 = none): it stopped before its first checkpoint or was "
+                "written without; run the model again from the start",
+                path, p.checkpoint_interval);
+    }
+    cdem_h5_reader_close(rd);
+    if (st == CDEM_OK) {
+        int64_t next_inc = 0;
+        st = cdem_ckpt_get_i64(snap, "run", "next_inc", &next_inc, err);
+        if (st == CDEM_OK && next_inc - 1 != inc)
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: the checkpoint says it follows increment %lld but is stored for "
+                           "increment %d (corrupt checkpoint)",
+                           path, (long long)(next_inc - 1), (int)inc);
+    }
+    if (st != CDEM_OK) {
+        cdem_snapshot_free(snap);
+        return st;
+    }
+    cdem_run_options o = *opt;
+    o.output_path = path;
+    cdem_run_ctx *r = NULL;
+    st = cdem_run_open(&p, &o, snap, &r, err);
+    cdem_snapshot_free(snap);
+    if (st != CDEM_OK)
+        return st;
+    st = cdem_run_advance(r, LONG_MAX, err);
+    return cdem_run_close(r, st, err);
 }
 
 cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long *n_wall,

@@ -5,6 +5,8 @@
  * |dx| < r + rj, which touches its support and overlaps nothing. */
 #include "sediment.h"
 
+#include "checkpoint.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -279,4 +281,58 @@ long cdem_sediment_after_step(cdem_sediment *sd, cdem_integrator *it, const cdem
     const long made = cdem_sediment_make_cohesive(it, s, sd->settling_layer);
     sd->settling_layer = 0;
     return made;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+cdem_status cdem_sediment_snapshot_put(const cdem_sediment *sd, cdem_snapshot *snap,
+                                       cdem_error *err) {
+    const char *P = "sed";
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "enabled", sd->enabled, err));
+    if (!sd->enabled)
+        return CDEM_OK;
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "ymax0", sd->ymax0, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "events", sd->events, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "event_step", sd->event_step, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "settle_end", sd->settle_end, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "settling_layer", sd->settling_layer, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "n_deposited", sd->n_deposited, err));
+    CDEM_TRY(cdem_ckpt_put_text(snap, P, "rng_type", gsl_rng_name(sd->rng), err));
+    return cdem_ckpt_put_array(snap, P, "rng_state", CDEM_SNAP_U8, gsl_rng_size(sd->rng),
+                               gsl_rng_state(sd->rng), err);
+}
+
+cdem_status cdem_sediment_snapshot_get(cdem_sediment *sd, const cdem_snapshot *snap,
+                                       cdem_error *err) {
+    const char *P = "sed";
+    int64_t enabled = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "enabled", 0, 1, &enabled, err));
+    if (enabled != sd->enabled)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint sed.enabled = %lld but this run has surface.sedimentation = "
+                         "%s: the checkpoint belongs to another model",
+                         (long long)enabled, sd->enabled ? "on" : "off");
+    if (!sd->enabled)
+        return CDEM_OK;
+    CDEM_TRY(
+        cdem_ckpt_check_text(snap, P, "rng_type", gsl_rng_name(sd->rng), "random generator", err));
+    const cdem_snapshot_array *st = NULL;
+    CDEM_TRY(
+        cdem_ckpt_get_array(snap, P, "rng_state", CDEM_SNAP_U8, gsl_rng_size(sd->rng), &st, err));
+    int64_t events = 0, event_step = 0, settle_end = 0, layer = 0, n_dep = 0;
+    double ymax0 = 0.0;
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "ymax0", &ymax0, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "events", 0, INT32_MAX, &events, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "event_step", -1, INT64_MAX, &event_step, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "settle_end", -1, INT64_MAX, &settle_end, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "settling_layer", 0, INT32_MAX, &layer, err));
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "n_deposited", 0, INT64_MAX, &n_dep, err));
+    memcpy(gsl_rng_state(sd->rng), st->data, st->count);
+    sd->ymax0 = ymax0;
+    sd->events = (int)events;
+    sd->event_step = (long)event_step;
+    sd->settle_end = (long)settle_end;
+    sd->settling_layer = (int32_t)layer;
+    sd->n_deposited = (long)n_dep;
+    return CDEM_OK;
 }

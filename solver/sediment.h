@@ -95,4 +95,14 @@ long cdem_sediment_make_cohesive(cdem_integrator *it, const cdem_state *s, int32
 long cdem_sediment_after_step(cdem_sediment *sd, cdem_integrator *it, const cdem_state *s,
                               long step);
 
+/* Checkpoints (checkpoint.h): under "sed." the evolving fields (sea-level reference ymax0,
+ * events, event_step, settle_end, settling_layer, n_deposited) and the RNG state (the raw
+ * mt19937 state bytes and the generator's name); a disabled context stores only "enabled".
+ * _get restores into a context initialised from the same parameters (CDEM_ERR_CONFLICT
+ * when the stored one was enabled differently or used another generator). */
+cdem_status cdem_sediment_snapshot_put(const cdem_sediment *sd, cdem_snapshot *snap,
+                                       cdem_error *err);
+cdem_status cdem_sediment_snapshot_get(cdem_sediment *sd, const cdem_snapshot *snap,
+                                       cdem_error *err);
+
 #endif

@@ -1,0 +1,409 @@
+/* Tests of cdem-run --resume and of determinism, with the program ($CDEM_BUILD/cdem-run):
+ *  - the same small run with OMP_NUM_THREADS = 1, 2 and 3 and --par-min 64 (so the threaded
+ *    loops really run threaded) gives identical files: every increment's attributes and
+ *    datasets, the series, the texts and the newest checkpoint (compared through the reader;
+ *    the creation time is the only attribute left out);
+ *  - a run SIGKILLed after a checkpoint, or stopped by --max-steps, and resumed gives the
+ *    file (and newest checkpoint) of an uninterrupted run;
+ *  - refused resumes: a completed run, -s overrides, a model file, -o, a missing file, a
+ *    non-HDF5 file, a file without checkpoint, each with its message and exit status.
+ * Scratch files go to a private directory under $CDEM_TEST_TMP. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "h5format.h"
+#include "snapshot.h"
+
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+typedef struct {
+    char bin[1024]; /* path of cdem-run */
+    char tmp[1024]; /* private scratch directory */
+} rs_ctx;
+
+/* The small model every test runs (1370 elements, 5322 steps, 22 increments). */
+#define SMALL                                                                                      \
+    "-s assembly.width=10 -s assembly.height=2.5 -s time.equilibration=100 "                       \
+    "-s time.runtime=150 -s output.series_interval=50 -s "                                         \
+    "physics.calculate_stress=on"
+
+static int setup(void **state) {
+    rs_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return -1;
+    const char *b = getenv("CDEM_BUILD");
+    char rel[1024];
+    snprintf(rel, sizeof rel, "%s/cdem-run", b && b[0] ? b : "build");
+    if (!realpath(rel, c->bin)) /* the tests cd into their scratch directory */
+        snprintf(c->bin, sizeof c->bin, "%s", rel);
+    const char *t = getenv("CDEM_TEST_TMP");
+    snprintf(c->tmp, sizeof c->tmp, "%s/test_resume_XXXXXX", t && t[0] ? t : "/tmp");
+    if (!mkdtemp(c->tmp)) {
+        free(c);
+        return -1;
+    }
+    *state = c;
+    return 0;
+}
+
+static int teardown(void **state) {
+    rs_ctx *c = *state;
+    char cmd[2200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
+    int rc = system(cmd);
+    free(c);
+    return rc == 0 ? 0 : -1;
+}
+
+/* Runs "env ENV cdem-run ARGS" (shell syntax) with stderr to tmp/err.txt; the
+ * exit status. */
+static int run(const rs_ctx *c, const char *env, const char *args) {
+    if (access(c->bin, X_OK) != 0) {
+        print_error("%s is missing: build it first (make build/cdem-run)\n", c->bin);
+        fail();
+    }
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "cd '%s' && env OMP_WAIT_POLICY=passive %s '%s' %s 2>'%s/err.txt'",
+             c->tmp, env ? env : "", c->bin, args, c->tmp);
+    int st = system(cmd);
+    assert_true(WIFEXITED(st));
+    return WEXITSTATUS(st);
+}
+
+static char *slurp(const rs_ctx *c, const char *name) {
+    char path[1100];
+    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char *buf = calloc(1, 1 << 16);
+    assert_non_null(buf);
+    size_t n = fread(buf, 1, (1 << 16) - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static void expect_err(const rs_ctx *c, const char *needle) {
+    char *e = slurp(c, "err.txt");
+    if (!strstr(e, needle))
+        fail_msg("stderr lacks \"%s\":\n%s", needle, e);
+    free(e);
+}
+
+static void path_of(const rs_ctx *c, const char *name, char *buf, size_t n) {
+    snprintf(buf, n, "%s/%s", c->tmp, name);
+}
+
+#define SAME_BITS(a, b, what, ...)                                                                 \
+    do {                                                                                           \
+        if (memcmp(&(a), &(b), sizeof(a)) != 0)                                                    \
+            fail_msg(what, __VA_ARGS__);                                                           \
+    } while (0)
+
+static void same_array(const void *a, const void *b, size_t n, size_t size, const char *what,
+                       int inc) {
+    if (n == 0)
+        return;
+    if ((a == NULL) != (b == NULL))
+        fail_msg("increment %d: %s present in one file only", inc, what);
+    if (a && memcmp(a, b, n * size) != 0)
+        fail_msg("increment %d: dataset %s differs", inc, what);
+}
+
+/* Every increment (attributes and datasets), the series and the texts of two
+ * files are identical bit for bit; only the creation time may differ. */
+static void compare_files(const char *pa, const char *pb) {
+    cdem_error err;
+    cdem_h5_reader *a = NULL, *b = NULL;
+    if (cdem_h5_reader_open(pa, &a, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    if (cdem_h5_reader_open(pb, &b, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_string_equal(cdem_h5_reader_stop_reason(a), cdem_h5_reader_stop_reason(b));
+    assert_string_equal(cdem_h5_reader_stop_detail(a), cdem_h5_reader_stop_detail(b));
+    assert_string_equal(cdem_h5_reader_summary(a), cdem_h5_reader_summary(b));
+    assert_string_equal(cdem_h5_reader_params_text(a), cdem_h5_reader_params_text(b));
+    assert_string_equal(cdem_h5_reader_program_version(a), cdem_h5_reader_program_version(b));
+    const size_t n = cdem_h5_reader_increment_count(a);
+    assert_int_equal(n, cdem_h5_reader_increment_count(b));
+    assert_true(n > 3);
+    for (size_t k = 0; k < n; k++) {
+        cdem_state sa, sb;
+        memset(&sa, 0, sizeof sa);
+        memset(&sb, 0, sizeof sb);
+        cdem_increment_info ia, ib;
+        if (cdem_h5_reader_load_increment(a, k, &sa, &ia, &err) != CDEM_OK ||
+            cdem_h5_reader_load_increment(b, k, &sb, &ib, &err) != CDEM_OK)
+            fail_msg("%s", err.msg);
+        const int num = ia.number;
+        assert_int_equal(ia.number, ib.number);
+        assert_int_equal(ia.step, ib.step);
+        assert_int_equal(ia.phase, ib.phase);
+        SAME_BITS(ia.time, ib.time, "increment %d: time differs", num);
+        SAME_BITS(ia.net_displacement, ib.net_displacement, "increment %d: net differs", num);
+        SAME_BITS(ia.axial_strain, ib.axial_strain, "increment %d: axial strain differs", num);
+        SAME_BITS(ia.differential_stress, ib.differential_stress, "increment %d: stress differs",
+                  num);
+        SAME_BITS(ia.sea_level, ib.sea_level, "increment %d: sea level differs", num);
+        assert_int_equal(sa.n, sb.n);
+        assert_int_equal(sa.has_stress, sb.has_stress);
+        same_array(sa.id, sb.id, sa.n, sizeof *sa.id, "id", num);
+        same_array(sa.x, sb.x, sa.n, sizeof *sa.x, "x", num);
+        same_array(sa.y, sb.y, sa.n, sizeof *sa.y, "y", num);
+        same_array(sa.radius, sb.radius, sa.n, sizeof *sa.radius, "radius", num);
+        same_array(sa.layer, sb.layer, sa.n, sizeof *sa.layer, "layer", num);
+        same_array(sa.flags, sb.flags, sa.n, sizeof *sa.flags, "flags", num);
+        same_array(sa.born, sb.born, sa.n, sizeof *sa.born, "born", num);
+        if (sa.has_stress) {
+            same_array(sa.sxx, sb.sxx, sa.n, sizeof *sa.sxx, "sxx", num);
+            same_array(sa.syy, sb.syy, sa.n, sizeof *sa.syy, "syy", num);
+            same_array(sa.sxy, sb.sxy, sa.n, sizeof *sa.sxy, "sxy", num);
+        }
+        cdem_state_free(&sa);
+        cdem_state_free(&sb);
+    }
+    cdem_series_sample *qa = NULL, *qb = NULL;
+    size_t na = 0, nb = 0;
+    if (cdem_h5_reader_read_series(a, &qa, &na, &err) != CDEM_OK ||
+        cdem_h5_reader_read_series(b, &qb, &nb, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(na, nb);
+    assert_true(na > 10);
+    for (size_t k = 0; k < na; k++) {
+        const cdem_series_sample *x = &qa[k], *y = &qb[k];
+        const long st = (long)x->step;
+        assert_int_equal(x->step, y->step);
+        assert_int_equal(x->contacts, y->contacts);
+        assert_int_equal(x->bonds, y->bonds);
+        assert_int_equal(x->n_elements, y->n_elements);
+        SAME_BITS(x->time, y->time, "series step %ld: time differs", st);
+        SAME_BITS(x->kinetic_energy, y->kinetic_energy, "series step %ld: energy differs", st);
+        SAME_BITS(x->net_displacement, y->net_displacement, "series step %ld: net differs", st);
+        SAME_BITS(x->boundary_force_x, y->boundary_force_x, "series step %ld: force differs", st);
+        SAME_BITS(x->boundary_force_y, y->boundary_force_y, "series step %ld: force differs", st);
+        SAME_BITS(x->base_force_x, y->base_force_x, "series step %ld: base force differs", st);
+        SAME_BITS(x->base_force_y, y->base_force_y, "series step %ld: base force differs", st);
+        SAME_BITS(x->axial_strain, y->axial_strain, "series step %ld: strain differs", st);
+        SAME_BITS(x->differential_stress, y->differential_stress, "series step %ld: differs", st);
+        SAME_BITS(x->sea_level, y->sea_level, "series step %ld: sea level differs", st);
+    }
+    free(qa);
+    free(qb);
+    cdem_h5_reader_close(a);
+    cdem_h5_reader_close(b);
+}
+
+static void compare_checkpoints(const char *pa, const char *pb);
+
+static void test_resume_determinism_threads_1_2_3(void **state) {
+    const rs_ctx *c = *state;
+    char p1[1200], p2[1200], p3[1200];
+    assert_int_equal(run(c, "OMP_NUM_THREADS=1", "-q -o t1.h5 --par-min 64 " SMALL), 0);
+    assert_int_equal(run(c, "OMP_NUM_THREADS=2", "-q -o t2.h5 --par-min 64 " SMALL), 0);
+    assert_int_equal(run(c, "OMP_NUM_THREADS=3", "-q -o t3.h5 --par-min 64 " SMALL), 0);
+    path_of(c, "t1.h5", p1, sizeof p1);
+    path_of(c, "t2.h5", p2, sizeof p2);
+    path_of(c, "t3.h5", p3, sizeof p3);
+    compare_files(p1, p2);
+    compare_files(p1, p3);
+    /* the newest checkpoints (default: every 10 increments) hold velocities, forces and the
+     * contact histories: identical too */
+    compare_checkpoints(p1, p2);
+    compare_checkpoints(p1, p3);
+}
+
+/* The newest checkpoints of two files are identical (and exist). */
+static void compare_checkpoints(const char *pa, const char *pb) {
+    cdem_error err;
+    cdem_h5_reader *a = NULL, *b = NULL;
+    cdem_snapshot *sa = NULL, *sb = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&sa, &err), CDEM_OK);
+    assert_int_equal(cdem_snapshot_alloc(&sb, &err), CDEM_OK);
+    if (cdem_h5_reader_open(pa, &a, &err) != CDEM_OK ||
+        cdem_h5_reader_open(pb, &b, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    int32_t ia = -1, ib = -2;
+    if (cdem_h5_reader_read_checkpoint(a, sa, &ia, &err) != CDEM_OK ||
+        cdem_h5_reader_read_checkpoint(b, sb, &ib, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(ia, ib);
+    const char *diff = NULL;
+    if (!cdem_snapshot_equal(sa, sb, &diff))
+        fail_msg("checkpoints of increment %d differ in %s", (int)ia, diff ? diff : "?");
+    cdem_snapshot_free(sa);
+    cdem_snapshot_free(sb);
+    cdem_h5_reader_close(a);
+    cdem_h5_reader_close(b);
+}
+
+/* 1 when the file contains needle. */
+static int file_has(const char *path, const char *needle) {
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    const size_t cap = 1 << 16;
+    char *buf = calloc(1, cap);
+    assert_non_null(buf);
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    const int has = strstr(buf, needle) != NULL;
+    free(buf);
+    return has;
+}
+
+/* Starts cdem-run on the small model (checkpoint every 2 increments) writing name.h5, its
+ * log to name.log, sends sig as soon as the log reports the end of equilibration (several
+ * increments and at least one checkpoint are in the file by then; a third of the run is
+ * left) and returns its wait status. */
+static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
+    char log[1200], out[1200], base[64];
+    snprintf(base, sizeof base, "%s.log", name);
+    path_of(c, base, log, sizeof log);
+    snprintf(base, sizeof base, "%s.h5", name);
+    path_of(c, base, out, sizeof out);
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        FILE *f = freopen(log, "wb", stderr);
+        if (!f || chdir(c->tmp) != 0)
+            _exit(99);
+        execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
+              "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",
+              "-s", "time.runtime=150", "-s", "output.series_interval=50", "-s",
+              "physics.calculate_stress=on", (char *)NULL);
+        _exit(98);
+    }
+    int sent = 0;
+    for (int i = 0; i < 60000 && !sent; i++) {
+        int st = 0;
+        if (waitpid(pid, &st, WNOHANG) == pid)
+            fail_msg("cdem-run ended (status %d) before it could be signalled", st);
+        if (file_has(log, "end of equilibration")) {
+            assert_int_equal(kill(pid, sig), 0);
+            sent = 1;
+        } else {
+            const struct timespec ts = {0, 5000000};
+            nanosleep(&ts, NULL);
+        }
+    }
+    assert_true(sent);
+    int st = 0;
+    assert_int_equal(waitpid(pid, &st, 0), pid);
+    return st;
+}
+
+/* The run straight; the same run SIGKILLed mid-run (after at least one checkpoint) and
+ * resumed, and SIGINTed (stop reason "interrupted", exit 3) and resumed: each gives the
+ * straight run's increments, series and newest checkpoint. */
+static void test_resume_after_sigkill_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
+    char ps[1200], pk[1200], pi[1200];
+    path_of(c, "straight.h5", ps, sizeof ps);
+    path_of(c, "killed.h5", pk, sizeof pk);
+    path_of(c, "stopped.h5", pi, sizeof pi);
+
+    int st = start_and_signal(c, "killed", SIGKILL);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    assert_int_equal(run(c, NULL, "-q --resume killed.h5"), 0);
+    compare_files(ps, pk);
+    compare_checkpoints(ps, pk);
+    /* and now it is complete */
+    assert_int_equal(run(c, NULL, "--resume killed.h5"), 1);
+    expect_err(c, "already completed");
+
+    st = start_and_signal(c, "stopped", SIGINT);
+    assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 3);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(pi, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "interrupted");
+    cdem_h5_reader_close(r);
+    assert_int_equal(run(c, NULL, "-q --resume stopped.h5"), 0);
+    compare_files(ps, pi);
+    compare_checkpoints(ps, pi);
+}
+
+/* Stopped by --max-steps between checkpoints (its stop checkpoint is the
+ * newest) and resumed: the uninterrupted run's file and newest checkpoint. */
+static void test_resume_after_max_steps_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o straight3.h5 -s output.checkpoint_interval=3 " SMALL), 0);
+    assert_int_equal(run(c, NULL,
+                         "-q -o early.h5 --max-steps 4321 -s "
+                         "output.checkpoint_interval=3 " SMALL),
+                     0);
+    char pe[1200], ps[1200];
+    path_of(c, "early.h5", pe, sizeof pe);
+    path_of(c, "straight3.h5", ps, sizeof ps);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(pe, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
+    cdem_h5_reader_close(r);
+    assert_int_equal(run(c, NULL, "-q --resume early.h5"), 0);
+    compare_files(ps, pe);
+    compare_checkpoints(ps, pe);
+}
+
+static void test_resume_refusals(void **state) {
+    const rs_ctx *c = *state;
+    /* a completed run */
+    assert_int_equal(
+        run(c, NULL, "-q -o done.h5 --max-steps 1 -s output.checkpoint_interval=0 " SMALL), 0);
+    assert_int_equal(run(c, NULL,
+                         "-q -o full.h5 -s time.runtime=100.5 -s assembly.width=10 "
+                         "-s assembly.height=2.5 -s time.equilibration=100"),
+                     0);
+    assert_int_equal(run(c, NULL, "--resume full.h5"), 1);
+    expect_err(c, "already completed");
+    /* overrides, a model file and -o cannot be combined with --resume */
+    assert_int_equal(run(c, NULL, "--resume done.h5 -s time.runtime=300"), 2);
+    expect_err(c, "-s overrides");
+    assert_int_equal(run(c, NULL, "model.ini --resume done.h5"), 2);
+    expect_err(c, "a model file");
+    assert_int_equal(run(c, NULL, "--resume done.h5 -o other.h5"), 2);
+    expect_err(c, "-o");
+    assert_int_equal(run(c, NULL, "--resume"), 2);
+    expect_err(c, "needs the run file");
+    /* a missing file, a file that is not HDF5 */
+    assert_int_equal(run(c, NULL, "--resume missing.h5"), 1);
+    expect_err(c, "missing.h5");
+    assert_int_equal(run(c, NULL, "--resume err.txt"), 1);
+    expect_err(c, "err.txt");
+    /* written without checkpoints (and stopped after 1 step): nothing to resume
+     * from */
+    assert_int_equal(run(c, NULL, "--resume done.h5"), 1);
+    expect_err(c, "has no checkpoint to resume from");
+    /* the refused resume left the file as it was */
+    char p[1200];
+    path_of(c, "done.h5", p, sizeof p);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(p, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
+    assert_int_equal(cdem_h5_reader_increment_count(r), 2);
+    cdem_h5_reader_close(r);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_resume_determinism_threads_1_2_3),
+        cmocka_unit_test(test_resume_after_sigkill_is_bit_identical),
+        cmocka_unit_test(test_resume_after_max_steps_is_bit_identical),
+        cmocka_unit_test(test_resume_refusals),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
