@@ -29,6 +29,9 @@
 #include "params.h"
 #include "state.h"
 
+/* Largest number of element chunks (threads) of the force pass. */
+#define CDEM_MAX_CHUNKS 64
+
 typedef struct {
     double dt;            /* s, time step, > 0 */
     double damping;       /* N s/m, viscous coefficient c, >= 0 */
@@ -41,6 +44,19 @@ typedef struct {
                              whose boundary forces are reported) */
     long par_min;         /* loops over fewer items than this run on one thread (>= 0);
                              results are bit-identical either way */
+
+    /* force pass decomposition (scratch derived from the pair list, not state: rebuilt
+     * whenever the list or the thread count changes; never serialised). Chunk c owns the
+     * elements chunk_elem[c]..chunk_elem[c+1]-1 and their pi ranges; a cross pair has its
+     * pj in a later chunk than its pi. */
+    int nchunk;                              /* chunks of the last force pass, 1..CDEM_MAX_CHUNKS */
+    long chunk_build;                        /* nb.n_builds the chunks were derived for */
+    size_t chunk_n;                          /* element count the chunks were derived for */
+    int32_t chunk_elem[CDEM_MAX_CHUNKS + 1]; /* first element of each chunk; [nchunk] = n */
+    int32_t cross_start[CDEM_MAX_CHUNKS + 1]; /* cross pairs into chunk c: cross[cross_start[c]
+                                                 .. cross_start[c+1]-1], ascending slots */
+    int32_t *cross;                           /* pair slots of the cross pairs (crosscap) */
+    size_t crosscap;                          /* capacity of cross, >= nb.pcap after builds */
 
     /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
      * y < ymin - max_radius; x bounds follow the moving lateral walls */
