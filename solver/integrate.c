@@ -355,7 +355,8 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
                                    double dt) {
     const double R = Rp[p];
     const uint8_t h = hist[p];
-    if (!(h & CDEM_PAIR_BONDED) && dx * dx + dy * dy >= R * R) {
+    const double r2 = dx * dx + dy * dy;
+    if (!(h & CDEM_PAIR_BONDED) && (r2 >= R * R || r2 <= 0.0)) {
         /* the common case: a list pair that does not touch (xs != 0 only with h != 0) */
         pfx[p] = 0.0;
         pfy[p] = 0.0;
@@ -363,6 +364,38 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
             hist[p] = 0;
             xs[p] = 0.0;
         }
+        return;
+    }
+    if (law->model == CDEM_MATERIAL_GRANULAR) {
+        /* a touching granular pair: cdem_contact_eval's arithmetic, operation for operation
+         * (same bits), without the call and the re-tests */
+        const int c = cls[p];
+        const double r = sqrt(r2);
+        const double inv = 1.0 / r;
+        const double nx = dx * inv, ny = dy * inv;
+        const double fn = law->kn * (R - r);
+        double ftx = 0.0, fty = 0.0;
+        uint8_t hn = (uint8_t)(h | CDEM_PAIR_TOUCH);
+        if (law->ks > 0.0) {
+            const double tx = -ny, ty = nx;
+            double sv = xs[p] + (dvx * tx + dvy * ty) * dt;
+            double fs = law->ks * sv;
+            double limit = law->friction[c] * fn;
+            if (hn & CDEM_PAIR_COHESIVE)
+                limit += law->cohesion[c];
+            if (fabs(fs) > limit) {
+                fs = fs > 0.0 ? limit : -limit;
+                sv = fs / law->ks;
+                if (law->first_slip)
+                    hn &= (uint8_t)~CDEM_PAIR_COHESIVE;
+            }
+            xs[p] = sv;
+            ftx = fs * tx;
+            fty = fs * ty;
+        }
+        pfx[p] = -fn * nx + ftx;
+        pfy[p] = -fn * ny + fty;
+        hist[p] = hn;
         return;
     }
     cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
@@ -446,8 +479,8 @@ static void chunk_pass(const force_pass *fp, long lo, long hi, const int32_t *re
         fy[pj[p]] -= pfy[p];
     }
     const int32_t *restrict pi = fp->pi;
-    const long pe = istart[hi];
-    for (long p = istart[lo]; p < pe; p++) {
+    const long p0 = istart[lo], pe = istart[hi];
+    for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
             pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
