@@ -19,8 +19,9 @@
 #define RESORT_EVERY 20
 /* Default of cdem_integrator.par_min: loops shorter than this run on one thread. A step of
  * the default model (~2500 elements, ~5000 pairs) takes ~0.1 ms, comparable to the cost of
- * an OpenMP barrier when the cores are shared, so small models stay serial. */
-#define PAR_MIN_DEFAULT 16384
+ * waking a sleeping thread (OMP_WAIT_POLICY=passive) on a shared machine, so small models
+ * stay serial; from ~8,000 elements (half radii) the force pass and the build are threaded. */
+#define PAR_MIN_DEFAULT 8192
 
 cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
                                  cdem_error *err) {
@@ -154,6 +155,7 @@ static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) 
     CDEM_TRY(find_escapes(it, s, &nrem, err));
     it->n_removed_last = nrem;
     it->n_removed += (long)nrem;
+    it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err));
     CDEM_TRY(reserve_cross(it, err));
     cdem_integrator_classify(it, s);
@@ -671,6 +673,7 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
 static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem, cdem_error *err) {
     CDEM_TRY(collect_removed(it, s, nrem, err));
     it->n_removed_last = nrem;
+    it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
     CDEM_TRY(reserve_cross(it, err));
     cdem_integrator_classify(it, s);
