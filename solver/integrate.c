@@ -12,6 +12,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -441,7 +442,27 @@ typedef struct {
     const uint32_t *flags;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
+    int nchunk;  /* chunks of this pass */
+    long gen;    /* generation of this pass */
+    long *ready; /* per-chunk generation flags (it->cross_ready) */
 } force_pass;
+
+/* Waits until every chunk after c has evaluated its cross pairs of this pass (their slots
+ * are read by chunk c). Usually already done: each thread evaluates its few cross pairs
+ * first, while chunk c meets its first cross pair only well into its own pass. */
+static void wait_cross(const force_pass *fp, int c) {
+    for (int d = c + 1; d < fp->nchunk; d++) {
+        for (long spins = 0;; spins++) {
+            long v;
+#pragma omp atomic read seq_cst
+            v = fp->ready[d];
+            if (v == fp->gen)
+                break;
+            if (spins > 1000)
+                sched_yield(); /* the other thread may be descheduled (shared machine) */
+        }
+    }
+}
 
 /* Evaluates the cross pairs into chunk c (their slots only; no sums). */
 static void cross_eval(const force_pass *fp, const int32_t *restrict list, int32_t a, int32_t b) {
@@ -464,8 +485,8 @@ static void cross_eval(const force_pass *fp, const int32_t *restrict list, int32
  * finished. (A loop nested per element, accumulating each pi range in registers and
  * finishing the element right after it, was measured slower: the short inner loops
  * mispredict their exits.) */
-static void chunk_pass(const force_pass *fp, long lo, long hi, const int32_t *restrict list,
-                       int32_t ca, int32_t cb) {
+static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
+                       const int32_t *restrict list, int32_t ca, int32_t cb) {
     const cdem_contact_law *restrict law = fp->law;
     const double *restrict x = fp->x, *restrict y = fp->y;
     double *restrict vx = fp->vx, *restrict vy = fp->vy;
@@ -482,6 +503,7 @@ static void chunk_pass(const force_pass *fp, long lo, long hi, const int32_t *re
     }
     const int32_t *restrict pi = fp->pi;
     const long p0 = istart[lo], pe = istart[hi];
+    int ready = chunk + 1 >= fp->nchunk; /* the last chunk has no cross pairs out */
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
@@ -489,10 +511,20 @@ static void chunk_pass(const force_pass *fp, long lo, long hi, const int32_t *re
                        fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
+            fx[i] += pfx[p];
+            fy[i] += pfy[p];
+        } else {
+            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
+            if (!ready) {
+                wait_cross(fp, chunk);
+                ready = 1;
+            }
+            fx[i] += fp->pfx[p];
+            fy[i] += fp->pfy[p];
         }
-        fx[i] += pfx[p];
-        fy[i] += pfy[p];
     }
+    if (!ready)
+        wait_cross(fp, chunk); /* the cross pairs read these velocities: kick after them */
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->flags, vx, vy, fx, fy, fp->hdt, fp->c, fp->g,
                        fp->ob, fp->kick, x, fp->ef, fp->exmid);
@@ -564,7 +596,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     cdem_neighbour *nb = &it->nb;
     const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
     const long np = (long)nb->np, n = (long)s->n;
-    const force_pass fp = {
+    force_pass fp = {
         .law = &lawc,
         .kick = kick,
         .dt = it->dt,
@@ -598,19 +630,25 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         make_chunks(it, (size_t)n, nch);
     const int nchunk = it->nchunk;
     const int32_t *ce = it->chunk_elem, *cs = it->cross_start, *list = it->cross;
+    fp.nchunk = nchunk;
     if (nchunk == 1) {
-        chunk_pass(&fp, 0, n, list, 0, 0);
+        chunk_pass(&fp, 0, 0, n, list, 0, 0);
         return;
     }
+    fp.gen = ++it->cross_gen;
+    fp.ready = it->cross_ready;
 #pragma omp parallel num_threads(nchunk)
     {
+        /* each thread first evaluates the cross pairs into its chunks and flags them, then
+         * runs its chunks (no barrier: wait_cross spins on the flags when needed) */
         const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-        for (int c = t; c < nchunk; c += nt)
-            cross_eval(&fp, list, cs[c], cs[c + 1]);
-#pragma omp barrier
         for (int c = t; c < nchunk; c += nt) {
-            chunk_pass(&fp, ce[c], ce[c + 1], list, cs[c], cs[c + 1]);
+            cross_eval(&fp, list, cs[c], cs[c + 1]);
+#pragma omp atomic write seq_cst
+            it->cross_ready[c] = fp.gen;
         }
+        for (int c = t; c < nchunk; c += nt)
+            chunk_pass(&fp, c, ce[c], ce[c + 1], list, cs[c], cs[c + 1]);
     }
 }
 
