@@ -7,17 +7,17 @@
  * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
  * state fx, fy (boundary elements: the contact force on them, for reports, when
  * boundary_forces is set).
- * Determinism: every element sums its pair forces in ascending pair order (serial scatter
- * or threaded merge of per-pair slots), schedule(static): bit-identical for any thread
- * count. The integrator owns the neighbour list and contact histories; it never owns the
- * state. Escaping elements (cdem_integrator_enable_escape) are removed at list rebuilds.
- * Nothing allocates in a step except at list rebuilds (geometric growth).
- * Heterogeneity: after each list rebuild the element-element pair classes are refined from
- * layers and flags (cdem_contact_refine). Overburden: at each rebuild the highest free
- * element of each column (width 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a
- * constant force -p x column width in y until the next rebuild. Confining pressure: the
- * same sideways on the band edges (cdem_integrator_find_edges), ramped during equilibration.
- * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
+ * Determinism: every element sums its pair forces in ascending pair order (a scatter in
+ * slot order; threads own element chunks, cross-chunk pairs are subtracted first): bit-
+ * identical for any thread count. The integrator owns the neighbour list and contact histories; it
+ * never owns the state. Escaping elements (cdem_integrator_enable_escape) are removed at list
+ * rebuilds. Nothing allocates in a step except at list rebuilds (geometric growth). Heterogeneity:
+ * after each list rebuild the element-element pair classes are refined from layers and flags
+ * (cdem_contact_refine). Overburden: at each rebuild the highest free element of each column (width
+ * 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a constant force -p x column width in y
+ * until the next rebuild. Confining pressure: the same sideways on the band edges
+ * (cdem_integrator_find_edges), ramped during equilibration. Thread safety: one integrator per run.
+ * Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
 
@@ -39,9 +39,9 @@ typedef struct {
     cdem_contact_law law; /* contact law and materials */
     cdem_neighbour nb;    /* pair list with histories and force slots */
     long step;            /* steps taken so far */
-    int boundary_forces;  /* 1 (default): sum the contact force on boundary elements each step
-                             (state fx, fy); 0: skip them (faster; set it to 1 before a step
-                             whose boundary forces are reported) */
+    int boundary_forces;  /* 0/1, kept for the callers: the force pass now sums the contact
+                             force on boundary elements (state fx, fy) every step, as it
+                             costs nothing extra in the scatter; 1 = default */
     long par_min;         /* loops over fewer items than this run on one thread (>= 0);
                              results are bit-identical either way */
 

@@ -2,8 +2,10 @@
  * key, (2) drop removed elements, (3) maybe permute the state into cell order, (4) bin the
  * elements into cells (counting sort, so each cell lists ascending indices), (5) for each
  * element i in index order scan the 3 x 3 cells around it for j > i within reach + skin,
- * (6) restore histories by binary search on the sorted keys, (7) build the CSR.
- * All of it is serial and ordered, so the list is the same for any thread count. */
+ * (6) restore histories through the index map, (7) build the CSR. Step (5) is threaded
+ * above par_min elements (contiguous element ranges per thread, buffers appended in thread
+ * order); everything else is serial and ordered, so the list is the same for any thread
+ * count. */
 #include "neighbour.h"
 
 #include "contact.h"
