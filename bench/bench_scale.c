@@ -78,8 +78,8 @@ static cdem_status settle(bench *b, long steps, cdem_error *err) {
 static cdem_status deform(bench *b, long steps, cdem_error *err) {
     for (long q = 0; q < steps; q++) {
         b->k++;
-        CDEM_TRY(cdem_integrator_step(&b->it, &b->s, &b->bc, b->k, b->m.displacement_per_step,
-                                      err));
+        CDEM_TRY(
+            cdem_integrator_step(&b->it, &b->s, &b->bc, b->k, b->m.displacement_per_step, err));
     }
     return CDEM_OK;
 }
@@ -132,8 +132,8 @@ static int mode_scale(int argc, char **argv) {
             printf("BENCH_SCALE rep %d threads %d N %zu pairs %zu contacts %ld builds %ld steps "
                    "%ld seconds %.4f cpu_seconds %.4f ns_per_el_step %.2f cpu_ns_per_el_step "
                    "%.2f ns_per_contact_step %.2f el_steps_per_s %.4g load %.2f\n",
-                   r, threads, b.s.n, b.it.nb.np, contacts, b.it.nb.n_builds - b0, nsteps,
-                   t1 - t0, c1 - c0, 1e9 * (t1 - t0) / es, 1e9 * (c1 - c0) / es,
+                   r, threads, b.s.n, b.it.nb.np, contacts, b.it.nb.n_builds - b0, nsteps, t1 - t0,
+                   c1 - c0, 1e9 * (t1 - t0) / es, 1e9 * (c1 - c0) / es,
                    1e9 * (t1 - t0) / ((double)(contacts > 0 ? contacts : 1) * (double)nsteps),
                    es / (t1 - t0), load);
             fflush(stdout);
