@@ -636,6 +636,10 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         return;
     }
     fp.gen = ++it->cross_gen;
+    if (fp.gen <= 0)
+        fp.gen = it->cross_gen = 1; /* after a wrap-around (or a foreign restore) */
+    for (int c = 0; c < nchunk; c++)
+        it->cross_ready[c] = 0; /* no stale flag can match: reset before every pass */
     fp.ready = it->cross_ready;
 #pragma omp parallel num_threads(nchunk)
     {

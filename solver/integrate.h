@@ -58,8 +58,9 @@ typedef struct {
     int32_t *cross;                           /* pair slots of the cross pairs (crosscap) */
     size_t crosscap;                          /* capacity of cross, >= nb.pcap after builds */
     long cross_gen;                           /* threaded force passes so far (generation count) */
-    long cross_ready[CDEM_MAX_CHUNKS];        /* = cross_gen once chunk c's cross pairs of this
-                                                 pass are evaluated (atomic; spun on by the earlier
+    long cross_ready[CDEM_MAX_CHUNKS];        /* 0 at the start of every threaded pass, then
+                                                 cross_gen once chunk c's cross pairs are
+                                                 evaluated (atomic; spun on by the earlier
                                                  chunks instead of a barrier) */
 
     /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
