@@ -1,15 +1,20 @@
-/* integrate: see integrate.h. The step is three passes over memory: (1) half kick + drift
- * of the free elements (fused with nothing else, so the boundary mode can move its
- * elements after it), (2) one pass over the pair slots computing each pair force once,
- * (3) one pass over the elements summing their slots through the CSR and finishing the
- * kick. Pass 2 and 3 are the hot loops; both are OpenMP schedule(static) with one writer
- * per output slot, so any thread count gives identical bits. */
+/* integrate: see integrate.h. The step is: (1) half kick + drift of the free elements
+ * (fused with nothing else, so the boundary mode can move its elements after it), (2) one
+ * force pass (chunk_pass): the pair loop computes each pair force once into its slot and
+ * scatters it to its two elements, then the elements are finished (second half kick).
+ * Threads: the elements are cut into one chunk per thread (equal pair counts); a pair
+ * whose two elements lie in different chunks (a cross pair, ~1-3 % of them with the state
+ * in cell order) is evaluated first, then after one barrier every chunk sums and finishes
+ * its own elements. Each element's sum has the same additions in the same order (ascending
+ * pair index) for any chunking, so any thread count gives identical bits, the same as the
+ * serial scatter. One parallel region per force pass. */
 #include "integrate.h"
 
 #include "checkpoint.h"
 
 #include <math.h>
 #include <omp.h>
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -17,8 +22,9 @@
 #define RESORT_EVERY 20
 /* Default of cdem_integrator.par_min: loops shorter than this run on one thread. A step of
  * the default model (~2500 elements, ~5000 pairs) takes ~0.1 ms, comparable to the cost of
- * an OpenMP barrier when the cores are shared, so small models stay serial. */
-#define PAR_MIN_DEFAULT 16384
+ * waking a sleeping thread (OMP_WAIT_POLICY=passive) on a shared machine, so small models
+ * stay serial; from ~8,000 elements (half radii) the force pass and the build are threaded. */
+#define PAR_MIN_DEFAULT 8192
 
 cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
                                  cdem_error *err) {
@@ -57,6 +63,7 @@ void cdem_integrator_free(cdem_integrator *it) {
     free(it->col_top);
     free(it->band_lo);
     free(it->band_hi);
+    free(it->cross);
     memset(it, 0, sizeof *it);
 }
 
@@ -132,12 +139,28 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
     return collect_removed(it, s, nrem, err);
 }
 
+/* Grows the cross-pair buffer to the pair capacity (after a list build, outside the step's
+ * hot loops). */
+static cdem_status reserve_cross(cdem_integrator *it, cdem_error *err) {
+    if (it->crosscap >= it->nb.pcap)
+        return CDEM_OK;
+    const size_t c = it->nb.pcap;
+    int32_t *q = realloc(it->cross, (c ? c : 1) * sizeof *q);
+    if (!q)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu cross pairs)", c);
+    it->cross = q;
+    it->crosscap = c;
+    return CDEM_OK;
+}
+
 static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
     size_t nrem = 0;
     CDEM_TRY(find_escapes(it, s, &nrem, err));
     it->n_removed_last = nrem;
     it->n_removed += (long)nrem;
+    it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err));
+    CDEM_TRY(reserve_cross(it, err));
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
@@ -321,20 +344,25 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
     return CDEM_OK;
 }
 
-/* Force of pair p on pi[p] into its slot (zero when it does not touch). */
-static inline void pair_force(const cdem_contact_law *law, long p, const double *restrict x,
-                              const double *restrict y, const double *restrict vx,
-                              const double *restrict vy, const int32_t *restrict pi,
-                              const int32_t *restrict pj, const double *restrict Rp,
-                              const uint8_t *restrict cls, uint8_t *restrict hist,
-                              double *restrict xs, double *restrict pfx, double *restrict pfy,
-                              double dt) {
-    const int32_t i = pi[p], j = pj[p];
-    const double dx = x[j] - x[i], dy = y[j] - y[i];
+#if defined(__GNUC__)
+#define CDEM_INLINE inline __attribute__((always_inline))
+#else
+#define CDEM_INLINE inline
+#endif
+
+/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch).
+ * (A branch-free variant of the granular law, evaluating every list pair and selecting the
+ * result, was measured 40-50 % slower: gcc -O2 still branches and does more work.) */
+static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
+                                   double dy, double dvx, double dvy, const double *restrict Rp,
+                                   const uint8_t *restrict cls, uint8_t *restrict hist,
+                                   double *restrict xs, double *restrict pfx, double *restrict pfy,
+                                   double dt) {
     const double R = Rp[p];
     const uint8_t h = hist[p];
-    if (!(h & CDEM_PAIR_BONDED) && dx * dx + dy * dy >= R * R) {
-        /* the common case: a list pair that does not touch */
+    const double r2 = dx * dx + dy * dy;
+    if (!(h & CDEM_PAIR_BONDED) && (r2 >= R * R || r2 <= 0.0)) {
+        /* the common case: a list pair that does not touch (xs != 0 only with h != 0) */
         pfx[p] = 0.0;
         pfy[p] = 0.0;
         if (h) {
@@ -343,20 +371,57 @@ static inline void pair_force(const cdem_contact_law *law, long p, const double 
         }
         return;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, vx[j] - vx[i], vy[j] - vy[i], dt, &xs[p], &hist[p],
-                      &pfx[p], &pfy[p]);
+    if (law->model == CDEM_MATERIAL_GRANULAR) {
+        /* a touching granular pair: cdem_contact_eval's arithmetic, operation for operation
+         * (same bits), without the call and the re-tests */
+        const int c = cls[p];
+        const double r = sqrt(r2);
+        const double inv = 1.0 / r;
+        const double nx = dx * inv, ny = dy * inv;
+        const double fn = law->kn * (R - r);
+        double ftx = 0.0, fty = 0.0;
+        uint8_t hn = (uint8_t)(h | CDEM_PAIR_TOUCH);
+        if (law->ks > 0.0) {
+            const double tx = -ny, ty = nx;
+            double sv = xs[p] + (dvx * tx + dvy * ty) * dt;
+            double fs = law->ks * sv;
+            double limit = law->friction[c] * fn;
+            if (hn & CDEM_PAIR_COHESIVE)
+                limit += law->cohesion[c];
+            if (fabs(fs) > limit) {
+                fs = fs > 0.0 ? limit : -limit;
+                sv = fs / law->ks;
+                if (law->first_slip)
+                    hn &= (uint8_t)~CDEM_PAIR_COHESIVE;
+            }
+            xs[p] = sv;
+            ftx = fs * tx;
+            fty = fs * ty;
+        }
+        pfx[p] = -fn * nx + ftx;
+        pfy[p] = -fn * ny + fty;
+        hist[p] = hn;
+        return;
+    }
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
 }
 
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
- * kick (when kick), and the total force stored in fx, fy. */
+ * kick (when kick), and the total force stored in fx, fy. Boundary elements keep the sum. */
 static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
                                   double hdt, double c, double g, double ob, int kick,
                                   const double *restrict x, double ef, double exmid) {
+    const uint32_t fl = flags[i];
+    if (fl & CDEM_FLAGS_BOUNDARY) {
+        fx[i] = sx;
+        fy[i] = sy;
+        return;
+    }
     const double m = mass[i];
-    sy -= m * g + ((flags[i] & CDEM_FLAG_SURFACE) ? ob : 0.0);
-    if (flags[i] & CDEM_FLAG_BIAXIAL_EDGE)
+    sy -= m * g + ((fl & CDEM_FLAG_SURFACE) ? ob : 0.0);
+    if (fl & CDEM_FLAG_BIAXIAL_EDGE)
         sx += x[i] < exmid ? ef : -ef;
     if (kick) {
         /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
@@ -368,83 +433,228 @@ static inline void finish_element(long i, double sx, double sy, const double *re
     fy[i] = sy - c * vyw[i];
 }
 
-/* Pair forces, per-element sums and the second half kick. Two paths give the same bits:
- *  - serial: each pair force is added to its two elements as it is computed (a scatter in
- *    ascending pair order), then one streaming pass finishes the elements;
- *  - threaded: pair forces go to their slots (one writer each), then each element merges
- *    its pi range and its pj list in ascending pair order, i.e. the same additions in the
- *    same order as the scatter. */
+/* Everything the force pass reads or writes, gathered once per step. */
+typedef struct {
+    const cdem_contact_law *law;
+    int kick;
+    double dt, hdt, c, g, ob, ef, exmid;
+    const double *x, *y, *mass, *Rp;
+    const int32_t *pi, *pj, *istart;
+    const uint8_t *cls;
+    const uint32_t *flags;
+    uint8_t *hist;
+    double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
+    int nchunk;  /* chunks of this pass */
+    long gen;    /* generation of this pass */
+    long *ready; /* per-chunk generation flags (it->cross_ready) */
+} force_pass;
+
+/* Waits until every chunk after c has evaluated its cross pairs of this pass (their slots
+ * are read by chunk c). Usually already done: each thread evaluates its few cross pairs
+ * first, while chunk c meets its first cross pair only well into its own pass. */
+static void wait_cross(const force_pass *fp, int c) {
+    for (int d = c + 1; d < fp->nchunk; d++) {
+        for (long spins = 0;; spins++) {
+            long v;
+#pragma omp atomic read seq_cst
+            v = fp->ready[d];
+            if (v == fp->gen)
+                break;
+            if (spins > 1000)
+                sched_yield(); /* the other thread may be descheduled (shared machine) */
+        }
+    }
+}
+
+/* Evaluates the cross pairs into chunk c (their slots only; no sums). */
+static void cross_eval(const force_pass *fp, const int32_t *restrict list, int32_t a, int32_t b) {
+    const double *restrict x = fp->x, *restrict y = fp->y;
+    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    for (int32_t k = a; k < b; k++) {
+        const long p = list[k];
+        const int32_t i = fp->pi[p], j = fp->pj[p];
+        pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                   fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+    }
+}
+
+/* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
+ * istart[hi]-1). Every element's sum is built in ascending pair order, as one scatter loop
+ * over all pairs would: fx, fy of the chunk start at zero, the cross pairs from earlier
+ * chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then the
+ * chunk's pairs are scattered in order (a pair whose pj lies in a later chunk was evaluated
+ * by that chunk's thread and only adds to its pi here). Then the chunk's elements are
+ * finished. (A loop nested per element, accumulating each pi range in registers and
+ * finishing the element right after it, was measured slower: the short inner loops
+ * mispredict their exits.) */
+static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
+                       const int32_t *restrict list, int32_t ca, int32_t cb) {
+    const cdem_contact_law *restrict law = fp->law;
+    const double *restrict x = fp->x, *restrict y = fp->y;
+    double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict pj = fp->pj, *restrict istart = fp->istart;
+    double *restrict fx = fp->fx, *restrict fy = fp->fy;
+    double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+    const double dt = fp->dt;
+    memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
+    memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
+    for (int32_t k = ca; k < cb; k++) {
+        const long p = list[k];
+        fx[pj[p]] -= pfx[p];
+        fy[pj[p]] -= pfy[p];
+    }
+    const int32_t *restrict pi = fp->pi;
+    const long p0 = istart[lo], pe = istart[hi];
+    int ready = chunk + 1 >= fp->nchunk; /* the last chunk has no cross pairs out */
+    for (long p = p0; p < pe; p++) {
+        const int32_t i = pi[p], j = pj[p];
+        if (j < hi) {
+            pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                       fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+            fx[j] -= pfx[p];
+            fy[j] -= pfy[p];
+            fx[i] += pfx[p];
+            fy[i] += pfy[p];
+        } else {
+            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
+            if (!ready) {
+                wait_cross(fp, chunk);
+                ready = 1;
+            }
+            fx[i] += fp->pfx[p];
+            fy[i] += fp->pfy[p];
+        }
+    }
+    if (!ready)
+        wait_cross(fp, chunk); /* the cross pairs read these velocities: kick after them */
+    for (long i = lo; i < hi; i++)
+        finish_element(i, fx[i], fy[i], fp->mass, fp->flags, vx, vy, fx, fy, fp->hdt, fp->c, fp->g,
+                       fp->ob, fp->kick, x, fp->ef, fp->exmid);
+}
+
+/* Splits the elements into nchunk ranges of about equal pair counts and lists the cross
+ * pairs of each chunk. Falls back to one chunk when the buffer is too small (never after a
+ * build through rebuild/remove_marked, which reserve it). */
+static void make_chunks(cdem_integrator *it, size_t n, int nchunk) {
+    const cdem_neighbour *nb = &it->nb;
+    const size_t np = nb->np;
+    if (nchunk > CDEM_MAX_CHUNKS)
+        nchunk = CDEM_MAX_CHUNKS;
+    if (nchunk < 1 || (size_t)nchunk > n || it->crosscap < np)
+        nchunk = 1;
+    it->nchunk = nchunk;
+    it->chunk_build = nb->n_builds;
+    it->chunk_n = n;
+    it->chunk_elem[0] = 0;
+    for (int c = 1; c < nchunk; c++) {
+        /* first element whose pi range starts at or after c/nchunk of the pairs */
+        const size_t want = np * (size_t)c / (size_t)nchunk;
+        size_t lo = (size_t)it->chunk_elem[c - 1], hi = n;
+        while (lo < hi) {
+            const size_t mid = lo + (hi - lo) / 2;
+            if ((size_t)nb->istart[mid] < want)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        it->chunk_elem[c] = (int32_t)lo;
+    }
+    it->chunk_elem[nchunk] = (int32_t)n;
+    for (int c = 0; c <= nchunk; c++)
+        it->cross_start[c] = 0;
+    if (nchunk == 1)
+        return;
+    /* count, then fill, the cross pairs by the chunk of pj (ascending slots in each) */
+    for (int pass = 0; pass < 2; pass++) {
+        int32_t cursor[CDEM_MAX_CHUNKS + 1];
+        for (int c = 0; c <= nchunk; c++)
+            cursor[c] = it->cross_start[c];
+        for (int ci = 0; ci < nchunk; ci++) {
+            const int32_t end = it->chunk_elem[ci + 1];
+            for (int32_t p = nb->istart[it->chunk_elem[ci]]; p < nb->istart[end]; p++) {
+                const int32_t j = nb->pj[p];
+                if (j < end)
+                    continue;
+                int cj = ci + 1;
+                while (j >= it->chunk_elem[cj + 1])
+                    cj++;
+                if (pass == 0)
+                    cursor[cj + 1]++;
+                else
+                    it->cross[cursor[cj]++] = p;
+            }
+        }
+        if (pass == 0)
+            for (int c = 0; c < nchunk; c++)
+                it->cross_start[c + 1] = it->cross_start[c] + cursor[c + 1];
+    }
+}
+
+/* Pair forces, per-element sums and the second half kick, in one pass over the elements
+ * (chunk_pass). Threaded: one parallel region, each thread evaluates the cross pairs of its
+ * chunks, one barrier, then runs its chunks; every element sum has the same additions in
+ * the same order for any chunking, so the bits do not depend on the thread count. */
 static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     cdem_neighbour *nb = &it->nb;
     const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
-    const cdem_contact_law *law = &lawc;
-    const double dt = it->dt;
     const long np = (long)nb->np, n = (long)s->n;
-    const double *restrict x = s->x, *restrict y = s->y;
-    const int32_t *restrict pi = nb->pi, *restrict pj = nb->pj;
-    const double *restrict Rp = nb->R;
-    const uint8_t *restrict cls = nb->cls;
-    uint8_t *restrict hist = nb->hist;
-    double *restrict xs = nb->xs, *restrict pfx = nb->pfx, *restrict pfy = nb->pfy;
-    const double *restrict mass = s->mass;
-    const uint32_t *restrict flags = s->flags;
-    double *restrict fx = s->fx, *restrict fy = s->fy;
-    double *restrict vxw = s->vx, *restrict vyw = s->vy;
-    const double hdt = 0.5 * dt, c = it->damping, g = it->gravity, ob = it->overburden_force;
-    const double ef = it->confining_pressure * it->column_width * it->confining_factor;
-    const double exmid = it->edge_x_mid;
-    const int threaded = (np > it->par_min || n > it->par_min) && omp_get_max_threads() > 1;
-
-    if (!threaded) {
-        memset(fx, 0, (size_t)n * sizeof *fx);
-        memset(fy, 0, (size_t)n * sizeof *fy);
-        for (long p = 0; p < np; p++) {
-            pair_force(law, p, x, y, vxw, vyw, pi, pj, Rp, cls, hist, xs, pfx, pfy, dt);
-            const double ffx = pfx[p], ffy = pfy[p];
-            fx[pi[p]] += ffx;
-            fy[pi[p]] += ffy;
-            fx[pj[p]] -= ffx;
-            fy[pj[p]] -= ffy;
-        }
-        for (long i = 0; i < n; i++)
-            if (!(flags[i] & CDEM_FLAGS_BOUNDARY))
-                finish_element(i, fx[i], fy[i], mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick,
-                               x, ef, exmid);
+    force_pass fp = {
+        .law = &lawc,
+        .kick = kick,
+        .dt = it->dt,
+        .hdt = 0.5 * it->dt,
+        .c = it->damping,
+        .g = it->gravity,
+        .ob = it->overburden_force,
+        .ef = it->confining_pressure * it->column_width * it->confining_factor,
+        .exmid = it->edge_x_mid,
+        .x = s->x,
+        .y = s->y,
+        .mass = s->mass,
+        .Rp = nb->R,
+        .pi = nb->pi,
+        .pj = nb->pj,
+        .istart = nb->istart,
+        .cls = nb->cls,
+        .flags = s->flags,
+        .hist = nb->hist,
+        .xs = nb->xs,
+        .pfx = nb->pfx,
+        .pfy = nb->pfy,
+        .fx = s->fx,
+        .fy = s->fy,
+        .vx = s->vx,
+        .vy = s->vy,
+    };
+    const int want = (np > it->par_min || n > it->par_min) ? omp_get_max_threads() : 1;
+    const int nch = want < 1 ? 1 : (want > CDEM_MAX_CHUNKS ? CDEM_MAX_CHUNKS : want);
+    if (it->nchunk != nch || it->chunk_build != nb->n_builds || it->chunk_n != (size_t)n)
+        make_chunks(it, (size_t)n, nch);
+    const int nchunk = it->nchunk;
+    const int32_t *ce = it->chunk_elem, *cs = it->cross_start, *list = it->cross;
+    fp.nchunk = nchunk;
+    if (nchunk == 1) {
+        chunk_pass(&fp, 0, 0, n, list, 0, 0);
         return;
     }
-
-#pragma omp parallel for schedule(static)
-    for (long p = 0; p < np; p++)
-        pair_force(law, p, x, y, vxw, vyw, pi, pj, Rp, cls, hist, xs, pfx, pfy, dt);
-
-    const int32_t *restrict istart = nb->istart, *restrict jstart = nb->jstart;
-    const int32_t *restrict jslot = nb->jslot;
-    const int want_boundary = it->boundary_forces || !kick;
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < n; i++) {
-        const int boundary = (flags[i] & CDEM_FLAGS_BOUNDARY) != 0;
-        if (boundary && !want_boundary)
-            continue; /* not integrated; its force only matters for reports */
-        double sx = 0.0, sy = 0.0;
-        int32_t a = istart[i], b = jstart[i];
-        const int32_t ae = istart[i + 1], be = jstart[i + 1];
-        while (a < ae || b < be) {
-            if (b >= be || (a < ae && a < jslot[b])) {
-                sx += pfx[a];
-                sy += pfy[a];
-                a++;
-            } else {
-                sx -= pfx[jslot[b]];
-                sy -= pfy[jslot[b]];
-                b++;
-            }
+    fp.gen = ++it->cross_gen;
+    if (fp.gen <= 0)
+        fp.gen = it->cross_gen = 1; /* after a wrap-around (or a foreign restore) */
+    for (int c = 0; c < nchunk; c++)
+        it->cross_ready[c] = 0; /* no stale flag can match: reset before every pass */
+    fp.ready = it->cross_ready;
+#pragma omp parallel num_threads(nchunk)
+    {
+        /* each thread first evaluates the cross pairs into its chunks and flags them, then
+         * runs its chunks (no barrier: wait_cross spins on the flags when needed) */
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        for (int c = t; c < nchunk; c += nt) {
+            cross_eval(&fp, list, cs[c], cs[c + 1]);
+#pragma omp atomic write seq_cst
+            it->cross_ready[c] = fp.gen;
         }
-        if (boundary) {
-            fx[i] = sx;
-            fy[i] = sy;
-            continue;
-        }
-        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid);
+        for (int c = t; c < nchunk; c += nt)
+            chunk_pass(&fp, c, ce[c], ce[c + 1], list, cs[c], cs[c + 1]);
     }
 }
 
@@ -507,7 +717,9 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
 static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem, cdem_error *err) {
     CDEM_TRY(collect_removed(it, s, nrem, err));
     it->n_removed_last = nrem;
+    it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
+    CDEM_TRY(reserve_cross(it, err));
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));

@@ -7,17 +7,17 @@
  * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
  * state fx, fy (boundary elements: the contact force on them, for reports, when
  * boundary_forces is set).
- * Determinism: every element sums its pair forces in ascending pair order (serial scatter
- * or threaded merge of per-pair slots), schedule(static): bit-identical for any thread
- * count. The integrator owns the neighbour list and contact histories; it never owns the
- * state. Escaping elements (cdem_integrator_enable_escape) are removed at list rebuilds.
- * Nothing allocates in a step except at list rebuilds (geometric growth).
- * Heterogeneity: after each list rebuild the element-element pair classes are refined from
- * layers and flags (cdem_contact_refine). Overburden: at each rebuild the highest free
- * element of each column (width 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a
- * constant force -p x column width in y until the next rebuild. Confining pressure: the
- * same sideways on the band edges (cdem_integrator_find_edges), ramped during equilibration.
- * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
+ * Determinism: every element sums its pair forces in ascending pair order (a scatter in
+ * slot order; threads own element chunks, cross-chunk pairs are subtracted first): bit-
+ * identical for any thread count. The integrator owns the neighbour list and contact histories; it
+ * never owns the state. Escaping elements (cdem_integrator_enable_escape) are removed at list
+ * rebuilds. Nothing allocates in a step except at list rebuilds (geometric growth). Heterogeneity:
+ * after each list rebuild the element-element pair classes are refined from layers and flags
+ * (cdem_contact_refine). Overburden: at each rebuild the highest free element of each column (width
+ * 2 x max radius) is flagged CDEM_FLAG_SURFACE and carries a constant force -p x column width in y
+ * until the next rebuild. Confining pressure: the same sideways on the band edges
+ * (cdem_integrator_find_edges), ramped during equilibration. Thread safety: one integrator per run.
+ * Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
 
@@ -29,6 +29,9 @@
 #include "params.h"
 #include "state.h"
 
+/* Largest number of element chunks (threads) of the force pass. */
+#define CDEM_MAX_CHUNKS 64
+
 typedef struct {
     double dt;            /* s, time step, > 0 */
     double damping;       /* N s/m, viscous coefficient c, >= 0 */
@@ -36,11 +39,29 @@ typedef struct {
     cdem_contact_law law; /* contact law and materials */
     cdem_neighbour nb;    /* pair list with histories and force slots */
     long step;            /* steps taken so far */
-    int boundary_forces;  /* 1 (default): sum the contact force on boundary elements each step
-                             (state fx, fy); 0: skip them (faster; set it to 1 before a step
-                             whose boundary forces are reported) */
+    int boundary_forces;  /* 0/1, kept for the callers: the force pass now sums the contact
+                             force on boundary elements (state fx, fy) every step, as it
+                             costs nothing extra in the scatter; 1 = default */
     long par_min;         /* loops over fewer items than this run on one thread (>= 0);
                              results are bit-identical either way */
+
+    /* force pass decomposition (scratch derived from the pair list, not state: rebuilt
+     * whenever the list or the thread count changes; never serialised). Chunk c owns the
+     * elements chunk_elem[c]..chunk_elem[c+1]-1 and their pi ranges; a cross pair has its
+     * pj in a later chunk than its pi. */
+    int nchunk;                              /* chunks of the last force pass, 1..CDEM_MAX_CHUNKS */
+    long chunk_build;                        /* nb.n_builds the chunks were derived for */
+    size_t chunk_n;                          /* element count the chunks were derived for */
+    int32_t chunk_elem[CDEM_MAX_CHUNKS + 1]; /* first element of each chunk; [nchunk] = n */
+    int32_t cross_start[CDEM_MAX_CHUNKS + 1]; /* cross pairs into chunk c: cross[cross_start[c]
+                                                 .. cross_start[c+1]-1], ascending slots */
+    int32_t *cross;                           /* pair slots of the cross pairs (crosscap) */
+    size_t crosscap;                          /* capacity of cross, >= nb.pcap after builds */
+    long cross_gen;                           /* threaded force passes so far (generation count) */
+    long cross_ready[CDEM_MAX_CHUNKS];        /* 0 at the start of every threaded pass, then
+                                                 cross_gen once chunk c's cross pairs are
+                                                 evaluated (atomic; spun on by the earlier
+                                                 chunks instead of a barrier) */
 
     /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
      * y < ymin - max_radius; x bounds follow the moving lateral walls */

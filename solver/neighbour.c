@@ -2,14 +2,17 @@
  * key, (2) drop removed elements, (3) maybe permute the state into cell order, (4) bin the
  * elements into cells (counting sort, so each cell lists ascending indices), (5) for each
  * element i in index order scan the 3 x 3 cells around it for j > i within reach + skin,
- * (6) restore histories by binary search on the sorted keys, (7) build the CSR.
- * All of it is serial and ordered, so the list is the same for any thread count. */
+ * (6) restore histories through the index map, (7) build the CSR. Step (5) is threaded
+ * above par_min elements (contiguous element ranges per thread, buffers appended in thread
+ * order); everything else is serial and ordered, so the list is the same for any thread
+ * count. */
 #include "neighbour.h"
 
 #include "checkpoint.h"
 #include "contact.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,6 +44,7 @@ cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_fa
     nb->skin = skin;
     nb->reach_factor = reach_factor;
     nb->resort_every = resort_every > 0 ? resort_every : 1;
+    nb->par_min = 8192;
     return CDEM_OK;
 }
 
@@ -67,6 +71,12 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->cell_items);
     free(nb->carry);
     free(nb->oldmap);
+    for (int t = 0; t < CDEM_NB_MAX_THREADS; t++) {
+        free(nb->tbuf[t].pi);
+        free(nb->tbuf[t].pj);
+        free(nb->tbuf[t].R);
+        free(nb->tbuf[t].cls);
+    }
     memset(nb, 0, sizeof *nb);
 }
 
@@ -196,6 +206,93 @@ static void permute_state(cdem_neighbour *nb, cdem_state *s) {
     }
 }
 
+/* Grows one thread's pair buffer (called only by its thread, at build time). */
+static int buf_grow(cdem_pair_buf *b, size_t want) {
+    const size_t c = next_cap(b->cap, want);
+    int32_t *pi = realloc(b->pi, c * sizeof *pi);
+    if (pi)
+        b->pi = pi;
+    int32_t *pj = pi ? realloc(b->pj, c * sizeof *pj) : NULL;
+    if (pj)
+        b->pj = pj;
+    double *R = pj ? realloc(b->R, c * sizeof *R) : NULL;
+    if (R)
+        b->R = R;
+    uint8_t *cls = R ? realloc(b->cls, c * sizeof *cls) : NULL;
+    if (!cls)
+        return -1;
+    b->cls = cls;
+    b->cap = c;
+    return 0;
+}
+
+/* Cell grid dimensions of a build. */
+typedef struct {
+    size_t nx, ny; /* cells in x and y */
+} grid;
+
+/* Enumerates the pairs (i, j > i) of the elements lo..hi-1 in index order: into the list
+ * (buf NULL; serial) or into buf (one thread's share; err unused, buf->failed on NOMEM). */
+static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const grid *g, size_t lo,
+                             size_t hi, cdem_pair_buf *buf, cdem_error *err) {
+    const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
+    const uint32_t *restrict fl = s->flags;
+    const int32_t *restrict cell_start = nb->cell_start, *restrict cell_items = nb->cell_items;
+    const double rf = nb->reach_factor, skin = nb->skin;
+    const size_t nx = g->nx, ny = g->ny;
+    for (size_t i = lo; i < hi; i++) {
+        if (fl[i] & CDEM_FLAG_FOOTWALL)
+            continue;
+        const size_t ci = (size_t)nb->cell_of[i];
+        const size_t cx = ci % nx, cy = ci / nx;
+        const size_t x_lo = cx > 0 ? cx - 1 : 0, x_hi = cx + 1 < nx ? cx + 1 : cx;
+        const size_t y_lo = cy > 0 ? cy - 1 : 0, y_hi = cy + 1 < ny ? cy + 1 : cy;
+        const double xi = x[i], yi = y[i], ri = rad[i];
+        const uint32_t fi = fl[i];
+        for (size_t yy = y_lo; yy <= y_hi; yy++) {
+            /* the cells of one row are contiguous in cell_items */
+            const int32_t k0 = cell_start[yy * nx + x_lo], k1 = cell_start[yy * nx + x_hi + 1];
+            for (int32_t k = k0; k < k1; k++) {
+                const size_t j = (size_t)cell_items[k];
+                if (j <= i)
+                    continue;
+                const double R = ri + rad[j];
+                const double cut = R * rf + skin;
+                const double dx = x[j] - xi, dy = y[j] - yi;
+                if (dx * dx + dy * dy >= cut * cut)
+                    continue;
+                const int cls = cdem_contact_class(fi, fl[j]);
+                if (cls < 0)
+                    continue;
+                if (buf) {
+                    if (buf->n == buf->cap && buf_grow(buf, buf->n + 1) != 0) {
+                        buf->failed = 1;
+                        return CDEM_ERR_NOMEM;
+                    }
+                    const size_t p = buf->n++;
+                    buf->pi[p] = (int32_t)i;
+                    buf->pj[p] = (int32_t)j;
+                    buf->R[p] = R;
+                    buf->cls[p] = (uint8_t)cls;
+                    continue;
+                }
+                if (nb->np == nb->pcap)
+                    CDEM_TRY(reserve_pairs(nb, nb->np + 1, err));
+                const size_t p = nb->np++;
+                nb->pi[p] = (int32_t)i;
+                nb->pj[p] = (int32_t)j;
+                nb->R[p] = R;
+                nb->cls[p] = (uint8_t)cls;
+                nb->hist[p] = 0;
+                nb->xs[p] = 0.0;
+                nb->pfx[p] = 0.0;
+                nb->pfy[p] = 0.0;
+            }
+        }
+    }
+    return CDEM_OK;
+}
+
 cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
                                  int resort, cdem_error *err) {
     CDEM_TRY(save_carry(nb, s, err));
@@ -307,46 +404,61 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         nb->cell_start[0] = 0;
     }
 
-    /* enumerate pairs */
+    /* enumerate pairs: element i in index order, j > i in the 3 x 3 cells around it */
     nb->np = 0;
-    const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
-    const uint32_t *restrict fl = s->flags;
-    const double rf = nb->reach_factor, skin = nb->skin;
-    for (size_t i = 0; i < n; i++) {
-        if (fl[i] & CDEM_FLAG_FOOTWALL)
-            continue;
-        const size_t ci = (size_t)nb->cell_of[i];
-        const size_t cx = ci % nx, cy = ci / nx;
-        const size_t x_lo = cx > 0 ? cx - 1 : 0, x_hi = cx + 1 < nx ? cx + 1 : cx;
-        const size_t y_lo = cy > 0 ? cy - 1 : 0, y_hi = cy + 1 < ny ? cy + 1 : cy;
-        for (size_t yy = y_lo; yy <= y_hi; yy++) {
-            for (size_t xx = x_lo; xx <= x_hi; xx++) {
-                const size_t c = yy * nx + xx;
-                for (int32_t k = nb->cell_start[c]; k < nb->cell_start[c + 1]; k++) {
-                    const size_t j = (size_t)nb->cell_items[k];
-                    if (j <= i)
-                        continue;
-                    const int cls = cdem_contact_class(fl[i], fl[j]);
-                    if (cls < 0)
-                        continue;
-                    const double R = rad[i] + rad[j];
-                    const double cut = R * rf + skin;
-                    const double dx = x[j] - x[i], dy = y[j] - y[i];
-                    if (dx * dx + dy * dy >= cut * cut)
-                        continue;
-                    if (nb->np == nb->pcap)
-                        CDEM_TRY(reserve_pairs(nb, nb->np + 1, err));
-                    const size_t p = nb->np++;
-                    nb->pi[p] = (int32_t)i;
-                    nb->pj[p] = (int32_t)j;
-                    nb->R[p] = R;
-                    nb->cls[p] = (uint8_t)cls;
-                    nb->hist[p] = 0;
-                    nb->xs[p] = 0.0;
-                    nb->pfx[p] = 0.0;
-                    nb->pfy[p] = 0.0;
+    const grid g = {.nx = nx, .ny = ny};
+    int nthr = omp_get_max_threads();
+    if (nthr > CDEM_NB_MAX_THREADS)
+        nthr = CDEM_NB_MAX_THREADS;
+    if ((long)n < nb->par_min || nthr < 2) {
+        CDEM_TRY(enumerate(nb, s, &g, 0, n, NULL, err));
+    } else {
+        /* thread t takes the t-th contiguous element range into its own buffer; the buffers
+         * are then appended in thread order: the same list as the serial loop */
+#pragma omp parallel num_threads(nthr)
+        {
+            const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+            const size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
+            cdem_pair_buf *b = &nb->tbuf[t];
+            b->n = 0;
+            b->failed = 0;
+            enumerate(nb, s, &g, lo, hi, b, NULL);
+#pragma omp barrier
+#pragma omp single
+            {
+                size_t total = 0;
+                int failed = 0;
+                for (int q = 0; q < nt; q++) {
+                    total += nb->tbuf[q].n;
+                    failed |= nb->tbuf[q].failed;
+                }
+                nb->np = failed ? SIZE_MAX : total;
+                if (!failed && total > nb->pcap && reserve_pairs(nb, total, NULL) != CDEM_OK)
+                    nb->np = SIZE_MAX;
+            }
+            if (nb->np != SIZE_MAX) {
+                size_t off = 0;
+                for (int q = 0; q < t; q++)
+                    off += nb->tbuf[q].n;
+                const size_t m = b->n;
+                memcpy(nb->pi + off, b->pi, m * sizeof *b->pi);
+                memcpy(nb->pj + off, b->pj, m * sizeof *b->pj);
+                memcpy(nb->R + off, b->R, m * sizeof *b->R);
+                memcpy(nb->cls + off, b->cls, m * sizeof *b->cls);
+                memset(nb->hist + off, 0, m * sizeof *nb->hist);
+                for (size_t k = 0; k < m; k++) {
+                    nb->xs[off + k] = 0.0;
+                    nb->pfx[off + k] = 0.0;
+                    nb->pfy[off + k] = 0.0;
                 }
             }
+        }
+        if (nb->np == SIZE_MAX) {
+            nb->np = 0;
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                             "neighbour list: out of memory for the pairs of a threaded build "
+                             "(%zu elements)",
+                             n);
         }
     }
     /* CSR of slots per element, ascending slot order */

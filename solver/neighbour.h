@@ -9,7 +9,8 @@
  * state arrays are permuted into cell order (memory locality).
  * Between builds the caller may only append elements to the state (removal goes through
  * the keep argument of the build). Ownership: cdem_neighbour owns its buffers (grown geometrically,
- * only at build time); it never owns the state. Thread safety: build is serial; readers may share
+ * only at build time); it never owns the state. Thread safety: one build at a time (it
+ * threads its pair enumeration itself: same list for any thread count); readers may share
  * the lists. Units: m. */
 #ifndef CDEM_NEIGHBOUR_H
 #define CDEM_NEIGHBOUR_H
@@ -29,11 +30,26 @@ typedef struct {
     uint8_t hist; /* CDEM_PAIR_* flags */
 } cdem_pair_carry;
 
+/* Largest number of threads the list build uses (more are ignored: the build stays on at
+ * most this many). */
+#define CDEM_NB_MAX_THREADS 64
+
+/* Pairs found by one thread of a threaded build (scratch, grown at builds only). */
+typedef struct {
+    int32_t *pi, *pj; /* element indices, pi < pj */
+    double *R;        /* m, sum of the radii */
+    uint8_t *cls;     /* CDEM_CLASS_* base class */
+    size_t n, cap;    /* used, capacity */
+    int failed;       /* 1: out of memory while growing */
+} cdem_pair_buf;
+
 typedef struct {
     /* configuration (set by init) */
     double skin;         /* m, extra list distance beyond contact reach, > 0 */
     double reach_factor; /* pairs interact up to R * reach_factor (1 + max breaking strain) */
     int resort_every;    /* re-sort the state into cell order every this many builds, >= 1 */
+    long par_min;        /* builds of fewer elements than this enumerate pairs on one thread;
+                            the list is the same either way (default 8192, >= 0) */
 
     /* pair list, struct of arrays, np used of pcap */
     size_t np, pcap;
@@ -68,6 +84,10 @@ typedef struct {
     /* carried histories */
     size_t ncarry, carrycap;
     cdem_pair_carry *carry;
+
+    /* per-thread pair buffers of a threaded build (thread t enumerates the t-th contiguous
+     * element range; the buffers are concatenated in thread order) */
+    cdem_pair_buf tbuf[CDEM_NB_MAX_THREADS];
 
     long n_builds; /* builds so far */
     long n_sorts;  /* re-sorts so far */

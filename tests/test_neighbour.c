@@ -11,6 +11,7 @@
 #include "neighbour.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -220,11 +221,50 @@ static void test_neighbour_rejects_bad_input(void **st) {
     cdem_state_free(&s);
 }
 
+/* The threaded pair enumeration (par_min 0, 1..3 threads, contiguous element ranges per
+ * thread) gives the same list, slot for slot, as the serial one, and it equals brute force. */
+static void test_neighbour_threaded_build_same_list(void **st) {
+    (void)st;
+    const int saved = omp_get_max_threads();
+    cdem_state s[3];
+    cdem_neighbour nb[3];
+    cdem_error err;
+    for (int t = 0; t < 3; t++) {
+        make_cloud(&s[t], 3000, 12000.0, 4242);
+        assert_int_equal(cdem_neighbour_init(&nb[t], 12.5, 1.0, 1, &err), CDEM_OK);
+        nb[t].par_min = t == 0 ? 1000000 : 0;
+        omp_set_num_threads(t + 1);
+        assert_int_equal(cdem_neighbour_build(&nb[t], &s[t], NULL, 1, &err), CDEM_OK);
+    }
+    omp_set_num_threads(saved);
+    uint64_t *bk = NULL;
+    const size_t nbk = brute_pairs(&s[0], nb[0].reach_factor, nb[0].skin, &bk);
+    assert_int_equal(nb[0].np, nbk);
+    assert_true(nbk > 3000);
+    for (int t = 1; t < 3; t++) {
+        assert_int_equal(nb[t].np, nb[0].np);
+        assert_memory_equal(s[t].id, s[0].id, s[0].n * sizeof *s[0].id);
+        assert_memory_equal(nb[t].pi, nb[0].pi, nb[0].np * sizeof *nb[0].pi);
+        assert_memory_equal(nb[t].pj, nb[0].pj, nb[0].np * sizeof *nb[0].pj);
+        assert_memory_equal(nb[t].R, nb[0].R, nb[0].np * sizeof *nb[0].R);
+        assert_memory_equal(nb[t].cls, nb[0].cls, nb[0].np * sizeof *nb[0].cls);
+        assert_memory_equal(nb[t].jslot, nb[0].jslot, nb[0].np * sizeof *nb[0].jslot);
+        for (size_t p = 0; p < nb[t].np; p++)
+            assert_true(nb[t].hist[p] == 0 && nb[t].xs[p] == 0.0);
+    }
+    free(bk);
+    for (int t = 0; t < 3; t++) {
+        cdem_neighbour_free(&nb[t]);
+        cdem_state_free(&s[t]);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_neighbour_matches_brute_force),
         cmocka_unit_test(test_neighbour_history_survives_resort_and_removal),
         cmocka_unit_test(test_neighbour_rejects_bad_input),
+        cmocka_unit_test(test_neighbour_threaded_build_same_list),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
