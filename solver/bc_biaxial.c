@@ -1,18 +1,17 @@
 /* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (common/model.c).
  * Init: the base row is the bottom platen; a top platen of wall elements (base radius r,
- * spaced r) is added one radius above the highest free element; both platens are extended
- * 25% of the base length beyond each end so the sample keeps touching them as it widens.
- * Both platens are CDEM_FLAG_MOVING. Equilibration: the lateral walls hold the sample while the
- * solver ramps the confining pressure (lateral_pressure hook) from 0 at mid-equilibration to
- * full at its end. Start of deformation: the lateral walls are removed (the sides are free,
- * loaded only by the confining pressure). Deformation: each platen moves toward the other at
- * half the boundary speed, so the closure per step is the boundary increment du and the net
- * displacement is the closure. Measurements at each time-series sample: axial strain =
- * closure / H0 (H0 = platen gap at the end of equilibration, between the platens' inner
- * faces); differential stress = F / L - p x ramp, F = mean |contact force y| of the two
- * platens, L = span of the free elements (left edge to right edge), F and L averaged over the
- * samples of the last 5 increments (v3.1), minus the value at the end of equilibration (v2.6)
- * from then on (during equilibration the uncorrected value is reported). Units: m, N, N/m. */
+ * spaced r) is added one radius above the highest free element; both platens extend 25% of
+ * the base length beyond each end and are CDEM_FLAG_MOVING. Platens are smooth (adjust_law:
+ * wall-class friction, cohesion and breaking strain 0). Equilibration: the lateral walls
+ * hold the sample while the solver ramps the confining pressure p on the free edges from 0 at
+ * mid-equilibration to full at its end; the platens are servo-controlled (equilibrate) to
+ * carry the same ramped pressure, so the sample starts isotropic. Deformation: the lateral
+ * walls are removed; each platen moves inward at half the boundary speed (closure per step =
+ * du = net displacement). Measurements (each time-series sample): axial strain = closure / H0
+ * (H0 = gap between the platens' inner faces at the start of deformation); differential
+ * stress = F / L - p x ramp, F = mean |contact force y| of the two platens, L = span of the
+ * free elements, both averaged over the samples of the last 5 increments (v3.1), minus the
+ * value at the end of equilibration (v2.6). Single-threaded; units m, N, N/m. */
 #include "bc.h"
 
 #include <math.h>
@@ -40,7 +39,13 @@ typedef struct {
     int have_ref;    /* 1 once the end-of-equilibration reference is taken */
     double ref;      /* N/m, differential stress at the end of equilibration */
     double last;     /* N/m, uncorrected differential stress of the last sample */
+    double kn;       /* N/m, contact normal stiffness (servo gain scale), > 0 */
+    long eq_step;    /* equilibration steps done (servo ramp), 0..equil */
+    double servo;    /* N/m, last servo target axial stress p x ramp, >= 0 */
 } biaxial_ctx;
+
+/* Servo gain: fraction of the force error closed per step through the platen contacts. */
+#define BIAXIAL_SERVO_GAIN 0.5
 
 static int is_platen(uint32_t f) {
     return (f & CDEM_FLAG_WALL) && (f & CDEM_FLAG_MOVING);
@@ -103,6 +108,7 @@ static cdem_status biaxial_init(void *vctx, const cdem_params *p, const cdem_mod
     c->y_mid = 0.5 * (c->y_top + c->y_bottom);
     c->pressure = p->confining_pressure;
     c->equil = m->equil_steps;
+    c->kn = m->kn > 0.0 ? m->kn : 1.0;
     const long interval = p->series_interval > 0 ? p->series_interval : 1;
     const double win = ceil(5.0 * m->display_steps / (double)interval);
     c->window = win >= 1.0 ? (win < 1e6 ? (size_t)win : 1000000) : 1;
@@ -134,10 +140,77 @@ static cdem_status biaxial_apply(void *vctx, cdem_state *s, long k, double du, d
     return CDEM_OK;
 }
 
+/* Servo step of one platen: the contact force error (load - target, N, positive = the
+ * sample pushes harder than the target) moves the platen outward by GAIN x error / (Kn x
+ * platen contacts), at most du per step (never faster than the deformation). */
+static double servo_move(double load, double target, long contacts, double kn, double du) {
+    const double nc = contacts > 0 ? (double)contacts : 1.0;
+    const double d = BIAXIAL_SERVO_GAIN * (load - target) / (kn * nc);
+    return d > du ? du : (d < -du ? -du : d);
+}
+
+static cdem_status biaxial_equilibrate(void *vctx, cdem_state *s, double du, double dt,
+                                       cdem_error *err) {
+    biaxial_ctx *c = vctx;
+    if (!(dt > 0.0) || !(du > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "biaxial: equilibration step with dt = %g s, du = %g m: both must be > 0",
+                         dt, du);
+    c->eq_step++;
+    double ft = 0.0, fb = 0.0, lo = INFINITY, hi = -INFINITY;
+    long nt = 0, nb = 0;
+    for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible */
+        const uint32_t f = s->flags[i];
+        if (is_platen(f)) {
+            if (s->y[i] > c->y_mid) {
+                ft += s->fy[i];
+                nt += s->fy[i] != 0.0;
+            } else {
+                fb += s->fy[i];
+                nb += s->fy[i] != 0.0;
+            }
+        } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            lo = fmin(lo, s->x[i] - s->radius[i]);
+            hi = fmax(hi, s->x[i] + s->radius[i]);
+        }
+    }
+    const double width = hi > lo ? hi - lo : 0.0;
+    c->servo = c->pressure * cdem_bc_confining_ramp(c->eq_step, c->equil);
+    const double target = c->servo * width;
+    /* top platen: pushed up (+y) by the sample; bottom: pushed down */
+    const double dtop = servo_move(ft, target, nt, c->kn, du);
+    const double dbot = servo_move(-fb, target, nb, c->kn, du);
+    for (size_t i = 0; i < s->n; i++) {
+        if (!is_platen(s->flags[i]))
+            continue;
+        const double d = s->y[i] > c->y_mid ? dtop : -dbot;
+        s->y[i] += d;
+        s->vx[i] = 0.0;
+        s->vy[i] = d / dt;
+    }
+    c->y_top += dtop;
+    c->y_bottom -= dbot;
+    c->y_mid = 0.5 * (c->y_top + c->y_bottom);
+    return CDEM_OK;
+}
+
+/* Smooth platens: element-wall contacts (the platens; the lateral walls until they are
+ * removed) carry no friction, no cohesion and no bond. */
+static void biaxial_law(const void *vctx, cdem_contact_law *law) {
+    (void)vctx;
+    law->friction[CDEM_CLASS_WALL] = 0.0;
+    law->cohesion[CDEM_CLASS_WALL] = 0.0;
+    law->breaking_strain[CDEM_CLASS_WALL] = 0.0;
+}
+
 static cdem_status biaxial_begin(void *vctx, const cdem_state *s, unsigned char *keep,
                                  size_t *n_remove, cdem_error *err) {
-    (void)vctx;
-    (void)err;
+    biaxial_ctx *c = vctx;
+    c->h0 = (c->y_top - c->r_top) - (c->y_bottom + c->r_bottom);
+    if (!(c->h0 > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "biaxial: platen gap at the start of deformation = %g m: must be > 0",
+                         c->h0);
     size_t n = 0;
     for (size_t i = 0; i < s->n; i++)
         if ((s->flags[i] & CDEM_FLAG_WALL) && !(s->flags[i] & CDEM_FLAG_MOVING)) {
@@ -228,6 +301,8 @@ static const cdem_bc_ops biaxial_ops = {
     .begin_deformation = biaxial_begin,   /* removes the lateral walls */
     .lateral_pressure = biaxial_pressure, /* confining pressure */
     .measure = biaxial_measure,           /* axial strain, differential stress */
+    .equilibrate = biaxial_equilibrate,   /* servo platens: isotropic start */
+    .adjust_law = biaxial_law,            /* smooth platens */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

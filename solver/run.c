@@ -302,6 +302,7 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     r->base_tol_y = ywall + 0.5 * r->m.radius[0];
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
+    cdem_bc_adjust_law(&r->bc, &r->it.law); /* e.g. the biaxial test's smooth platens */
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
@@ -347,9 +348,13 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
                         nrem, r->bc.ops->name, r->s.n);
             }
         }
-        /* wall forces are summed only on the steps whose sample reports them */
-        r->it.boundary_forces = (step % interval == 0);
-        cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL, r->k_def,
+        /* wall forces are summed only on the steps whose sample reports them, and on every
+         * equilibration step of a mode that moves boundaries then (biaxial servo platens) */
+        const int eq_moves = step <= equil && cdem_bc_moves_in_equilibration(&r->bc);
+        r->it.boundary_forces = (step % interval == 0) || eq_moves;
+        cdem_status st = cdem_integrator_step(&r->it, &r->s,
+                                              (deforming || eq_moves) ? &r->bc : NULL,
+                                              deforming ? r->k_def : 0,
                                               r->m.displacement_per_step, err);
         if (st != CDEM_OK)
             return st;
