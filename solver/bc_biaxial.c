@@ -46,6 +46,8 @@ typedef struct {
 
 /* Servo gain: fraction of the force error closed per step through the platen contacts. */
 #define BIAXIAL_SERVO_GAIN 0.5
+/* Servo speed limit: platen travel per step at most this many boundary increments du. */
+#define BIAXIAL_SERVO_SPEED 10.0
 
 static int is_platen(uint32_t f) {
     return (f & CDEM_FLAG_WALL) && (f & CDEM_FLAG_MOVING);
@@ -146,7 +148,8 @@ static cdem_status biaxial_apply(void *vctx, cdem_state *s, long k, double du, d
 static double servo_move(double load, double target, long contacts, double kn, double du) {
     const double nc = contacts > 0 ? (double)contacts : 1.0;
     const double d = BIAXIAL_SERVO_GAIN * (load - target) / (kn * nc);
-    return d > du ? du : (d < -du ? -du : d);
+    const double cap = BIAXIAL_SERVO_SPEED * du;
+    return d > cap ? cap : (d < -cap ? -cap : d);
 }
 
 static cdem_status biaxial_equilibrate(void *vctx, cdem_state *s, double du, double dt,

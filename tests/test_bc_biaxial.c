@@ -13,6 +13,7 @@
 
 #include "assert_near.h"
 #include "bc.h"
+#include "contact.h"
 #include "h5format.h"
 #include "integrate.h"
 #include "model.h"
@@ -111,6 +112,121 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
     assert_int_equal(cdem_integrator_set_confining(&it, NAN, 0, &err), CDEM_ERR_RANGE);
     cdem_integrator_free(&it);
     cdem_state_free(&s);
+}
+
+
+/* One free disc (radius 125 m, no gravity) on a short bottom platen; the mode adds the top
+ * platen. Equilibration steps (cdem_bc_apply with k = 0 runs the servo) for twice the ramp:
+ * both platens must end up carrying the confining pressure over the sample width, F = p x 2r
+ * (the disc is the whole sample), and the platens must have moved (the servo closed the gap
+ * until the disc is squeezed by F / Kn in total). */
+static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
+    (void)st;
+    cdem_params p = biaxial_params();
+    cdem_model m;
+    cdem_error err;
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    m.equil_steps = 200;
+    m.total_steps = 600;
+    cdem_state s;
+    assert_int_equal(cdem_state_init(&s, 64, 0, &err), CDEM_OK);
+    const double rw = m.radius[0], R = m.radius[3];
+    for (int k = -6; k <= 6; k++)
+        assert_int_equal(cdem_state_append(&s, -1, k * rw, 0.0, rw, 1.0, 0, CDEM_FLAG_WALL, 0, NULL,
+                                           &err),
+                         CDEM_OK);
+    const double mass = p.density * M_PI * R * R;
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, rw + R, R, mass, 1, 0, 0, NULL, &err),
+                     CDEM_OK);
+    cdem_bc bc;
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
+    assert_true(cdem_bc_moves_in_equilibration(&bc));
+    cdem_integrator it;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    cdem_bc_adjust_law(&bc, &it.law);
+    assert_int_equal(cdem_integrator_set_confining(&it, PRESSURE, m.equil_steps, &err), CDEM_OK);
+    double top0 = -INFINITY;
+    for (size_t i = 0; i < s.n; i++)
+        if ((s.flags[i] & CDEM_FLAG_MOVING) && s.y[i] > rw)
+            top0 = fmax(top0, s.y[i]);
+    for (long j = 1; j <= 2 * m.equil_steps; j++)
+        assert_int_equal(cdem_integrator_step(&it, &s, &bc, 0, m.displacement_per_step, &err),
+                         CDEM_OK);
+    double ft = 0.0, fb = 0.0, top1 = -INFINITY, bot1 = INFINITY, yd = 0.0;
+    for (size_t i = 0; i < s.n; i++) {
+        if (!(s.flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            yd = s.y[i];
+            continue;
+        }
+        if (s.y[i] > rw) {
+            ft += s.fy[i];
+            top1 = fmax(top1, s.y[i]);
+        } else {
+            fb += s.fy[i];
+            bot1 = fmin(bot1, s.y[i]);
+        }
+    }
+    const double target = PRESSURE * 2.0 * R;
+    assert_near(ft, target, 0.02 * target);  /* the disc pushes the top platen up */
+    assert_near(-fb, target, 0.02 * target); /* and the bottom one down */
+    assert_true(top1 < top0 - 0.5 * target / m.kn); /* the top platen came down */
+    assert_true(bot1 > 0.0);                         /* the bottom one up */
+    assert_true(yd > bot1 && yd < top1);
+    /* the confining pressure is the lateral load of the mode */
+    assert_near(cdem_bc_lateral_pressure(&bc), PRESSURE, 0.0);
+    cdem_integrator_free(&it);
+    cdem_bc_free(&bc);
+    cdem_state_free(&s);
+}
+
+/* Smooth platens: the mode's law hook zeroes the wall-class friction, cohesion and breaking
+ * strain and nothing else; a cohesive element-wall contact pressed and sheared carries no
+ * tangential force, while an element-element one does. */
+static void test_bc_biaxial_smooth_platens(void **st) {
+    (void)st;
+    cdem_params p = biaxial_params();
+    cdem_model m;
+    cdem_error err;
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    cdem_state s;
+    assert_int_equal(cdem_state_init(&s, 64, 0, &err), CDEM_OK);
+    for (int k = -3; k <= 3; k++)
+        assert_int_equal(cdem_state_append(&s, -1, k * 50.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0,
+                                           NULL, &err),
+                         CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, 150.0, 100.0, 1.0, 1, 0, 0, NULL, &err),
+                     CDEM_OK);
+    cdem_bc bc;
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
+    cdem_contact_law law;
+    assert_int_equal(cdem_contact_law_init(&law, &p, m.kn, m.ks, &err), CDEM_OK);
+    const cdem_contact_law before = law;
+    assert_true(law.friction[CDEM_CLASS_WALL] > 0.0 && law.cohesion[CDEM_CLASS_WALL] > 0.0);
+    cdem_bc_adjust_law(&bc, &law);
+    assert_near(law.friction[CDEM_CLASS_WALL], 0.0, 0.0);
+    assert_near(law.cohesion[CDEM_CLASS_WALL], 0.0, 0.0);
+    assert_near(law.breaking_strain[CDEM_CLASS_WALL], 0.0, 0.0);
+    assert_near(law.friction[CDEM_CLASS_ELEMENT], before.friction[CDEM_CLASS_ELEMENT], 0.0);
+    assert_near(law.cohesion[CDEM_CLASS_ELEMENT], before.cohesion[CDEM_CLASS_ELEMENT], 0.0);
+    assert_near(law.friction[CDEM_CLASS_FAULT], before.friction[CDEM_CLASS_FAULT], 0.0);
+    for (int cls = CDEM_CLASS_ELEMENT; cls <= CDEM_CLASS_WALL; cls++) {
+        /* j straight above i, overlapping 1 m, sliding 0.5 m along the tangent in one step */
+        double xs = 0.0, fx = 0.0, fy = 0.0;
+        uint8_t h = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
+        cdem_contact_eval(&law, cls, 0.0, 149.0, 150.0, -0.5, 0.0, 1.0, &xs, &h, &fx, &fy);
+        assert_near(fy, -m.kn * 1.0, 1e-9 * m.kn); /* repulsion on i, same for both */
+        if (cls == CDEM_CLASS_WALL)
+            assert_near(fx, 0.0, 0.0);
+        else
+            assert_true(fabs(fx) > 0.1 * m.kn * 0.5);
+    }
+    cdem_bc_free(&bc);
+    cdem_state_free(&s);
+    /* without a mode the law is left alone */
+    cdem_contact_law other = before;
+    cdem_bc_adjust_law(NULL, &other);
+    assert_near(other.friction[CDEM_CLASS_WALL], before.friction[CDEM_CLASS_WALL], 0.0);
+    assert_false(cdem_bc_moves_in_equilibration(NULL));
 }
 
 static void test_bc_biaxial_refuses_bad_parameters(void **st) {
@@ -288,6 +404,8 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bc_biaxial_ramp),
         cmocka_unit_test(test_bc_biaxial_edge_force_analytic),
+        cmocka_unit_test(test_bc_biaxial_servo_platens_carry_the_pressure),
+        cmocka_unit_test(test_bc_biaxial_smooth_platens),
         cmocka_unit_test(test_bc_biaxial_refuses_bad_parameters),
         cmocka_unit_test(test_bc_biaxial_end_to_end),
     };
