@@ -44,9 +44,11 @@ static double fixture_top(void) {
 }
 
 /* Checks the geometry after init against the curve pl (basal dip db_deg): fault elements on
- * the ramp / curve / vertical top, footwall = left of or touching the curve, left wall
- * display-only. */
-static void check_geometry(const cdem_state *s, const cdem_fault_polyline *pl, double db_deg) {
+ * the ramp / curve / vertical top; no free or footwall element overlaps a fault element (the
+ * ones cut by the fault were removed: n_before - n_cut_expected elements remain besides the
+ * fault); footwall = exactly the elements left of the curve; left wall display-only. */
+static void check_geometry(const cdem_state *s, const cdem_fault_polyline *pl, double db_deg,
+                           const cdem_state *before) {
     const double db = db_deg * M_PI / 180.0;
     long nf = 0, nfw = 0, nfree = 0;
     double ylo = INFINITY, yhi = -INFINITY;
@@ -77,7 +79,10 @@ static void check_geometry(const cdem_state *s, const cdem_fault_polyline *pl, d
             nfree++;
             const double xc = cdem_fault_file_x_at(pl, s->y[i]);
             const double dist = cdem_fault_file_distance(pl, s->x[i], s->y[i]);
-            const int expect = s->x[i] < xc || dist < s->radius[i] + RW;
+            if (dist < s->radius[i] + RW)
+                fail_msg("element %d at (%g, %g) overlaps the fault (%g m from the curve)",
+                         (int)s->id[i], s->x[i], s->y[i], dist);
+            const int expect = s->x[i] < xc;
             assert_int_equal((f & CDEM_FLAG_FOOTWALL) != 0, expect);
             nfw += expect;
             assert_int_equal(cdem_contact_class(f, 0), expect ? -1 : CDEM_CLASS_ELEMENT);
@@ -85,6 +90,19 @@ static void check_geometry(const cdem_state *s, const cdem_fault_polyline *pl, d
     }
     assert_true(nf > 20);
     assert_true(nfw > 10 && nfw < nfree - 10);
+    /* the removed elements are exactly the free ones cut by the fault */
+    long cut = 0, kept_free = 0;
+    for (size_t i = 0; i < before->n; i++) {
+        if (before->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        const int is_cut = cdem_fault_file_distance(pl, before->x[i], before->y[i]) <
+                           before->radius[i] + RW;
+        cut += is_cut;
+        kept_free += !is_cut;
+        assert_int_equal(fx_find(s, before->id[i]) == SIZE_MAX, is_cut);
+    }
+    assert_true(cut > 3);
+    assert_int_equal(nfree, kept_free);
     assert_true(ylo < -((double)K * DPS + 3.0 * RW) * sin(db)); /* ramp below the base */
     assert_true(yhi > 1500.0 - RW);                             /* up to the top of the walls */
 }
@@ -93,8 +111,9 @@ static void test_bc_listric_geometry(void **st) {
     (void)st;
     cdem_model m = fx_model(K);
     cdem_params p = listric_params(CDEM_MODE_LISTRIC_FAULT);
-    cdem_state s;
+    cdem_state s, before;
     fx_assembly(&s);
+    fx_assembly(&before);
     cdem_error err;
     cdem_bc bc;
     if (cdem_bc_init(&bc, &p, &m, &s, &err) != CDEM_OK)
@@ -102,7 +121,8 @@ static void test_bc_listric_geometry(void **st) {
     cdem_fault_polyline pl;
     assert_int_equal(
         cdem_fault_file_listric(X0, fixture_top(), DIP, CDEM_LISTRIC_SEGMENTS, &pl, &err), CDEM_OK);
-    check_geometry(&s, &pl, DIP);
+    check_geometry(&s, &pl, DIP, &before);
+    cdem_state_free(&before);
     char *v = fx_view(&bc);
     assert_non_null(strstr(v, "listric normal fault, constant heave (CH)"));
     assert_non_null(strstr(v, "basal dip 45.0 deg"));
@@ -116,8 +136,9 @@ static void test_bc_listric_irregular_geometry(void **st) {
     (void)st;
     cdem_model m = fx_model(K);
     cdem_params p = listric_params(CDEM_MODE_IRREGULAR_FAULT);
-    cdem_state s;
+    cdem_state s, before;
     fx_assembly(&s);
+    fx_assembly(&before);
     cdem_error err;
     cdem_bc bc;
     if (cdem_bc_init(&bc, &p, &m, &s, &err) != CDEM_OK)
@@ -125,7 +146,8 @@ static void test_bc_listric_irregular_geometry(void **st) {
     cdem_fault_polyline pl;
     assert_int_equal(cdem_fault_file_read(p.fault_file, X0, 25.0, &pl, &err), CDEM_OK);
     assert_int_equal(pl.n, 4);
-    check_geometry(&s, &pl, atan2(400.0, 231.0) * 180.0 / M_PI);
+    check_geometry(&s, &pl, atan2(400.0, 231.0) * 180.0 / M_PI, &before);
+    cdem_state_free(&before);
     char *v = fx_view(&bc);
     assert_non_null(strstr(v, "irregular normal fault"));
     assert_non_null(strstr(v, "from the fault file"));
@@ -136,7 +158,8 @@ static void test_bc_listric_irregular_geometry(void **st) {
 }
 
 /* Runs K steps and checks every boundary element's displacement: fault elements `hx` in x,
- * the whole base and the right wall `vy` in y, footwall not at all. */
+ * the whole base and the right wall `vy` in y, the footwall display elements `hx` in x with
+ * the fault (CH: the footwall is rigid, so the fault is never drawn over it). */
 static void check_kinematics(cdem_params p, double hx, double vy, double net_end) {
     fx_result r;
     fx_run(p, K, &r);
@@ -152,6 +175,7 @@ static void check_kinematics(cdem_params p, double hx, double vy, double net_end
             ex = hx;
             nf++;
         } else if (f & CDEM_FLAG_FOOTWALL) {
+            ex = hx;
             nfw++;
         } else {
             ey = vy;
@@ -164,6 +188,17 @@ static void check_kinematics(cdem_params p, double hx, double vy, double net_end
     }
     assert_true(nf > 20 && nb > 30 && nfw > 10);
     assert_true(nfix > 5); /* the base left of the fault moves too */
+    /* after the motion no footwall display element overlaps a fault element */
+    for (size_t i = 0; i < r.s.n; i++) {
+        if (!(r.s.flags[i] & CDEM_FLAG_FOOTWALL) || r.s.layer[i] == 0)
+            continue;
+        for (size_t j = 0; j < r.s.n; j++)
+            if ((r.s.flags[j] & CDEM_FLAG_FAULT) &&
+                hypot(r.s.x[i] - r.s.x[j], r.s.y[i] - r.s.y[j]) <
+                    r.s.radius[i] + r.s.radius[j] - 1e-6)
+                fail_msg("footwall element %d at (%g, %g) overlaps fault element %d at (%g, %g)",
+                         (int)r.s.id[i], r.s.x[i], r.s.y[i], (int)r.s.id[j], r.s.x[j], r.s.y[j]);
+    }
     assert_float_equal(r.net_end, net_end, 1e-9);
     fx_result_free(&r);
 }
