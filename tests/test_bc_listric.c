@@ -226,16 +226,20 @@ static void test_bc_listric_reverse_and_inversion(void **st) {
     check_kinematics(p, 0.0, 0.0, 0.0);
 }
 
-/* CD (mylar sheet): after K steps the sheet elements slid u = K du down-dip along the fault
- * (exactly u (cos d, -sin d) on the ramp, (0, -u) on the vertical top, on the curve in
- * between), the base and right wall moved u (cos d, -sin d), the footwall not at all; with
- * inversion at 50 % everything is back. */
-static void check_cd(int inversion) {
-    const double d = DIP * M_PI / 180.0, u = inversion ? 0.0 : (double)K * DPS;
+/* CD (mylar sheet): after K steps the sheet elements slid s down-dip along the fixed path
+ * (s < 0: up-dip), exactly s (cos d, -sin d) on the ramp, (0, -s) on the vertical top and on
+ * the curve in between; the base and right wall moved s (cos d, -sin d); the footwall not at
+ * all; the net displacement is `net` (along the initial sense). Reverse and inversion use the
+ * same single sheet: it is kinematic, so it drags the hanging wall up-dip as well as down-dip
+ * (the original's second sheet for reverse motion, manual v4.0, is not needed; see
+ * docs/solver.md). */
+static void check_cd(int sense, int inversion, double pct, double s, double net) {
+    const double d = DIP * M_PI / 180.0;
     cdem_params p = listric_params(CDEM_MODE_LISTRIC_FAULT);
     p.kinematics = CDEM_KIN_CD;
+    p.fault_sense = sense;
     p.inversion = inversion;
-    p.inversion_percent = 50.0;
+    p.inversion_percent = pct;
     const double H = fixture_top();
     cdem_fault_polyline pl;
     cdem_error err;
@@ -243,22 +247,23 @@ static void check_cd(int inversion) {
                      CDEM_OK);
     fx_result r;
     fx_run(p, K, &r);
-    long nramp = 0, ntop = 0, ncurve = 0, nbase = 0;
+    const double us = fabs(s);
+    long nramp = 0, ntop = 0, ncurve = 0, nbase = 0, nfw = 0;
     for (size_t i = 0; i < r.s0.n; i++) {
         const uint32_t f = r.s0.flags[i];
         if (!(f & CDEM_FLAGS_BOUNDARY))
             continue;
         double dx, dy, ex = 0.0, ey = 0.0;
         fx_displacement(&r.s0, &r.s, r.s0.id[i], &dx, &dy);
-        const double y0 = r.s0.y[i];
+        const double y0 = r.s0.y[i], y1 = y0 + dy;
         if (f & CDEM_FLAG_MYLAR) {
             assert_true(f & CDEM_FLAG_FAULT);
-            if (y0 < 0.0) {
-                ex = u * cos(d);
-                ey = -u * sin(d);
+            if (y0 < 0.0 && y1 < 0.0) {
+                ex = s * cos(d);
+                ey = -s * sin(d);
                 nramp++;
-            } else if (y0 - u > H + 1e-6) {
-                ey = -u;
+            } else if (y0 > H + 1e-6 && y1 > H + 1e-6) {
+                ey = -s;
                 ntop++;
             } else {
                 ncurve++;
@@ -267,28 +272,45 @@ static void check_cd(int inversion) {
                 const double off = yn < 0.0 ? fabs((xn - X0) * sin(d) + yn * cos(d))
                                             : cdem_fault_file_distance(&pl, xn, yn);
                 assert_true(off < 1e-6);
-                assert_true(hypot(dx, dy) <= u + 1e-9 && hypot(dx, dy) >= 0.99 * u);
+                assert_true(hypot(dx, dy) <= us + 1e-9 && hypot(dx, dy) >= 0.99 * us);
+                /* down-dip = toward +x and -y on this fault; up-dip the opposite */
+                if (us > 0.0)
+                    assert_true(s > 0.0 ? (dy < 0.0 && dx >= -1e-9) : (dy > 0.0 && dx <= 1e-9));
                 continue;
             }
         } else if (f & CDEM_FLAG_WALL) {
-            ex = u * cos(d);
-            ey = -u * sin(d);
+            ex = s * cos(d);
+            ey = -s * sin(d);
             nbase++;
+        } else {
+            nfw++; /* footwall display: fixed in CD */
         }
         if (fabs(dx - ex) > 1e-9 || fabs(dy - ey) > 1e-9)
             fail_msg("element %d (flags %u) at (%g, %g) moved (%g, %g), expected (%g, %g)",
                      (int)r.s0.id[i], (unsigned)f, r.s0.x[i], y0, dx, dy, ex, ey);
     }
-    assert_true(nramp > 2 && ntop > 10 && ncurve > 5 && nbase > 50);
-    assert_float_equal(r.net_end, u, 1e-9);
+    assert_true(nramp > 2 && ntop > 10 && ncurve > 5 && nbase > 50 && nfw > 10);
+    assert_float_equal(r.net_end, net, 1e-9);
     fx_result_free(&r);
     cdem_fault_file_free(&pl);
 }
 
 static void test_bc_listric_cd_kinematics(void **st) {
     (void)st;
-    check_cd(0);
-    check_cd(1);
+    const double u = (double)K * DPS;
+    check_cd(CDEM_SENSE_NORMAL, 0, 0.0, u, u);      /* normal: down-dip by u */
+    check_cd(CDEM_SENSE_NORMAL, 1, 50.0, 0.0, 0.0); /* inverted at 50 %: back */
+}
+
+/* CD reverse and inversion: the single kinematic sheet slides up-dip (reverse) by u, and
+ * with inversion of a reverse fault at 25 % it ends 0.5 u down-dip (net -0.5 u along the
+ * initial reverse sense); inversion of a normal fault at 75 % ends 0.5 u down-dip. */
+static void test_bc_listric_cd_reverse_and_inversion(void **st) {
+    (void)st;
+    const double u = (double)K * DPS;
+    check_cd(CDEM_SENSE_REVERSE, 0, 0.0, -u, u);
+    check_cd(CDEM_SENSE_REVERSE, 1, 25.0, 0.5 * u, -0.5 * u);
+    check_cd(CDEM_SENSE_NORMAL, 1, 75.0, 0.5 * u, 0.5 * u);
 }
 
 static void test_bc_listric_errors(void **st) {
@@ -357,6 +379,7 @@ int main(void) {
         cmocka_unit_test(test_bc_listric_normal_kinematics),
         cmocka_unit_test(test_bc_listric_reverse_and_inversion),
         cmocka_unit_test(test_bc_listric_cd_kinematics),
+        cmocka_unit_test(test_bc_listric_cd_reverse_and_inversion),
         cmocka_unit_test(test_bc_listric_errors),
         cmocka_unit_test(test_bc_listric_cdem_run),
     };
