@@ -306,6 +306,7 @@ static const cdem_bc_ops biaxial_ops = {
     .measure = biaxial_measure,           /* axial strain, differential stress */
     .equilibrate = biaxial_equilibrate,   /* servo platens: isotropic start */
     .adjust_law = biaxial_law,            /* smooth platens */
+    .affine_damping = 1,                  /* damping does not resist the imposed strain */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

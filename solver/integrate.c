@@ -351,19 +351,52 @@ static inline void finish_element(long i, double sx, double sy, const double *re
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
                                   double hdt, double c, double g, double ob, int kick,
-                                  const double *restrict x, double ef, double exmid) {
+                                  const double *restrict x, double ef, double exmid,
+                                  const double *restrict y, const double *restrict aff) {
     const double m = mass[i];
     sy -= m * g + ((flags[i] & CDEM_FLAG_SURFACE) ? ob : 0.0);
     if (flags[i] & CDEM_FLAG_BIAXIAL_EDGE)
         sx += x[i] < exmid ? ef : -ef;
+    /* damping acts on v - v_aff (v_aff = 0 exactly unless affine damping is on) */
+    const double rx = aff[0] * (x[i] - aff[2]), ry = aff[1] * (y[i] - aff[3]);
     if (kick) {
-        /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
+        /* v = (v_half + hdt/m (F + c v_aff)) / (1 + c hdt/m) with a single division */
         const double inv = 1.0 / (m + c * hdt);
-        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
-        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
+        vxw[i] = (m * vxw[i] + hdt * (sx + c * rx)) * inv;
+        vyw[i] = (m * vyw[i] + hdt * (sy + c * ry)) * inv;
     }
-    fx[i] = sx - c * vxw[i];
-    fy[i] = sy - c * vyw[i];
+    fx[i] = sx - c * (vxw[i] - rx);
+    fy[i] = sy - c * (vyw[i] - ry);
+}
+
+/* Affine damping: the least-squares homogeneous strain-rate field of the free elements'
+ * current (mid-step) velocities, v_aff = (ax (x - xc), ay (y - yc)), xc, yc their mean
+ * position. Serial sums in element order: reproducible for any thread count. */
+static void fit_affine(cdem_integrator *it, const cdem_state *s) {
+    double n = 0.0, sx = 0.0, sy = 0.0;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            n += 1.0;
+            sx += s->x[i];
+            sy += s->y[i];
+        }
+    it->aff[0] = it->aff[1] = it->aff[2] = it->aff[3] = 0.0;
+    if (n < 2.0)
+        return;
+    const double xc = sx / n, yc = sy / n;
+    double sxx = 0.0, syy = 0.0, svx = 0.0, svy = 0.0;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            const double dx = s->x[i] - xc, dy = s->y[i] - yc;
+            sxx += dx * dx;
+            syy += dy * dy;
+            svx += s->vx[i] * dx;
+            svy += s->vy[i] * dy;
+        }
+    it->aff[0] = sxx > 0.0 ? svx / sxx : 0.0;
+    it->aff[1] = syy > 0.0 ? svy / syy : 0.0;
+    it->aff[2] = xc;
+    it->aff[3] = yc;
 }
 
 /* Pair forces, per-element sums and the second half kick. Two paths give the same bits:
@@ -391,6 +424,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
     const double hdt = 0.5 * dt, c = it->damping, g = it->gravity, ob = it->overburden_force;
     const double ef = it->confining_pressure * it->column_width * it->confining_factor;
     const double exmid = it->edge_x_mid;
+    const double aff[4] = {it->aff[0], it->aff[1], it->aff[2], it->aff[3]};
     const int threaded = (np > it->par_min || n > it->par_min) && omp_get_max_threads() > 1;
 
     if (!threaded) {
@@ -407,7 +441,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         for (long i = 0; i < n; i++)
             if (!(flags[i] & CDEM_FLAGS_BOUNDARY))
                 finish_element(i, fx[i], fy[i], mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick,
-                               x, ef, exmid);
+                               x, ef, exmid, y, aff);
         return;
     }
 
@@ -442,7 +476,8 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
             fy[i] = sy;
             continue;
         }
-        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid);
+        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid, y,
+                       aff);
     }
 }
 
@@ -454,6 +489,8 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
                              (int)s->id[i], s->mass[i]);
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
+    if (it->affine_damping)
+        fit_affine(it, s);
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
@@ -494,6 +531,8 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(check_finite(it, s, err));
         CDEM_TRY(rebuild(it, s, err));
     }
+    if (it->affine_damping)
+        fit_affine(it, s);
     forces_and_kick(it, s, 1);
     return CDEM_OK;
 }

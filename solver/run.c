@@ -303,6 +303,7 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     cdem_bc_adjust_law(&r->bc, &r->it.law); /* e.g. the biaxial test's smooth platens */
+    r->it.affine_damping = cdem_bc_affine_damping(&r->bc); /* biaxial: quasi-static damping */
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
