@@ -476,8 +476,8 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
             fy[i] = sy;
             continue;
         }
-        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid, y,
-                       aff);
+        finish_element(i, sx, sy, mass, flags, vxw, vyw, fx, fy, hdt, c, g, ob, kick, x, ef, exmid,
+                       y, aff);
     }
 }
 

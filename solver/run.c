@@ -353,10 +353,9 @@ static cdem_status run_body(run_ctx *r, cdem_error *err) {
          * equilibration step of a mode that moves boundaries then (biaxial servo platens) */
         const int eq_moves = step <= equil && cdem_bc_moves_in_equilibration(&r->bc);
         r->it.boundary_forces = (step % interval == 0) || eq_moves;
-        cdem_status st = cdem_integrator_step(&r->it, &r->s,
-                                              (deforming || eq_moves) ? &r->bc : NULL,
-                                              deforming ? r->k_def : 0,
-                                              r->m.displacement_per_step, err);
+        cdem_status st =
+            cdem_integrator_step(&r->it, &r->s, (deforming || eq_moves) ? &r->bc : NULL,
+                                 deforming ? r->k_def : 0, r->m.displacement_per_step, err);
         if (st != CDEM_OK)
             return st;
         r->step = step;

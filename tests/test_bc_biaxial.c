@@ -114,7 +114,6 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
     cdem_state_free(&s);
 }
 
-
 /* One free disc (radius 125 m, no gravity) on a short bottom platen; the mode adds the top
  * platen. Equilibration steps (cdem_bc_apply with k = 0 runs the servo) for twice the ramp:
  * both platens must end up carrying the confining pressure over the sample width, F = p x 2r
@@ -132,12 +131,11 @@ static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
     assert_int_equal(cdem_state_init(&s, 64, 0, &err), CDEM_OK);
     const double rw = m.radius[0], R = m.radius[3];
     for (int k = -6; k <= 6; k++)
-        assert_int_equal(cdem_state_append(&s, -1, k * rw, 0.0, rw, 1.0, 0, CDEM_FLAG_WALL, 0, NULL,
-                                           &err),
-                         CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(&s, -1, k * rw, 0.0, rw, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
     const double mass = p.density * M_PI * R * R;
-    assert_int_equal(cdem_state_append(&s, -1, 0.0, rw + R, R, mass, 1, 0, 0, NULL, &err),
-                     CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, rw + R, R, mass, 1, 0, 0, NULL, &err), CDEM_OK);
     cdem_bc bc;
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
     assert_true(cdem_bc_moves_in_equilibration(&bc));
@@ -167,10 +165,10 @@ static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
         }
     }
     const double target = PRESSURE * 2.0 * R;
-    assert_near(ft, target, 0.02 * target);  /* the disc pushes the top platen up */
-    assert_near(-fb, target, 0.02 * target); /* and the bottom one down */
+    assert_near(ft, target, 0.02 * target);         /* the disc pushes the top platen up */
+    assert_near(-fb, target, 0.02 * target);        /* and the bottom one down */
     assert_true(top1 < top0 - 0.5 * target / m.kn); /* the top platen came down */
-    assert_true(bot1 > 0.0);                         /* the bottom one up */
+    assert_true(bot1 > 0.0);                        /* the bottom one up */
     assert_true(yd > bot1 && yd < top1);
     /* the confining pressure is the lateral load of the mode */
     assert_near(cdem_bc_lateral_pressure(&bc), PRESSURE, 0.0);
@@ -191,9 +189,9 @@ static void test_bc_biaxial_smooth_platens(void **st) {
     cdem_state s;
     assert_int_equal(cdem_state_init(&s, 64, 0, &err), CDEM_OK);
     for (int k = -3; k <= 3; k++)
-        assert_int_equal(cdem_state_append(&s, -1, k * 50.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0,
-                                           NULL, &err),
-                         CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(&s, -1, k * 50.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
     assert_int_equal(cdem_state_append(&s, -1, 0.0, 150.0, 100.0, 1.0, 1, 0, 0, NULL, &err),
                      CDEM_OK);
     cdem_bc bc;
@@ -250,8 +248,8 @@ static void test_bc_biaxial_affine_damping(void **st) {
         for (int i = 0; i < 4; i++)
             for (int j = 0; j < 3; j++) {
                 const double x = 1000.0 * i, y = 1000.0 * j;
-                assert_int_equal(
-                    cdem_state_append(&s, -1, x, y, 50.0, mass, 1, 0, 0, NULL, &err), CDEM_OK);
+                assert_int_equal(cdem_state_append(&s, -1, x, y, 50.0, mass, 1, 0, 0, NULL, &err),
+                                 CDEM_OK);
             }
         const double xc = 1500.0, yc = 1000.0;
         for (size_t i = 0; i < s.n; i++) {
@@ -298,9 +296,9 @@ static void test_bc_biaxial_affine_damping(void **st) {
     cdem_state s;
     assert_int_equal(cdem_state_init(&s, 32, 0, &err), CDEM_OK);
     for (int k = -3; k <= 3; k++)
-        assert_int_equal(cdem_state_append(&s, -1, k * 50.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0,
-                                           NULL, &err),
-                         CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(&s, -1, k * 50.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
     assert_int_equal(cdem_state_append(&s, -1, 0.0, 150.0, 100.0, 1.0, 1, 0, 0, NULL, &err),
                      CDEM_OK);
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);

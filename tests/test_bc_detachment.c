@@ -22,7 +22,7 @@ static void check_kinematics(cdem_walls_choice walls) {
     p.detachment_walls = walls;
     fx_result r;
     fx_run(p, K, &r);
-    const double u = (double)K * DPS; /* total shortening */
+    const double u = (double)K * DPS;                        /* total shortening */
     const double w = walls == CDEM_WALLS_BOTH ? 0.5 * u : u; /* each moving wall */
     long n_left = 0, n_right = 0, n_base = 0;
     for (size_t i = 0; i < r.s0.n; i++) {

@@ -95,8 +95,8 @@ static void check_geometry(const cdem_state *s, const cdem_fault_polyline *pl, d
     for (size_t i = 0; i < before->n; i++) {
         if (before->flags[i] & CDEM_FLAGS_BOUNDARY)
             continue;
-        const int is_cut = cdem_fault_file_distance(pl, before->x[i], before->y[i]) <
-                           before->radius[i] + RW;
+        const int is_cut =
+            cdem_fault_file_distance(pl, before->x[i], before->y[i]) < before->radius[i] + RW;
         cut += is_cut;
         kept_free += !is_cut;
         assert_int_equal(fx_find(s, before->id[i]) == SIZE_MAX, is_cut);
