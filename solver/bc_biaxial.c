@@ -278,11 +278,15 @@ static void biaxial_view(const void *vctx, FILE *out) {
     fprintf(out,
             "Boundary mode: biaxial test, confining pressure %.6g N/m on the free edges (ramped "
             "from 0 at mid-equilibration to full at its end); top platen of %ld elements added "
-            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); both platens "
-            "move toward each other at half the boundary speed; the %ld lateral wall elements "
-            "are removed at the start of deformation; initial sample height %.6g m; axial "
-            "strain = closure / height; differential stress averaged over %zu samples (5 "
-            "increments) and corrected to 0 at the end of equilibration.\n",
+            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); smooth "
+            "platens (no friction, cohesion or bond with the sample; material.wall_* not used); "
+            "in equilibration the platens are servo-controlled to carry the same ramped "
+            "pressure (isotropic start), then move toward each other at half the boundary "
+            "speed each; damping acts on the velocity relative to the sample's homogeneous "
+            "strain-rate field; the %ld lateral wall elements are removed at the start of "
+            "deformation; initial sample height %.6g m (re-measured at the start of "
+            "deformation); axial strain = closure / height; differential stress averaged over "
+            "%zu samples (5 increments) and corrected to 0 at the end of equilibration.\n",
             c->pressure, c->n_top, c->y_top, c->n_extend, c->n_walls, c->h0, c->window);
 }
 
