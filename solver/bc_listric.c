@@ -11,7 +11,9 @@
  * plus the fault radius, on either side) are removed; those left of it (entirely on the
  * footwall side of the fault elements) and the left wall become display-only footwall
  * elements (CDEM_FLAG_FOOTWALL; they never interact). The whole base moves with the hanging
- * wall (the part left of x0 stays left of the moving fault, never touching the hanging wall).
+ * wall, except its part left of x0 (below).
+ * The base left of x0 is the footwall's base: it stays a wall (it bounds the escape test) but
+ * moves with the footwall, not with the hanging wall (manual v4.1).
  * CH kinematics (Verrall 1981): relative to the footwall the hanging wall moves by the heave
  * du cos(db) horizontally and the throw du sin(db) vertically, db = dip of the basal segment,
  * and collapses by vertical shear onto the fault. In the model frame (hanging-wall base fixed
@@ -46,6 +48,7 @@ typedef struct {
     long n_footwall;          /* elements flagged CDEM_FLAG_FOOTWALL */
     long n_cut;               /* free elements removed at init: cut by the fault elements */
     long n_base_moving;       /* wall elements of the moving hanging-wall base/right wall */
+    long n_base_footwall;     /* base elements left of x0: the footwall's base (not MOVING) */
     double net;               /* m, net displacement along the basal segment (initial sense +) */
     int cd;                   /* 1: constant displacement (mylar sheet), 0: constant heave */
     size_t path_n;            /* vertices of the fault-element path (ramp, curve, top) */
@@ -196,6 +199,8 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
             if (!is_base && s->x[i] < w.x_mid) {
                 f = (f & ~(uint32_t)CDEM_FLAG_WALL) | CDEM_FLAG_FOOTWALL; /* left wall */
                 c->n_footwall++;
+            } else if (is_base && s->x[i] < c->x_fault) {
+                c->n_base_footwall++; /* the footwall's base: a wall, moves with the footwall */
             } else {
                 f |= CDEM_FLAG_MOVING;
                 c->n_base_moving++;
@@ -281,8 +286,9 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
     const uint32_t *restrict fl = s->flags;
 #pragma omp parallel for schedule(static) if (n > 20000)
     for (long i = 0; i < n; i++) {
-        if (fl[i] & CDEM_FLAG_FOOTWALL) { /* display only: rides with the fault */
-            x[i] += ux;
+        if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
+            (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {
+            x[i] += ux; /* footwall display and footwall base: ride with the fault */
             continue;
         }
         if (!(fl[i] & CDEM_FLAG_MOVING))
@@ -326,10 +332,10 @@ static void listric_view(const void *vctx, FILE *out) {
                 "from the hanging wall and the hanging-wall base %.4f m vertically; ",
                 c->heave, c->throw_);
     fprintf(out,
-            "%ld fault elements, %ld footwall display elements%s, %ld free elements cut by "
-            "the fault removed, %ld moving base/right-wall elements.",
-            c->n_fault, c->n_footwall, c->cd ? "" : " (moving with the fault)", c->n_cut,
-            c->n_base_moving);
+            "%ld fault elements, %ld footwall display elements and %ld footwall base elements%s, "
+            "%ld free elements cut by the fault removed, %ld moving base/right-wall elements.",
+            c->n_fault, c->n_footwall, c->n_base_footwall,
+            c->cd ? " (fixed)" : " (moving with the fault)", c->n_cut, c->n_base_moving);
     if (c->inversion)
         fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
     fprintf(out, "\n");
