@@ -11,7 +11,8 @@
  * (H0 = gap between the platens' inner faces at the start of deformation); differential
  * stress = F / L - p x ramp, F = mean |contact force y| of the two platens, L = span of the
  * free elements, both averaged over the samples of the last 5 increments (v3.1), minus the
- * value at the end of equilibration (v2.6). Single-threaded; units m, N, N/m. */
+ * value at the end of equilibration (v2.6). Asks for affine damping (integrate.h: damping
+ * does not resist the imposed strain). Single-threaded; units m, N, N/m. */
 #include "bc.h"
 
 #include <math.h>
