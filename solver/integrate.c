@@ -491,6 +491,8 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     CDEM_TRY(rebuild(it, s, err));
     if (it->affine_damping)
         fit_affine(it, s);
+    else
+        it->aff[0] = it->aff[1] = 0.0;
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
@@ -533,6 +535,8 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     }
     if (it->affine_damping)
         fit_affine(it, s);
+    else
+        it->aff[0] = it->aff[1] = 0.0; /* plain damping (also after switching it off) */
     forces_and_kick(it, s, 1);
     return CDEM_OK;
 }

@@ -314,6 +314,44 @@ static void test_bc_biaxial_affine_damping(void **st) {
     cdem_state_free(&s);
 }
 
+/* Uniaxial (p = 0) through cdem_run: the sample keeps its contact network through the
+ * equilibration (plain damping there; affine damping only while the platens shorten it, so
+ * the free expansion of the packing is damped) and the platens carry no load before
+ * deformation. */
+static void test_bc_biaxial_uniaxial_sample_stays_packed(void **st) {
+    (void)st;
+    char path[1024];
+    tmp_path(path, sizeof path, "test_bc_biaxial_uniaxial.h5");
+    cdem_params p = biaxial_params();
+    p.confining_pressure = 0.0;
+    p.runtime = 110.0;
+    cdem_model m;
+    cdem_error err;
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    cdem_run_options o;
+    memset(&o, 0, sizeof o);
+    o.output_path = path;
+    o.quiet = 1;
+    if (cdem_run(&p, &o, &err) != CDEM_OK)
+        fail_msg("cdem_run: %s", err.msg);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_series_sample *q = NULL;
+    size_t nq = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &q, &nq, &err), CDEM_OK);
+    size_t last_eq = 0;
+    for (size_t k = 0; k < nq; k++)
+        if (q[k].step <= m.equil_steps)
+            last_eq = k;
+    assert_true(last_eq > 10 && last_eq + 1 < nq);
+    assert_true(q[0].contacts > 1000);
+    assert_true((double)q[last_eq].contacts >= 0.9 * (double)q[0].contacts);
+    assert_near(q[last_eq].differential_stress, 0.0, 1e-9); /* no load on the platens */
+    assert_true(q[nq - 1].contacts >= q[last_eq].contacts / 2);
+    free(q);
+    cdem_h5_reader_close(r);
+}
+
 static void test_bc_biaxial_refuses_bad_parameters(void **st) {
     (void)st;
     char path[1024];
@@ -499,6 +537,7 @@ int main(void) {
         cmocka_unit_test(test_bc_biaxial_affine_damping),
         cmocka_unit_test(test_bc_biaxial_refuses_bad_parameters),
         cmocka_unit_test(test_bc_biaxial_end_to_end),
+        cmocka_unit_test(test_bc_biaxial_uniaxial_sample_stays_packed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
