@@ -10,7 +10,7 @@
 #     final surface is between 20 and 45 degrees;
 #  5. biaxial tests at 0 and 10 MPa (1e7 N/m): the differential stress rises, peaks and
 #     softens (the 10 MPa run to <= 0.95 of its peak), and the confined peak is above the
-#     unconfined one (docs/solver.md, Biaxial: measured 36.3 vs 0.3 MN/m, softening to 0.52);
+#     unconfined one (docs/solver.md, Biaxial: measured 36.0 vs 0.8 MN/m, softening to 0.56);
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth.
