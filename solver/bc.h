@@ -16,6 +16,7 @@
 #define CDEM_BC_H
 
 #include "cdem_error.h"
+#include "contact.h"
 #include "model.h"
 #include "params.h"
 #include "snapshot.h"
@@ -48,6 +49,15 @@ typedef struct {
      * init; a stored one that differs fails with CDEM_ERR_CONFLICT) */
     cdem_status (*save)(const void *ctx, cdem_snapshot *snap, cdem_error *err);
     cdem_status (*restore)(void *ctx, const cdem_snapshot *snap, cdem_error *err);
+    /* may be NULL (boundaries still in equilibration): called on every equilibration step
+     * (cdem_bc_apply with k = 0), after the drift, with s->fx/fy of the boundary elements
+     * holding their contact forces of the previous step; du, dt as for apply */
+    cdem_status (*equilibrate)(void *ctx, cdem_state *s, double du, double dt, cdem_error *err);
+    /* may be NULL: adjusts the contact law once after it is built (e.g. smooth platens) */
+    void (*adjust_law)(const void *ctx, cdem_contact_law *law);
+    /* 0 (default): plain viscous damping; 1: the solver damps the free elements' velocities
+     * relative to their homogeneous (affine) strain-rate field (integrate.h affine_damping) */
+    int affine_damping;
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
@@ -66,8 +76,16 @@ const char *cdem_bc_implemented(void);
 /* Finds the mode of p->mode, allocates its context and runs its init on s. */
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          cdem_error *err);
+/* k >= 1: the mode's apply (deformation step k); k <= 0: an equilibration step, the mode's
+ * equilibrate hook (nothing without one). */
 cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
                           cdem_error *err);
+/* 1 when the mode moves boundaries during equilibration (has an equilibrate hook). */
+int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
+/* 1 when the mode asks for affine damping (cdem_bc_ops.affine_damping); 0 without bc. */
+int cdem_bc_affine_damping(const cdem_bc *bc);
+/* Runs the mode's adjust_law hook on law (nothing without one or without bc). */
+void cdem_bc_adjust_law(const cdem_bc *bc, cdem_contact_law *law);
 double cdem_bc_net_displacement(const cdem_bc *bc);
 /* Runs the mode's begin_deformation hook (none: *n_remove = 0, keep untouched). */
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,

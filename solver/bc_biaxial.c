@@ -1,18 +1,18 @@
 /* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (common/model.c).
  * Init: the base row is the bottom platen; a top platen of wall elements (base radius r,
- * spaced r) is added one radius above the highest free element; both platens are extended
- * 25% of the base length beyond each end so the sample keeps touching them as it widens.
- * Both platens are CDEM_FLAG_MOVING. Equilibration: the lateral walls hold the sample while the
- * solver ramps the confining pressure (lateral_pressure hook) from 0 at mid-equilibration to
- * full at its end. Start of deformation: the lateral walls are removed (the sides are free,
- * loaded only by the confining pressure). Deformation: each platen moves toward the other at
- * half the boundary speed, so the closure per step is the boundary increment du and the net
- * displacement is the closure. Measurements at each time-series sample: axial strain =
- * closure / H0 (H0 = platen gap at the end of equilibration, between the platens' inner
- * faces); differential stress = F / L - p x ramp, F = mean |contact force y| of the two
- * platens, L = span of the free elements (left edge to right edge), F and L averaged over the
- * samples of the last 5 increments (v3.1), minus the value at the end of equilibration (v2.6)
- * from then on (during equilibration the uncorrected value is reported). Units: m, N, N/m. */
+ * spaced r) is added one radius above the highest free element; both platens extend 25% of
+ * the base length beyond each end and are CDEM_FLAG_MOVING. Platens are smooth (adjust_law:
+ * wall-class friction, cohesion and breaking strain 0). Equilibration: the lateral walls
+ * hold the sample while the solver ramps the confining pressure p on the free edges from 0 at
+ * mid-equilibration to full at its end; the platens are servo-controlled (equilibrate) to
+ * carry the same ramped pressure, so the sample starts isotropic. Deformation: the lateral
+ * walls are removed; each platen moves inward at half the boundary speed (closure per step =
+ * du = net displacement). Measurements (each time-series sample): axial strain = closure / H0
+ * (H0 = gap between the platens' inner faces at the start of deformation); differential
+ * stress = F / L - p x ramp, F = mean |contact force y| of the two platens, L = span of the
+ * free elements, both averaged over the samples of the last 5 increments (v3.1), minus the
+ * value at the end of equilibration (v2.6). Asks for affine damping (integrate.h: damping
+ * does not resist the imposed strain). Single-threaded; units m, N, N/m. */
 #include "bc.h"
 #include "checkpoint.h"
 
@@ -41,7 +41,15 @@ typedef struct {
     int have_ref;    /* 1 once the end-of-equilibration reference is taken */
     double ref;      /* N/m, differential stress at the end of equilibration */
     double last;     /* N/m, uncorrected differential stress of the last sample */
+    double kn;       /* N/m, contact normal stiffness (servo gain scale), > 0 */
+    long eq_step;    /* equilibration steps done (servo ramp), 0..equil */
+    double servo;    /* N/m, last servo target axial stress p x ramp, >= 0 */
 } biaxial_ctx;
+
+/* Servo gain: fraction of the force error closed per step through the platen contacts. */
+#define BIAXIAL_SERVO_GAIN 0.5
+/* Servo speed limit: platen travel per step at most this many boundary increments du. */
+#define BIAXIAL_SERVO_SPEED 10.0
 
 static int is_platen(uint32_t f) {
     return (f & CDEM_FLAG_WALL) && (f & CDEM_FLAG_MOVING);
@@ -104,6 +112,7 @@ static cdem_status biaxial_init(void *vctx, const cdem_params *p, const cdem_mod
     c->y_mid = 0.5 * (c->y_top + c->y_bottom);
     c->pressure = p->confining_pressure;
     c->equil = m->equil_steps;
+    c->kn = m->kn > 0.0 ? m->kn : 1.0;
     const long interval = p->series_interval > 0 ? p->series_interval : 1;
     const double win = ceil(5.0 * m->display_steps / (double)interval);
     c->window = win >= 1.0 ? (win < 1e6 ? (size_t)win : 1000000) : 1;
@@ -135,10 +144,78 @@ static cdem_status biaxial_apply(void *vctx, cdem_state *s, long k, double du, d
     return CDEM_OK;
 }
 
+/* Servo step of one platen: the contact force error (load - target, N, positive = the
+ * sample pushes harder than the target) moves the platen outward by GAIN x error / (Kn x
+ * platen contacts), at most du per step (never faster than the deformation). */
+static double servo_move(double load, double target, long contacts, double kn, double du) {
+    const double nc = contacts > 0 ? (double)contacts : 1.0;
+    const double d = BIAXIAL_SERVO_GAIN * (load - target) / (kn * nc);
+    const double cap = BIAXIAL_SERVO_SPEED * du;
+    return d > cap ? cap : (d < -cap ? -cap : d);
+}
+
+static cdem_status biaxial_equilibrate(void *vctx, cdem_state *s, double du, double dt,
+                                       cdem_error *err) {
+    biaxial_ctx *c = vctx;
+    if (!(dt > 0.0) || !(du > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "biaxial: equilibration step with dt = %g s, du = %g m: both must be > 0",
+                         dt, du);
+    c->eq_step++;
+    double ft = 0.0, fb = 0.0, lo = INFINITY, hi = -INFINITY;
+    long nt = 0, nb = 0;
+    for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible */
+        const uint32_t f = s->flags[i];
+        if (is_platen(f)) {
+            if (s->y[i] > c->y_mid) {
+                ft += s->fy[i];
+                nt += s->fy[i] != 0.0;
+            } else {
+                fb += s->fy[i];
+                nb += s->fy[i] != 0.0;
+            }
+        } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
+            lo = fmin(lo, s->x[i] - s->radius[i]);
+            hi = fmax(hi, s->x[i] + s->radius[i]);
+        }
+    }
+    const double width = hi > lo ? hi - lo : 0.0;
+    c->servo = c->pressure * cdem_bc_confining_ramp(c->eq_step, c->equil);
+    const double target = c->servo * width;
+    /* top platen: pushed up (+y) by the sample; bottom: pushed down */
+    const double dtop = servo_move(ft, target, nt, c->kn, du);
+    const double dbot = servo_move(-fb, target, nb, c->kn, du);
+    for (size_t i = 0; i < s->n; i++) {
+        if (!is_platen(s->flags[i]))
+            continue;
+        const double d = s->y[i] > c->y_mid ? dtop : -dbot;
+        s->y[i] += d;
+        s->vx[i] = 0.0;
+        s->vy[i] = d / dt;
+    }
+    c->y_top += dtop;
+    c->y_bottom -= dbot;
+    c->y_mid = 0.5 * (c->y_top + c->y_bottom);
+    return CDEM_OK;
+}
+
+/* Smooth platens: element-wall contacts (the platens; the lateral walls until they are
+ * removed) carry no friction, no cohesion and no bond. */
+static void biaxial_law(const void *vctx, cdem_contact_law *law) {
+    (void)vctx;
+    law->friction[CDEM_CLASS_WALL] = 0.0;
+    law->cohesion[CDEM_CLASS_WALL] = 0.0;
+    law->breaking_strain[CDEM_CLASS_WALL] = 0.0;
+}
+
 static cdem_status biaxial_begin(void *vctx, const cdem_state *s, unsigned char *keep,
                                  size_t *n_remove, cdem_error *err) {
-    (void)vctx;
-    (void)err;
+    biaxial_ctx *c = vctx;
+    c->h0 = (c->y_top - c->r_top) - (c->y_bottom + c->r_bottom);
+    if (!(c->h0 > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "biaxial: platen gap at the start of deformation = %g m: must be > 0",
+                         c->h0);
     size_t n = 0;
     for (size_t i = 0; i < s->n; i++)
         if ((s->flags[i] & CDEM_FLAG_WALL) && !(s->flags[i] & CDEM_FLAG_MOVING)) {
@@ -203,11 +280,15 @@ static void biaxial_view(const void *vctx, FILE *out) {
     fprintf(out,
             "Boundary mode: biaxial test, confining pressure %.6g N/m on the free edges (ramped "
             "from 0 at mid-equilibration to full at its end); top platen of %ld elements added "
-            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); both platens "
-            "move toward each other at half the boundary speed; the %ld lateral wall elements "
-            "are removed at the start of deformation; initial sample height %.6g m; axial "
-            "strain = closure / height; differential stress averaged over %zu samples (5 "
-            "increments) and corrected to 0 at the end of equilibration.\n",
+            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); smooth "
+            "platens (no friction, cohesion or bond with the sample; material.wall_* not used); "
+            "in equilibration the platens are servo-controlled to carry the same ramped "
+            "pressure (isotropic start), then move toward each other at half the boundary "
+            "speed each; damping acts on the velocity relative to the sample's homogeneous "
+            "strain-rate field; the %ld lateral wall elements are removed at the start of "
+            "deformation; initial sample height %.6g m (re-measured at the start of "
+            "deformation); axial strain = closure / height; differential stress averaged over "
+            "%zu samples (5 increments) and corrected to 0 at the end of equilibration.\n",
             c->pressure, c->n_top, c->y_top, c->n_extend, c->n_walls, c->h0, c->window);
 }
 
@@ -225,6 +306,8 @@ static cdem_status biaxial_save(const void *vctx, cdem_snapshot *snap, cdem_erro
     const biaxial_ctx *c = vctx;
     const char *P = "bc";
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "h0", c->h0, err));
+    CDEM_TRY(cdem_ckpt_put_i64(snap, P, "eq_step", (int64_t)c->eq_step, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "servo", c->servo, err));
     CDEM_TRY(cdem_ckpt_put_i64(snap, P, "window", (int64_t)c->window, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "y_bottom", c->y_bottom, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "y_top", c->y_top, err));
@@ -241,7 +324,12 @@ static cdem_status biaxial_save(const void *vctx, cdem_snapshot *snap, cdem_erro
 static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_error *err) {
     biaxial_ctx *c = vctx;
     const char *P = "bc";
-    CDEM_TRY(cdem_ckpt_check_f64(snap, P, "h0", c->h0, err));
+    /* h0 is re-measured at the start of deformation (servo platens move before it) */
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "h0", &c->h0, err));
+    int64_t eq_step = 0;
+    CDEM_TRY(cdem_ckpt_get_range(snap, P, "eq_step", 0, (int64_t)c->equil, &eq_step, err));
+    c->eq_step = (long)eq_step;
+    CDEM_TRY(cdem_ckpt_get_f64(snap, P, "servo", &c->servo, err));
     int64_t window = 0, n_ring = 0, head = 0, have_ref = 0;
     CDEM_TRY(cdem_ckpt_get_i64(snap, P, "window", &window, err));
     if (window != (int64_t)c->window)
@@ -281,6 +369,9 @@ static const cdem_bc_ops biaxial_ops = {
     .measure = biaxial_measure,           /* axial strain, differential stress */
     .save = biaxial_save,                 /* checkpoint: platens, window, reference */
     .restore = biaxial_restore,           /* resume */
+    .equilibrate = biaxial_equilibrate,   /* servo platens: isotropic start */
+    .adjust_law = biaxial_law,            /* smooth platens */
+    .affine_damping = 1,                  /* damping does not resist the imposed strain */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

@@ -2,12 +2,13 @@
  *
  * detachment_walls = right: the right lateral wall moves left (-x) by the step's boundary
  * increment du; = both: the left wall moves right and the right wall moves left, each by
- * du (each at the boundary speed). The base (lowest row of wall elements) never moves; its
- * contacts with elements are wall-class contacts (material.wall_*), like every wall
- * contact. The moving walls slide over the base (boundary-boundary pairs never interact).
- * Net displacement (docs/solver.md): the total shortening of the model, i.e. the right
- * wall's displacement for "right" and the sum of both walls' displacements (2 k du) for
- * "both", as in version 2.6 of the original program. */
+ * du / 2 (half the boundary speed), so the model shortens by du per step in both cases.
+ * The base (lowest row of wall elements) never moves; its contacts with elements are
+ * wall-class contacts (material.wall_*), like every wall contact. The moving walls slide
+ * over the base (boundary-boundary pairs never interact). Net displacement
+ * (docs/solver.md): the total shortening of the model (k du after k steps) for both
+ * choices, as version 2.6 of the original program reports it, so increments come every
+ * display interval of total shortening as in every other mode. Units: m, s. */
 #include "bc.h"
 #include "checkpoint.h"
 
@@ -59,7 +60,9 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
     detach_ctx *c = vctx;
     if (!(dt > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "detachment: dt = %g s: must be > 0", dt);
-    const double xm = c->x_mid, v = du / dt;
+    /* both walls: each at half the boundary speed, the model shortens by du per step */
+    const double step_u = c->walls == CDEM_WALLS_BOTH ? 0.5 * du : du;
+    const double xm = c->x_mid, v = step_u / dt;
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
@@ -68,12 +71,12 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
         if (fl[i] & CDEM_FLAG_MOVING) {
             /* the right wall moves left, the left wall right: both inward */
             const double sgn = x[i] > xm ? -1.0 : 1.0;
-            x[i] += sgn * du;
+            x[i] += sgn * step_u;
             vxa[i] = sgn * v;
             vya[i] = 0.0;
         }
     }
-    c->net += (c->walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * du;
+    c->net += du; /* total shortening: both walls' displacements together */
     return CDEM_OK;
 }
 
@@ -86,8 +89,9 @@ static void detach_view(const void *vctx, FILE *out) {
     if (c->walls == CDEM_WALLS_BOTH)
         fprintf(out,
                 "Boundary mode: detachment, both lateral walls move inward over the fixed base "
-                "at the boundary speed each (%ld left + %ld right wall elements); net "
-                "displacement = total shortening (sum of both walls).\n",
+                "at half the boundary speed each (%ld left + %ld right wall elements); net "
+                "displacement = total shortening (sum of both walls), one display interval "
+                "of it between increments.\n",
                 c->n_left, c->n_right);
     else
         fprintf(out,

@@ -7,17 +7,22 @@
  * polyline. Fault elements (CDEM_FLAG_FAULT | MOVING, radius of the base elements, spaced by
  * one radius) lie on the curve, extended below the base along the basal segment for the whole
  * displacement plus 4 radii and vertically above its top to the top of the walls plus the
- * whole displacement. Free elements left of the curve, or closer to it than their radius
- * plus the fault radius, and the left wall become fixed display-only footwall elements
- * (CDEM_FLAG_FOOTWALL; they never interact). The whole base moves with the hanging wall (the
- * part left of x0 stays left of the moving fault, so it never touches the hanging wall).
+ * whole displacement. Free elements cut by the fault (closer to the curve than their radius
+ * plus the fault radius, on either side) are removed; those left of it (entirely on the
+ * footwall side of the fault elements) and the left wall become display-only footwall
+ * elements (CDEM_FLAG_FOOTWALL; they never interact). The whole base moves with the hanging
+ * wall, except its part left of x0 (below).
+ * The base left of x0 is the footwall's base: it stays a wall (it bounds the escape test) but
+ * moves with the footwall, not with the hanging wall (manual v4.1).
  * CH kinematics (Verrall 1981): relative to the footwall the hanging wall moves by the heave
  * du cos(db) horizontally and the throw du sin(db) vertically, db = dip of the basal segment,
  * and collapses by vertical shear onto the fault. In the model frame (hanging-wall base fixed
  * in x) the fault elements move horizontally by the heave AWAY from the hanging wall (-x for
  * normal, +x for reverse) and the hanging-wall base (the base, the right wall) vertically by
  * the throw (down for normal), so the base-fault junction stays at x = x0 and slides down
- * the basal segment by du per step. Inversion as in bc_planar_fault.c.
+ * the basal segment by du per step; the footwall display elements move with the fault (the
+ * footwall is rigid), so the fault is never drawn over them. Inversion as in
+ * bc_planar_fault.c.
  * CD kinematics ("mylar sheet", kinematics = cd): the path stays fixed and the fault elements
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
  * right wall move du along the basal segment. */
@@ -42,7 +47,9 @@ typedef struct {
     cdem_fault_polyline line; /* the fault curve from (x0, 0) up-dip (owned) */
     long n_fault;             /* fault elements added */
     long n_footwall;          /* elements flagged CDEM_FLAG_FOOTWALL */
+    long n_cut;               /* free elements removed at init: cut by the fault elements */
     long n_base_moving;       /* wall elements of the moving hanging-wall base/right wall */
+    long n_base_footwall;     /* base elements left of x0: the footwall's base (not MOVING) */
     double net;               /* m, net displacement along the basal segment (initial sense +) */
     int cd;                   /* 1: constant displacement (mylar sheet), 0: constant heave */
     size_t path_n;            /* vertices of the fault-element path (ramp, curve, top) */
@@ -181,7 +188,11 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
     c->heave = cos(db);
     c->throw_ = sin(db);
     const double rf = w.r_base;
-    /* footwall, hanging-wall base and right wall */
+    /* footwall, hanging-wall base and right wall; elements cut by the fault are removed */
+    unsigned char *keep = malloc(s->n ? s->n : 1);
+    if (!keep)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu keep flags", name, s->n);
+    memset(keep, 1, s->n);
     for (size_t i = 0; i < s->n; i++) {
         uint32_t f = s->flags[i] & ~(uint32_t)CDEM_FLAG_MOVING;
         if (f & CDEM_FLAG_WALL) {
@@ -189,14 +200,18 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
             if (!is_base && s->x[i] < w.x_mid) {
                 f = (f & ~(uint32_t)CDEM_FLAG_WALL) | CDEM_FLAG_FOOTWALL; /* left wall */
                 c->n_footwall++;
+            } else if (is_base && s->x[i] < c->x_fault) {
+                c->n_base_footwall++; /* the footwall's base: a wall, moves with the footwall */
             } else {
                 f |= CDEM_FLAG_MOVING;
                 c->n_base_moving++;
             }
         } else if (!(f & CDEM_FLAGS_BOUNDARY)) {
             const double xi = s->x[i], yi = s->y[i];
-            if (xi < cdem_fault_file_x_at(pl, yi) ||
-                cdem_fault_file_distance(pl, xi, yi) < s->radius[i] + rf) {
+            if (cdem_fault_file_distance(pl, xi, yi) < s->radius[i] + rf) {
+                keep[i] = 0; /* overlaps the fault elements: neither wall keeps it */
+                c->n_cut++;
+            } else if (xi < cdem_fault_file_x_at(pl, yi)) {
                 f |= CDEM_FLAG_FOOTWALL;
                 s->vx[i] = s->vy[i] = 0.0;
                 c->n_footwall++;
@@ -204,6 +219,9 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
         }
         s->flags[i] = f;
     }
+    if (c->n_cut > 0)
+        cdem_state_compact(s, keep, NULL);
+    free(keep);
     const double ramp = m->total_displacement + 4.0 * rf;
     return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height) + m->total_displacement, err);
 }
@@ -269,6 +287,11 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
     const uint32_t *restrict fl = s->flags;
 #pragma omp parallel for schedule(static) if (n > 20000)
     for (long i = 0; i < n; i++) {
+        if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
+            (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {
+            x[i] += ux; /* footwall display and footwall base: ride with the fault */
+            continue;
+        }
         if (!(fl[i] & CDEM_FLAG_MOVING))
             continue;
         if (fl[i] & CDEM_FLAG_FAULT) {
@@ -310,9 +333,10 @@ static void listric_view(const void *vctx, FILE *out) {
                 "from the hanging wall and the hanging-wall base %.4f m vertically; ",
                 c->heave, c->throw_);
     fprintf(out,
-            "%ld fault elements, %ld footwall display elements, %ld moving base/right-wall "
-            "elements.",
-            c->n_fault, c->n_footwall, c->n_base_moving);
+            "%ld fault elements, %ld footwall display elements and %ld footwall base elements%s, "
+            "%ld free elements cut by the fault removed, %ld moving base/right-wall elements.",
+            c->n_fault, c->n_footwall, c->n_base_footwall,
+            c->cd ? " (fixed)" : " (moving with the fault)", c->n_cut, c->n_base_moving);
     if (c->inversion)
         fprintf(out, " Inversion after deformation step %ld.", c->k_inversion);
     fprintf(out, "\n");

@@ -66,7 +66,22 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
                           cdem_error *err) {
     if (!bc->ops)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_apply: boundary mode not initialised");
+    if (k <= 0)
+        return bc->ops->equilibrate ? bc->ops->equilibrate(bc->ctx, s, du, dt, err) : CDEM_OK;
     return bc->ops->apply(bc->ctx, s, k, du, dt, err);
+}
+
+int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
+    return bc && bc->ops && bc->ops->equilibrate;
+}
+
+int cdem_bc_affine_damping(const cdem_bc *bc) {
+    return bc && bc->ops && bc->ops->affine_damping;
+}
+
+void cdem_bc_adjust_law(const cdem_bc *bc, cdem_contact_law *law) {
+    if (bc && bc->ops && bc->ops->adjust_law)
+        bc->ops->adjust_law(bc->ctx, law);
 }
 
 double cdem_bc_net_displacement(const cdem_bc *bc) {

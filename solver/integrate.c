@@ -412,7 +412,8 @@ static inline void finish_element(long i, double sx, double sy, const double *re
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
                                   double hdt, double c, double g, double ob, int kick,
-                                  const double *restrict x, double ef, double exmid) {
+                                  const double *restrict x, double ef, double exmid,
+                                  const double *restrict y, const double *restrict aff) {
     const uint32_t fl = flags[i];
     if (fl & CDEM_FLAGS_BOUNDARY) {
         fx[i] = sx;
@@ -423,14 +424,46 @@ static inline void finish_element(long i, double sx, double sy, const double *re
     sy -= m * g + ((fl & CDEM_FLAG_SURFACE) ? ob : 0.0);
     if (fl & CDEM_FLAG_BIAXIAL_EDGE)
         sx += x[i] < exmid ? ef : -ef;
+    /* damping acts on v - v_aff (v_aff = 0 exactly unless affine damping is on) */
+    const double rx = aff[0] * (x[i] - aff[2]), ry = aff[1] * (y[i] - aff[3]);
     if (kick) {
-        /* v = (v_half + hdt/m F) / (1 + c hdt/m) with a single division */
+        /* v = (v_half + hdt/m (F + c v_aff)) / (1 + c hdt/m) with a single division */
         const double inv = 1.0 / (m + c * hdt);
-        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
-        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
+        vxw[i] = (m * vxw[i] + hdt * (sx + c * rx)) * inv;
+        vyw[i] = (m * vyw[i] + hdt * (sy + c * ry)) * inv;
     }
-    fx[i] = sx - c * vxw[i];
-    fy[i] = sy - c * vyw[i];
+    fx[i] = sx - c * (vxw[i] - rx);
+    fy[i] = sy - c * (vyw[i] - ry);
+}
+
+/* Affine damping: the least-squares homogeneous strain-rate field of the free elements'
+ * current (mid-step) velocities, v_aff = (ax (x - xc), ay (y - yc)), xc, yc their mean
+ * position. Serial sums in element order: reproducible for any thread count. */
+static void fit_affine(cdem_integrator *it, const cdem_state *s) {
+    double n = 0.0, sx = 0.0, sy = 0.0;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            n += 1.0;
+            sx += s->x[i];
+            sy += s->y[i];
+        }
+    it->aff[0] = it->aff[1] = it->aff[2] = it->aff[3] = 0.0;
+    if (n < 2.0)
+        return;
+    const double xc = sx / n, yc = sy / n;
+    double sxx = 0.0, syy = 0.0, svx = 0.0, svy = 0.0;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            const double dx = s->x[i] - xc, dy = s->y[i] - yc;
+            sxx += dx * dx;
+            syy += dy * dy;
+            svx += s->vx[i] * dx;
+            svy += s->vy[i] * dy;
+        }
+    it->aff[0] = sxx > 0.0 ? svx / sxx : 0.0;
+    it->aff[1] = syy > 0.0 ? svy / syy : 0.0;
+    it->aff[2] = xc;
+    it->aff[3] = yc;
 }
 
 /* Everything the force pass reads or writes, gathered once per step. */
@@ -438,6 +471,7 @@ typedef struct {
     const cdem_contact_law *law;
     int kick;
     double dt, hdt, c, g, ob, ef, exmid;
+    double aff[4]; /* affine damping field (integrate.h), zeros when off */
     const double *x, *y, *mass, *Rp;
     const int32_t *pi, *pj, *istart;
     const uint8_t *cls;
@@ -529,7 +563,7 @@ static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
         wait_cross(fp, chunk); /* the cross pairs read these velocities: kick after them */
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->flags, vx, vy, fx, fy, fp->hdt, fp->c, fp->g,
-                       fp->ob, fp->kick, x, fp->ef, fp->exmid);
+                       fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y, fp->aff);
 }
 
 /* Splits the elements into nchunk ranges of about equal pair counts and lists the cross
@@ -608,6 +642,7 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         .ob = it->overburden_force,
         .ef = it->confining_pressure * it->column_width * it->confining_factor,
         .exmid = it->edge_x_mid,
+        .aff = {it->aff[0], it->aff[1], it->aff[2], it->aff[3]},
         .x = s->x,
         .y = s->y,
         .mass = s->mass,
@@ -666,6 +701,10 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
                              (int)s->id[i], s->mass[i]);
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
+    if (it->affine_damping)
+        fit_affine(it, s);
+    else
+        it->aff[0] = it->aff[1] = 0.0;
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
@@ -706,6 +745,10 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(check_finite(it, s, err));
         CDEM_TRY(rebuild(it, s, err));
     }
+    if (it->affine_damping)
+        fit_affine(it, s);
+    else
+        it->aff[0] = it->aff[1] = 0.0; /* plain damping (also after switching it off) */
     forces_and_kick(it, s, 1);
     return CDEM_OK;
 }

@@ -324,6 +324,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     if (opt->par_min > 0)
         r->it.par_min = opt->par_min;
+    cdem_bc_adjust_law(&r->bc, &r->it.law); /* e.g. the biaxial test's smooth platens */
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
@@ -504,10 +505,16 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
                         nrem, r->bc.ops->name, r->s.n);
             }
         }
-        /* wall forces are summed only on the steps whose sample reports them */
-        r->it.boundary_forces = (step % interval == 0);
-        cdem_status st = cdem_integrator_step(&r->it, &r->s, deforming ? &r->bc : NULL, r->k_def,
-                                              r->m.displacement_per_step, err);
+        /* wall forces are summed only on the steps whose sample reports them, and on every
+         * equilibration step of a mode that moves boundaries then (biaxial servo platens) */
+        const int eq_moves = step <= equil && cdem_bc_moves_in_equilibration(&r->bc);
+        /* affine damping (biaxial) only while the boundaries impose a strain: equilibration
+         * (and settling) keep plain damping, so the assembly settles */
+        r->it.affine_damping = deforming && cdem_bc_affine_damping(&r->bc);
+        r->it.boundary_forces = (step % interval == 0) || eq_moves;
+        cdem_status st =
+            cdem_integrator_step(&r->it, &r->s, (deforming || eq_moves) ? &r->bc : NULL,
+                                 deforming ? r->k_def : 0, r->m.displacement_per_step, err);
         if (st != CDEM_OK)
             return st;
         r->step = step;

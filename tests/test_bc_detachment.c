@@ -1,7 +1,8 @@
-/* Tests of solver/bc_detachment: the right wall (or both lateral walls) moves inward by
- * exactly k x displacement_per_step, the base never moves, the net displacement is the
- * right wall's displacement ("right") or the total shortening ("both"), base contacts are
- * wall-class contacts, and the errors/view. */
+/* Tests of solver/bc_detachment: the right wall moves inward by exactly k x
+ * displacement_per_step ("right"), or both lateral walls by half of it each ("both"); the
+ * base never moves; the net displacement is the total shortening k x displacement_per_step
+ * in both cases, so increments come every display interval of it; base contacts are
+ * wall-class contacts; errors/view. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -21,7 +22,8 @@ static void check_kinematics(cdem_walls_choice walls) {
     p.detachment_walls = walls;
     fx_result r;
     fx_run(p, K, &r);
-    const double u = (double)K * DPS;
+    const double u = (double)K * DPS;                        /* total shortening */
+    const double w = walls == CDEM_WALLS_BOTH ? 0.5 * u : u; /* each moving wall */
     long n_left = 0, n_right = 0, n_base = 0;
     for (size_t i = 0; i < r.s0.n; i++) {
         const uint32_t f = r.s0.flags[i];
@@ -36,10 +38,10 @@ static void check_kinematics(cdem_walls_choice walls) {
             assert_true(!(f & CDEM_FLAG_MOVING));
             n_base++;
         } else if (r.s0.x[i] == WIDTH) { /* right wall: left by u */
-            assert_float_equal(dx, -u, 1e-9 * u);
+            assert_float_equal(dx, -w, 1e-9 * u);
             n_right++;
         } else { /* left wall: right by u with "both", else still */
-            assert_float_equal(dx, walls == CDEM_WALLS_BOTH ? u : 0.0, 1e-9 * u);
+            assert_float_equal(dx, walls == CDEM_WALLS_BOTH ? w : 0.0, 1e-9 * u);
             assert_int_equal((f & CDEM_FLAG_MOVING) != 0, walls == CDEM_WALLS_BOTH);
             n_left++;
         }
@@ -47,9 +49,10 @@ static void check_kinematics(cdem_walls_choice walls) {
     assert_int_equal(n_base, 41);
     assert_int_equal(n_right, 15);
     assert_int_equal(n_left, 15);
-    const double per = walls == CDEM_WALLS_BOTH ? 2.0 : 1.0; /* total shortening */
-    assert_float_equal(r.net_mid, per * (double)(K / 2) * DPS, 1e-9);
-    assert_float_equal(r.net_end, per * u, 1e-9);
+    /* net = total shortening = the sum of the walls' inward displacements */
+    assert_float_equal(r.net_mid, (double)(K / 2) * DPS, 1e-9);
+    assert_float_equal(r.net_end, u, 1e-9);
+    assert_float_equal(r.net_end, (walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * w, 1e-9);
     assert_int_equal(r.removed, 0);
     assert_int_equal(r.s.n, r.s0.n);
     fx_result_free(&r);
@@ -106,19 +109,49 @@ static void test_bc_detachment_errors_and_view(void **st) {
 }
 
 /* Both wall choices run through cdem_run on a small default model; the file reports the
- * total shortening (twice the wall displacement for "both"). */
+ * total shortening (the sum of both walls' displacements for "both"), and the deformation
+ * increments are one display interval of it apart for both choices (manual v2.6; before,
+ * "both" wrote one every 2 x display interval). */
 static void test_bc_detachment_cdem_run(void **st) {
     (void)st;
     cdem_params p;
     cdem_params_defaults(&p);
     p.mode = CDEM_MODE_DETACHMENT;
+    p.display_interval = 1.0; /* m: about 50 steps, so 300 steps write 6 increments */
     for (int k = 0; k < 2; k++) {
         p.detachment_walls = k == 0 ? CDEM_WALLS_RIGHT : CDEM_WALLS_BOTH;
         cdem_increment_info last;
         cdem_model m;
-        fx_cdem_run(p, "test_bc_detachment_run", 300, &last, &m);
+        const char *name = k == 0 ? "test_bc_detachment_run_right" : "test_bc_detachment_run_both";
+        fx_cdem_run(p, name, 300, &last, &m);
         assert_int_equal(last.step, m.equil_steps + 300);
-        assert_float_equal(last.net_displacement, (k + 1) * 300.0 * m.displacement_per_step, 1e-9);
+        assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
+        char path[1024];
+        const char *dir = getenv("CDEM_TEST_TMP");
+        snprintf(path, sizeof path, "%s/%s.h5", dir && *dir ? dir : "/tmp", name);
+        cdem_error err;
+        cdem_h5_reader *r = NULL;
+        assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+        const size_t n = cdem_h5_reader_increment_count(r);
+        int deform = 0;
+        double prev = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            cdem_increment_info inf;
+            assert_int_equal(cdem_h5_reader_increment_info(r, i, &inf, &err), CDEM_OK);
+            if (inf.step <= m.equil_steps)
+                continue;
+            /* every full deformation increment adds one display interval of net
+             * displacement (to within one step's rounding); the last may be shorter */
+            if (inf.step < last.step)
+                assert_float_equal(inf.net_displacement - prev, p.display_interval,
+                                   m.displacement_per_step);
+            assert_float_equal(inf.net_displacement,
+                               (double)(inf.step - m.equil_steps) * m.displacement_per_step, 1e-9);
+            prev = inf.net_displacement;
+            deform++;
+        }
+        assert_int_equal(deform, 6); /* 300 steps / ~50.3 steps per increment, + the last */
+        cdem_h5_reader_close(r);
     }
 }
 

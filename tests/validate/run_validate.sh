@@ -9,7 +9,8 @@
 #  4. repose-collapse of the default material (right wall removed): the slope angle of the
 #     final surface is between 20 and 45 degrees;
 #  5. biaxial tests at 0 and 10 MPa (1e7 N/m): the differential stress rises, peaks and
-#     softens, and the confined peak is above the unconfined one;
+#     softens (the 10 MPa run to <= 0.95 of its peak), and the confined peak is above the
+#     unconfined one (docs/solver.md, Biaxial: measured 36.0 vs 0.8 MN/m, softening to 0.56);
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
@@ -68,9 +69,13 @@ for path in sys.argv[1:]:
     q, e = q[e > 0], e[e > 0]
     k = int(np.argmax(q))
     peak, end = q[k], q[-1]
-    print(f"{path}: peak {peak / 1e6:.1f} MN/m at axial strain {e[k]:.3f}, final {end / 1e6:.1f} MN/m")
+    low = q[k:].min()  # softening: the lowest value after the peak
+    print(f"{path}: peak {peak / 1e6:.1f} MN/m at axial strain {e[k]:.3f}, lowest after it "
+          f"{low / 1e6:.1f}, final {end / 1e6:.1f} MN/m")
     if not (peak > 0 and 0 < k < len(q) - 1 and end < peak):
         problems.append(f"{path}: no peak followed by softening within axial strain {e[-1]:.3f}")
+    if len(peaks) == 1 and not low <= 0.95 * peak:  # the confined run softens by >= 5 %
+        problems.append(f"{path}: softens only to {low / peak:.3f} of its peak (needs <= 0.95)")
     peaks.append(peak)
 if peaks[1] <= peaks[0]:
     problems.append("confined peak not above the unconfined one")
