@@ -74,30 +74,37 @@ cdem_status cdem_sspx_export(cdem_analysis *a, size_t first, size_t last, const 
     int dirlen = (int)strlen(dir); /* "out/" and "out" name the same directory */
     while (dirlen > 1 && dir[dirlen - 1] == '/')
         dirlen--;
-    for (size_t k = first; k <= last; k++) {
+    cdem_status st = CDEM_OK;
+    size_t k = first;
+    char path[CDEM_PATH_MAX + 128];
+    for (; k <= last; k++) { /* on failure k is the increment that failed */
         const cdem_state *s;
-        CDEM_TRY(cdem_analysis_state(a, k, &s, err));
-        char path[CDEM_PATH_MAX + 128];
+        st = cdem_analysis_state(a, k, &s, err);
+        if (st != CDEM_OK)
+            break;
         int n = snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
                          (int)cdem_analysis_info(a, k)->number);
-        if (n < 0 || (size_t)n >= sizeof path)
-            return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: output path in '%s' is too long", dir);
-        cdem_status st = cdem_sspx_write(path, s, err);
-        if (st != CDEM_OK) {
-            /* no partial set that looks like a complete one: remove this call's files */
-            for (size_t j = first; j < k; j++) {
-                snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
-                         (int)cdem_analysis_info(a, j)->number);
-                remove(path);
-            }
-            if (written)
-                *written = 0;
-            return st;
+        if (n < 0 || (size_t)n >= sizeof path) {
+            st = CDEM_FAIL(err, CDEM_ERR_INVALID, "export: output path in '%s' is too long", dir);
+            break;
         }
+        st = cdem_sspx_write(path, s, err);
+        if (st != CDEM_OK)
+            break;
         if (written)
             (*written)++;
     }
-    return CDEM_OK;
+    if (st != CDEM_OK) {
+        /* no partial set that looks like a complete one: remove this call's files */
+        for (size_t j = first; j < k; j++) {
+            snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
+                     (int)cdem_analysis_info(a, j)->number);
+            remove(path);
+        }
+        if (written)
+            *written = 0;
+    }
+    return st;
 }
 
 cdem_status cdem_sspx_parse_range(const cdem_analysis *a, const char *spec, size_t *first,
