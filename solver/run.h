@@ -21,6 +21,8 @@ typedef struct {
     FILE *log;                       /* where progress goes (stderr) */
     volatile sig_atomic_t *stop_requested; /* set to 1 by the signal handler; may be NULL */
     long max_steps;                  /* > 0: stop after this many steps (tests, benchmarks) */
+    double dt_factor; /* tests only (fault injection): > 0 multiplies the derived time step,
+                         e.g. 10 to make a run blow up; 0 = the time step of the model */
 } cdem_run_options;
 
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was
