@@ -24,7 +24,7 @@ cdem_status cdem_outfile_begin(cdem_outfile *o, const char *path, cdem_error *er
     snprintf(o->tmp, sizeof o->tmp, "%s.tmp", path);
     struct stat sb;
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: it is a folder", path);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: it is a folder", path);
     /* the folder of path: everything before the last '/' ("." when none) */
     char dir[CDEM_OUTFILE_PATH_MAX];
     const char *slash = strrchr(path, '/');
@@ -35,15 +35,15 @@ cdem_status cdem_outfile_begin(cdem_outfile *o, const char *path, cdem_error *er
     else
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     if (stat(dir, &sb) != 0)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: folder %s: %s", path, dir,
+        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: folder %s: %s", path, dir,
                          strerror(errno));
     if (!S_ISDIR(sb.st_mode))
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: %s is not a folder", path, dir);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s is not a folder", path, dir);
     if (access(dir, W_OK | X_OK) != 0)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: folder %s is not writable: %s", path,
+        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: folder %s is not writable: %s", path,
                          dir, strerror(errno));
     if (unlink(o->tmp) != 0 && errno != ENOENT)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: cannot remove the stale %s: %s", path,
+        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: cannot remove the stale %s: %s", path,
                          o->tmp, strerror(errno));
     o->active = 1;
     return CDEM_OK;
