@@ -6,7 +6,12 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include "cdem2d.h"
+#include "fault_file.h"
 #include "params.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,9 +59,103 @@ static void test_bad_input_params_quote_inside_string_value(void **state) {
     free(buf);
 }
 
+static void tmp_dir(char *buf, size_t n, const char *name) {
+    const char *t = getenv("CDEM_TEST_TMP");
+    snprintf(buf, n, "%s/bad_input_%d_%s", t && *t ? t : "/tmp", (int)getpid(), name);
+    mkdir(buf, 0777);
+}
+
+static void write_bytes(const char *path, const char *data, size_t n) {
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, n, f), n);
+    fclose(f);
+}
+
+/* Review of the fuzzed readers: a NUL byte ended a fault-file line early without notice
+ * (fgets + strlen), so "1400 0<NUL>junk" read as "1400 0". Now refused with its offset. */
+static void test_bad_input_fault_file_nul_byte(void **state) {
+    (void)state;
+    char dir[1024], path[1100];
+    tmp_dir(dir, sizeof dir, "fault");
+    snprintf(path, sizeof path, "%s/fault.txt", dir);
+    static const char data[] = "1400 0\n1300 500\0 junk\n1200 900\n";
+    write_bytes(path, data, sizeof data - 1);
+    cdem_fault_polyline pl;
+    cdem_error err;
+    cdem_error_clear(&err);
+    assert_int_equal(cdem_fault_file_read(path, 1400.0, 25.0, &pl, &err), CDEM_ERR_PARSE);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, "byte 16 is a NUL byte"));
+    assert_int_equal(pl.n, 0);
+    remove(path);
+    rmdir(dir);
+}
+
+static cdem_status count_sink(void *user, const cdem_increment_info *info, const cdem_state *s,
+                              cdem_error *err) {
+    (void)info;
+    (void)s;
+    (void)err;
+    (*(int *)user)++;
+    return CDEM_OK;
+}
+
+/* Review of the fuzzed readers: the cdem2D reader reads a whole file as one C string, so a
+ * NUL byte silently dropped every row after it. Now refused, naming the file and offset. */
+static void test_bad_input_cdem2d_nul_byte(void **state) {
+    (void)state;
+    char dir[1024], path[1100];
+    tmp_dir(dir, sizeof dir, "cdem2d");
+    snprintf(path, sizeof path, "%s/modelresults_0.txt", dir);
+    static const char data[] = "100 100 50 1\n200 100 50 1\n\0"
+                               "300 100 50 1\n";
+    write_bytes(path, data, sizeof data - 1);
+    int calls = 0;
+    cdem_cdem2d_meta meta;
+    cdem_error err;
+    cdem_error_clear(&err);
+    assert_int_equal(cdem_cdem2d_import(dir, count_sink, &calls, &meta, &err), CDEM_ERR_PARSE);
+    cdem_cdem2d_meta_free(&meta);
+    assert_int_equal(calls, 0);
+    assert_non_null(strstr(err.msg, path));
+    if (!strstr(err.msg, "byte 27 is a NUL byte"))
+        fail_msg("%s", err.msg);
+    remove(path);
+    rmdir(dir);
+}
+
+/* Review of the fuzzed readers: radii so large that the id-matching grid cannot be built
+ * failed with a message that named no file. Now it names the results file. */
+static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
+    (void)state;
+    char dir[1024], p0[1100], p1[1100];
+    tmp_dir(dir, sizeof dir, "cdem2d_huge");
+    snprintf(p0, sizeof p0, "%s/modelresults_0.txt", dir);
+    snprintf(p1, sizeof p1, "%s/modelresults_1.txt", dir);
+    static const char data[] = "0 0 1e308 1\n1 1 1 1\n";
+    write_bytes(p0, data, sizeof data - 1);
+    write_bytes(p1, data, sizeof data - 1);
+    int calls = 0;
+    cdem_cdem2d_meta meta;
+    cdem_error err;
+    cdem_error_clear(&err);
+    cdem_status st = cdem_cdem2d_import(dir, count_sink, &calls, &meta, &err);
+    cdem_cdem2d_meta_free(&meta);
+    assert_int_not_equal(st, CDEM_OK);
+    assert_int_equal(calls, 1); /* the first increment needs no matching */
+    assert_non_null(strstr(err.msg, p1));
+    remove(p0);
+    remove(p1);
+    rmdir(dir);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_input_params_quote_inside_string_value),
+        cmocka_unit_test(test_bad_input_fault_file_nul_byte),
+        cmocka_unit_test(test_bad_input_cdem2d_nul_byte),
+        cmocka_unit_test(test_bad_input_cdem2d_huge_radius_names_file),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
