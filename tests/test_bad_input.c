@@ -8,6 +8,7 @@
 
 #include "cdem2d.h"
 #include "fault_file.h"
+#include "h5format.h"
 #include "params.h"
 
 #include <sys/stat.h>
@@ -150,12 +151,48 @@ static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
     rmdir(dir);
 }
 
+/* Loads increment 0 of the regression-corpus file `name` and expects a format error whose
+ * message contains needle. */
+static void expect_h5_load_error(const char *name, const char *needle) {
+    const char *c = getenv("CDEM_FUZZ_CORPUS");
+    const char *d = getenv("CDEM_TEST_DATA");
+    char path[1024];
+    if (c && *c)
+        snprintf(path, sizeof path, "%s/h5/%s", c, name);
+    else
+        snprintf(path, sizeof path, "%s/../fuzz/corpus/h5/%s", d && *d ? d : "tests/data", name);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    cdem_error_clear(&err);
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s: %s", path, err.msg);
+    cdem_state s = {0};
+    assert_int_equal(cdem_h5_reader_load_increment(r, 0, &s, NULL, &err), CDEM_ERR_FORMAT);
+    if (!strstr(err.msg, needle) || !strstr(err.msg, path))
+        fail_msg("expected '%s' and the path in: %s", needle, err.msg);
+    assert_int_equal(s.n, 0);
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+}
+
+/* fuzz_h5: an increment whose datasets claim 2e9 elements (89 kB file, storage never
+ * written: HDF5 would return fill values) made the reader allocate ~100 GB. Refused before
+ * allocating: above 20 million elements, or with no stored data. */
+static void test_bad_input_h5_forged_element_count(void **state) {
+    (void)state;
+    expect_h5_load_error("crash-oom-forged-length",
+                         "claims 2000000000 elements; this reader refuses more than 20000000");
+    expect_h5_load_error("crash-unwritten-storage",
+                         "claims 1000000 elements but none was ever written");
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_input_params_quote_inside_string_value),
         cmocka_unit_test(test_bad_input_fault_file_nul_byte),
         cmocka_unit_test(test_bad_input_cdem2d_nul_byte),
         cmocka_unit_test(test_bad_input_cdem2d_huge_radius_names_file),
+        cmocka_unit_test(test_bad_input_h5_forged_element_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
