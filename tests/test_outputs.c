@@ -35,21 +35,19 @@ typedef struct {
     char out[8192];    /* output of the last command */
 } fixture;
 
-static fixture g;
-
 static int exists(const char *path) {
     struct stat sb;
     return stat(path, &sb) == 0;
 }
 
-/* Runs cmd (2>&1) into g.out; returns its exit status (-1 when killed by a signal). */
-static int run(const char *cmd) {
+/* Runs cmd (2>&1) into g->out; returns its exit status (-1 when killed by a signal). */
+static int run(fixture *g, const char *cmd) {
     char full[4096];
     snprintf(full, sizeof full, "%s 2>&1", cmd);
     FILE *p = popen(full, "r");
     assert_non_null(p);
-    size_t got = fread(g.out, 1, sizeof g.out - 1, p);
-    g.out[got] = '\0';
+    size_t got = fread(g->out, 1, sizeof g->out - 1, p);
+    g->out[got] = '\0';
     while (fread(full, 1, sizeof full, p) > 0) {
     }
     int st = pclose(p);
@@ -118,19 +116,22 @@ static int write_run(const char *path) {
 }
 
 static int setup(void **state) {
-    (void)state;
+    fixture *g = calloc(1, sizeof *g);
+    if (!g)
+        return -1;
+    *state = g;
     const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(g.tmp, sizeof g.tmp, "%s/outputs_%d", t ? t : "/tmp", (int)getpid());
-    if (mkdir(g.tmp, 0777) != 0)
+    snprintf(g->tmp, sizeof g->tmp, "%s/outputs_%d", t ? t : "/tmp", (int)getpid());
+    if (mkdir(g->tmp, 0777) != 0)
         return -1;
     const char *b = getenv("CDEM_BUILD");
-    snprintf(g.exe, sizeof g.exe, "%s/cdem-strain", b ? b : "build");
-    snprintf(g.run, sizeof g.run, "%s/run.h5", g.tmp);
-    snprintf(g.broken, sizeof g.broken, "%s/broken.h5", g.tmp);
-    if (write_run(g.run) != 0 || write_run(g.broken) != 0)
+    snprintf(g->exe, sizeof g->exe, "%s/cdem-strain", b ? b : "build");
+    snprintf(g->run, sizeof g->run, "%s/run.h5", g->tmp);
+    snprintf(g->broken, sizeof g->broken, "%s/broken.h5", g->tmp);
+    if (write_run(g->run) != 0 || write_run(g->broken) != 0)
         return -1;
     /* delete the last increment's x dataset: the listing still reads, loading it fails */
-    hid_t f = H5Fopen(g.broken, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t f = H5Fopen(g->broken, H5F_ACC_RDWR, H5P_DEFAULT);
     if (f < 0)
         return -1;
     find_x fx = {""};
@@ -141,18 +142,20 @@ static int setup(void **state) {
 }
 
 static int teardown(void **state) {
-    (void)state;
+    fixture *g = *state;
     char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g.tmp);
-    return system(cmd) == 0 ? 0 : -1;
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g->tmp);
+    int rc = system(cmd) == 0 ? 0 : -1;
+    free(g);
+    return rc;
 }
 
 /* ------------------------------------------------------------- the module */
 
 static void test_outputs_outfile_commit(void **state) {
-    (void)state;
+    fixture *g = *state;
     char path[1200];
-    snprintf(path, sizeof path, "%s/commit.txt", g.tmp);
+    snprintf(path, sizeof path, "%s/commit.txt", g->tmp);
     cdem_outfile of;
     cdem_error err;
     cdem_error_clear(&err);
@@ -175,9 +178,9 @@ static void test_outputs_outfile_commit(void **state) {
 }
 
 static void test_outputs_outfile_failure_removes_tmp(void **state) {
-    (void)state;
+    fixture *g = *state;
     char path[1200];
-    snprintf(path, sizeof path, "%s/failed.txt", g.tmp);
+    snprintf(path, sizeof path, "%s/failed.txt", g->tmp);
     cdem_outfile of;
     cdem_error err;
     cdem_error_clear(&err);
@@ -194,9 +197,9 @@ static void test_outputs_outfile_failure_removes_tmp(void **state) {
 }
 
 static void test_outputs_outfile_stale_tmp_removed(void **state) {
-    (void)state;
+    fixture *g = *state;
     char path[1200], tmp[1300];
-    snprintf(path, sizeof path, "%s/stale.txt", g.tmp);
+    snprintf(path, sizeof path, "%s/stale.txt", g->tmp);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
     assert_non_null(f);
@@ -211,22 +214,22 @@ static void test_outputs_outfile_stale_tmp_removed(void **state) {
 }
 
 static void test_outputs_outfile_bad_destination(void **state) {
-    (void)state;
+    fixture *g = *state;
     cdem_outfile of;
     cdem_error err;
     char path[1200];
     /* missing folder */
-    snprintf(path, sizeof path, "%s/no-such-folder/out.csv", g.tmp);
+    snprintf(path, sizeof path, "%s/no-such-folder/out.csv", g->tmp);
     cdem_error_clear(&err);
     assert_int_equal(cdem_outfile_begin(&of, path, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, path));
     assert_non_null(strstr(err.msg, "No such file"));
     /* a regular file where the folder should be */
-    snprintf(path, sizeof path, "%s/run.h5/out.csv", g.tmp);
+    snprintf(path, sizeof path, "%s/run.h5/out.csv", g->tmp);
     assert_int_equal(cdem_outfile_begin(&of, path, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, path));
     /* the output itself is a folder */
-    assert_int_equal(cdem_outfile_begin(&of, g.tmp, &err), CDEM_ERR_IO);
+    assert_int_equal(cdem_outfile_begin(&of, g->tmp, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, "is a folder"));
     /* empty and overlong paths */
     assert_int_equal(cdem_outfile_begin(&of, "", &err), CDEM_ERR_INVALID);
@@ -243,9 +246,9 @@ static void test_outputs_outfile_bad_destination(void **state) {
 
 /* Asserts the last command failed with status 1, named `needle`, and left neither out nor
  * out.tmp. */
-static void expect_failed_clean(int rc, const char *needle, const char *out) {
-    if (rc != 1 || !strstr(g.out, needle))
-        fail_msg("expected exit 1 and '%s' in the message; got %d: %s", needle, rc, g.out);
+static void expect_failed_clean(const fixture *g, int rc, const char *needle, const char *out) {
+    if (rc != 1 || !strstr(g->out, needle))
+        fail_msg("expected exit 1 and '%s' in the message; got %d: %s", needle, rc, g->out);
     char tmp[1300];
     snprintf(tmp, sizeof tmp, "%s.tmp", out);
     assert_false(exists(out));
@@ -253,107 +256,107 @@ static void expect_failed_clean(int rc, const char *needle, const char *out) {
 }
 
 static void test_outputs_compute_csv_fails_midway(void **state) {
-    (void)state;
+    fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/values.csv", g.tmp);
+    snprintf(out, sizeof out, "%s/values.csv", g->tmp);
     /* the valid run: the file appears, no .tmp left */
     snprintf(cmd, sizeof cmd,
-             "'%s' compute '%s' --increment all --quantity total-max-shear -o '%s'", g.exe, g.run,
+             "'%s' compute '%s' --increment all --quantity total-max-shear -o '%s'", g->exe, g->run,
              out);
-    assert_int_equal(run(cmd), 0);
+    assert_int_equal(run(g, cmd), 0);
     assert_true(exists(out));
     remove(out);
     /* the broken run fails at the last increment, after the others were written */
     snprintf(cmd, sizeof cmd,
-             "'%s' compute '%s' --increment all --quantity total-max-shear -o '%s'", g.exe,
-             g.broken, out);
-    expect_failed_clean(run(cmd), g.broken, out);
-    assert_non_null(strstr(g.out, "/x"));
+             "'%s' compute '%s' --increment all --quantity total-max-shear -o '%s'", g->exe,
+             g->broken, out);
+    expect_failed_clean(g, run(g, cmd), g->broken, out);
+    assert_non_null(strstr(g->out, "/x"));
 }
 
 static void test_outputs_compute_h5_fails_midway(void **state) {
-    (void)state;
+    fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/values.h5", g.tmp);
+    snprintf(out, sizeof out, "%s/values.h5", g->tmp);
     snprintf(cmd, sizeof cmd,
              "'%s' compute '%s' --increment all --quantity total-max-shear --format h5 -o '%s'",
-             g.exe, g.broken, out);
-    expect_failed_clean(run(cmd), g.broken, out);
+             g->exe, g->broken, out);
+    expect_failed_clean(g, run(g, cmd), g->broken, out);
 }
 
 static void test_outputs_unwritable_destinations(void **state) {
-    (void)state;
+    fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/missing/values.csv", g.tmp);
+    snprintf(out, sizeof out, "%s/missing/values.csv", g->tmp);
     snprintf(cmd, sizeof cmd,
-             "'%s' compute '%s' --increment last --quantity total-max-shear -o '%s'", g.exe, g.run,
+             "'%s' compute '%s' --increment last --quantity total-max-shear -o '%s'", g->exe,
+             g->run, out);
+    expect_failed_clean(g, run(g, cmd), out, out);
+    snprintf(out, sizeof out, "%s/missing/picture.png", g->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment last -o '%s'", g->exe, g->run, out);
+    expect_failed_clean(g, run(g, cmd), out, out);
+    snprintf(out, sizeof out, "%s/missing/movie.gif", g->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --gif '%s'", g->exe, g->run, out);
+    expect_failed_clean(g, run(g, cmd), out, out);
+    snprintf(out, sizeof out, "%s/missing/series.svg", g->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' plot-series '%s' --y kinetic_energy -o '%s'", g->exe, g->run,
              out);
-    expect_failed_clean(run(cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/picture.png", g.tmp);
-    snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment last -o '%s'", g.exe, g.run, out);
-    expect_failed_clean(run(cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/movie.gif", g.tmp);
-    snprintf(cmd, sizeof cmd, "'%s' render '%s' --gif '%s'", g.exe, g.run, out);
-    expect_failed_clean(run(cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/series.svg", g.tmp);
-    snprintf(cmd, sizeof cmd, "'%s' plot-series '%s' --y kinetic_energy -o '%s'", g.exe, g.run,
-             out);
-    int rc = run(cmd);
+    int rc = run(g, cmd);
     /* this run has no series samples: either reason is an error naming a file */
     assert_int_equal(rc, 1);
     assert_false(exists(out));
-    snprintf(out, sizeof out, "%s/missing/biaxial.txt", g.tmp);
-    snprintf(cmd, sizeof cmd, "'%s' export-biaxial '%s' -o '%s'", g.exe, g.run, out);
-    rc = run(cmd);
+    snprintf(out, sizeof out, "%s/missing/biaxial.txt", g->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' export-biaxial '%s' -o '%s'", g->exe, g->run, out);
+    rc = run(g, cmd);
     assert_int_equal(rc, 1); /* not a biaxial run: refused, naming the run file */
-    assert_non_null(strstr(g.out, g.run));
+    assert_non_null(strstr(g->out, g->run));
     assert_false(exists(out));
 }
 
 static void test_outputs_render_series_fails_midway(void **state) {
-    (void)state;
+    fixture *g = *state;
     char dir[1200], gif[1200], cmd[4096];
-    snprintf(dir, sizeof dir, "%s/pictures", g.tmp);
+    snprintf(dir, sizeof dir, "%s/pictures", g->tmp);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment all --zoom -100,2100,-100,1300 -o '%s'",
-             g.exe, g.broken, dir);
-    int rc = run(cmd);
-    if (rc != 1 || !strstr(g.out, g.broken))
-        fail_msg("render: expected exit 1 naming %s; got %d: %s", g.broken, rc, g.out);
+             g->exe, g->broken, dir);
+    int rc = run(g, cmd);
+    if (rc != 1 || !strstr(g->out, g->broken))
+        fail_msg("render: expected exit 1 naming %s; got %d: %s", g->broken, rc, g->out);
     assert_int_equal(count_entries(dir), 0); /* earlier pictures of this call removed */
-    snprintf(gif, sizeof gif, "%s/movie.gif", g.tmp);
-    snprintf(cmd, sizeof cmd, "'%s' render '%s' --zoom -100,2100,-100,1300 --gif '%s'", g.exe,
-             g.broken, gif);
-    expect_failed_clean(run(cmd), g.broken, gif);
+    snprintf(gif, sizeof gif, "%s/movie.gif", g->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' --zoom -100,2100,-100,1300 --gif '%s'", g->exe,
+             g->broken, gif);
+    expect_failed_clean(g, run(g, cmd), g->broken, gif);
 }
 
 static void test_outputs_export_sspx_fails_midway(void **state) {
-    (void)state;
+    fixture *g = *state;
     char dir[1200], cmd[4096];
-    snprintf(dir, sizeof dir, "%s/sspx", g.tmp);
+    snprintf(dir, sizeof dir, "%s/sspx", g->tmp);
     assert_int_equal(mkdir(dir, 0777), 0);
-    snprintf(cmd, sizeof cmd, "'%s' export-sspx '%s' --increments first-last '%s'", g.exe, g.broken,
-             dir);
-    int rc = run(cmd);
-    if (rc != 1 || !strstr(g.out, g.broken))
-        fail_msg("export-sspx: expected exit 1 naming %s; got %d: %s", g.broken, rc, g.out);
+    snprintf(cmd, sizeof cmd, "'%s' export-sspx '%s' --increments first-last '%s'", g->exe,
+             g->broken, dir);
+    int rc = run(g, cmd);
+    if (rc != 1 || !strstr(g->out, g->broken))
+        fail_msg("export-sspx: expected exit 1 naming %s; got %d: %s", g->broken, rc, g->out);
     assert_int_equal(count_entries(dir), 0);
     /* the valid run writes all NINC files */
-    snprintf(cmd, sizeof cmd, "'%s' export-sspx '%s' --increments first-last '%s'", g.exe, g.run,
+    snprintf(cmd, sizeof cmd, "'%s' export-sspx '%s' --increments first-last '%s'", g->exe, g->run,
              dir);
-    assert_int_equal(run(cmd), 0);
+    assert_int_equal(run(g, cmd), 0);
     assert_int_equal(count_entries(dir), NINC);
 }
 
 static void test_outputs_import_cdem2d_fails_midway(void **state) {
-    (void)state;
+    fixture *g = *state;
     const char *d = getenv("CDEM_TEST_DATA");
     char out[1200], xmf[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/imported.h5", g.tmp);
-    snprintf(xmf, sizeof xmf, "%s/imported.xmf", g.tmp);
+    snprintf(out, sizeof out, "%s/imported.h5", g->tmp);
+    snprintf(xmf, sizeof xmf, "%s/imported.xmf", g->tmp);
     /* modelresults_0.txt is valid (written), modelresults_1.txt is malformed */
-    snprintf(cmd, sizeof cmd, "'%s' import-cdem2d '%s/cdem2d_malformed' -o '%s'", g.exe,
+    snprintf(cmd, sizeof cmd, "'%s' import-cdem2d '%s/cdem2d_malformed' -o '%s'", g->exe,
              d && *d ? d : "tests/data", out);
-    expect_failed_clean(run(cmd), "modelresults_1.txt", out);
+    expect_failed_clean(g, run(g, cmd), "modelresults_1.txt", out);
     assert_false(exists(xmf));
 }
 
