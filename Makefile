@@ -7,6 +7,8 @@
 #   make bench      benchmarks (bench/)
 #   make deps       install missing Debian packages (apt-get)
 #   make demo       the main job: simulate the default model, analyse, render a picture
+#   make fuzz       build the libFuzzer harnesses (tests/fuzz/, clang) and run each for
+#                   FUZZ_SECONDS (default 600); FUZZ_HARNESSES picks a subset
 
 BUILD   ?= build
 CC      ?= gcc
@@ -36,7 +38,7 @@ LIBSOLVER   := $(BUILD)/libcdemsolver.a
 LIBANALYSIS := $(BUILD)/libcdemanalysis.a
 LIBS        := $(LIBANALYSIS) $(LIBSOLVER) $(LIBCOMMON)
 
-.PHONY: all test asan validate bench deps demo clean format tests-build
+.PHONY: all test asan validate bench deps demo clean format tests-build fuzz fuzz-build fuzz-bins
 PROGRAMS := $(if $(wildcard solver/main.c),$(BUILD)/cdem-run) $(if $(wildcard analysis/main.c),$(BUILD)/cdem-strain)
 all: $(PROGRAMS)
 
@@ -83,10 +85,26 @@ bench: all
 demo: all
 	@sh scripts/demo.sh $(BUILD)
 
+# Fuzzing (tests/fuzz/README.md): every source compiled by clang with coverage
+# instrumentation and address + undefined sanitizers into build-fuzz/, one libFuzzer binary
+# per harness; tests/fuzz/run_fuzz.sh runs them one after another under nice.
+FUZZ_SECONDS   ?= 600
+FUZZ_HARNESSES ?= params fault_file cdem2d h5
+FUZZ_OPT := -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer-no-link,address,undefined \
+            -fno-sanitize-recover=undefined
+fuzz: fuzz-build
+	@sh tests/fuzz/run_fuzz.sh build-fuzz $(FUZZ_SECONDS) $(FUZZ_HARNESSES)
+fuzz-build:
+	$(MAKE) BUILD=build-fuzz CC=clang OPT="$(FUZZ_OPT)" fuzz-bins
+fuzz-bins: $(FUZZ_HARNESSES:%=$(BUILD)/fuzz/fuzz_%)
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
+
 format:
 	clang-format -i common/*.[ch] solver/*.[ch] analysis/*.[ch] tests/*.[ch] 2>/dev/null || true
 
 clean:
-	rm -rf build build-asan
+	rm -rf build build-asan build-fuzz
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -45,6 +45,13 @@ static cdem_status read_text(const char *path, char **out, int optional, cdem_er
         return CDEM_FAIL(err, CDEM_ERR_IO, "error reading %s", path);
     }
     buf[n] = '\0';
+    const char *nul = memchr(buf, '\0', n);
+    if (nul) { /* the rows after it would be dropped silently */
+        size_t at = (size_t)(nul - buf);
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: byte %zu is a NUL byte: not a text file", path,
+                         at + 1);
+    }
     *out = buf;
     return CDEM_OK;
 }
@@ -393,8 +400,11 @@ cdem_status cdem_cdem2d_import(const char *dir, cdem_cdem2d_sink sink, void *use
                                "%s: %zu stress rows for %zu elements in modelresults_%ld.txt", path,
                                fc.stress_row, cur.n, nums[k]);
         }
-        if (st == CDEM_OK)
+        if (st == CDEM_OK) {
             st = assign_ids(have_prev ? &prev : NULL, &cur, &next_id, err);
+            if (st != CDEM_OK) /* e.g. coordinates too far apart to match: name the file */
+                cdem_error_prefix(err, "%s/modelresults_%ld.txt", dir, nums[k]);
+        }
         if (st != CDEM_OK)
             break;
         cur.next_id = next_id;

@@ -4,6 +4,7 @@
  * modelparameters.txt verbatim. Kept apart from cdem2d.c so the parser links without HDF5. */
 #include "cdem2d.h"
 
+#include "outfile.h"
 #include "params.h"
 
 #include <stdio.h>
@@ -41,6 +42,10 @@ static cdem_status write_sink(void *user, const cdem_increment_info *info, const
 /* The meta (params text, mode) is read before the first increment is delivered, so the
  * writer can be created lazily inside the sink; meta is passed by pointer to the context. */
 cdem_status cdem_cdem2d_import_h5(const char *dir, const char *out_path, cdem_error *err) {
+    /* The HDF5 writer keeps a sidecar (.xmf) that names the file, so the import is written
+     * under its final name and removed on failure (with the sidecar) instead of renamed. */
+    cdem_outfile of;
+    CDEM_TRY(cdem_outfile_begin(&of, out_path, err)); /* writable destination, up front */
     cdem_cdem2d_meta meta;
     h5_sink_ctx c;
     memset(&c, 0, sizeof c);
@@ -59,5 +64,16 @@ cdem_status cdem_cdem2d_import_h5(const char *dir, const char *out_path, cdem_er
         }
     }
     cdem_cdem2d_meta_free(&meta);
+    if (st != CDEM_OK && c.w) {
+        remove(out_path);
+        char xmf[CDEM_OUTFILE_PATH_MAX + 8];
+        size_t stem = strlen(out_path);
+        const char *dot = strrchr(out_path, '.'), *slash = strrchr(out_path, '/');
+        if (dot && (!slash || dot > slash) &&
+            (!strcmp(dot, ".h5") || !strcmp(dot, ".hdf5") || !strcmp(dot, ".hdf")))
+            stem = (size_t)(dot - out_path);
+        snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)stem, out_path);
+        remove(xmf);
+    }
     return st;
 }

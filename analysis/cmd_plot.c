@@ -6,6 +6,8 @@
 #include "render.h"
 #include "repose.h"
 
+#include "outfile.h"
+
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
 
@@ -501,15 +503,20 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
         CDEM_TRY(cdem_render_auto_height(&sc, &o, &h, err));
     cdem_render_layout lay;
     CDEM_TRY(cdem_render_layout_compute(&sc, &o, o.width, h, &lay, err));
+    /* written to OUT.tmp, renamed on success (outfile.h) */
+    cdem_outfile of;
+    CDEM_TRY(cdem_outfile_begin(&of, a->out, err));
     cairo_surface_t *surf = fmt == CDEM_RENDER_PNG
                                 ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, o.width, h)
-                            : fmt == CDEM_RENDER_PDF ? cairo_pdf_surface_create(a->out, o.width, h)
-                                                     : cairo_svg_surface_create(a->out, o.width, h);
+                            : fmt == CDEM_RENDER_PDF ? cairo_pdf_surface_create(of.tmp, o.width, h)
+                                                     : cairo_svg_surface_create(of.tmp, o.width, h);
     cairo_status_t cs = cairo_surface_status(surf);
     if (cs != CAIRO_STATUS_SUCCESS) {
         cairo_surface_destroy(surf);
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create image file '%s': %s", a->out,
-                         cairo_status_to_string(cs));
+        return cdem_outfile_end(&of,
+                                CDEM_FAIL(err, CDEM_ERR_IO, "cannot create image file '%s': %s",
+                                          a->out, cairo_status_to_string(cs)),
+                                err);
     }
     cairo_t *cr = cairo_create(surf);
     cdem_status st = cdem_render_draw(cr, o.width, h, &sc, &o, err);
@@ -531,7 +538,7 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
     cairo_destroy(cr);
     if (st == CDEM_OK) {
         if (fmt == CDEM_RENDER_PNG)
-            cs = cairo_surface_write_to_png(surf, a->out);
+            cs = cairo_surface_write_to_png(surf, of.tmp);
         else {
             cairo_surface_finish(surf);
             cs = cairo_surface_status(surf);
@@ -541,7 +548,7 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
                            cairo_status_to_string(cs));
     }
     cairo_surface_destroy(surf);
-    return st;
+    return cdem_outfile_end(&of, st, err);
 }
 
 int cdem_cmd_plot_repose(int argc, char **argv) {

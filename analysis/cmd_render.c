@@ -441,8 +441,15 @@ static int run_render(const render_args *a) {
             char path[4096];
             snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
                      (int)cdem_analysis_info(an, i)->number, a->format);
-            if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK)
+            if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK) {
                 rc = fail(&err);
+                /* no partial series that looks complete: remove this run's pictures */
+                for (size_t j = 0; j < i; j++) {
+                    snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+                             (int)cdem_analysis_info(an, j)->number, a->format);
+                    remove(path);
+                }
+            }
         }
         if (rc == 0)
             printf("%s: %zu pictures\n", a->output, n);

@@ -5,6 +5,8 @@
  * nearest grey, in plain RGB distance. */
 #include "gif.h"
 
+#include "outfile.h"
+
 #include <gif_lib.h>
 #include <math.h>
 #include <stdio.h>
@@ -154,8 +156,8 @@ cdem_status cdem_gif_open(cdem_gif **out, const char *path, int width, int heigh
      * is an ordinary output file (0666 less the umask, like every other file we write). */
     int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
     if (fd < 0) {
-        cdem_status st = CDEM_FAIL(err, CDEM_ERR_IO, "gif '%s': cannot create the file: %s",
-                                   path, strerror(errno));
+        cdem_status st = CDEM_FAIL(err, CDEM_ERR_IO, "gif '%s': cannot create the file: %s", path,
+                                   strerror(errno));
         free(g->path);
         g->path = NULL; /* nothing was created: do not delete anything */
         cdem_gif_free(g);
@@ -361,7 +363,10 @@ cdem_status cdem_gif_write(const char *path, size_t n_frames, int width, int hei
     }
     cdem_gif_frame_order(n_frames, o, order);
     cdem_gif *g = NULL;
-    cdem_status st = cdem_gif_open(&g, path, width, height, o, err);
+    cdem_outfile of; /* written to path.tmp, renamed on success (outfile.h) */
+    cdem_status st = cdem_outfile_begin(&of, path, err);
+    if (st == CDEM_OK)
+        st = cdem_gif_open(&g, of.tmp, width, height, o, err);
     for (size_t k = 0; st == CDEM_OK && k < count; k++) {
         st = fn(user, order[k], rgba, width, height, err);
         if (st != CDEM_OK)
@@ -373,6 +378,8 @@ cdem_status cdem_gif_write(const char *path, size_t n_frames, int width, int hei
         st = cdem_gif_close(g, err);
     else
         cdem_gif_free(g);
+    if (of.active)
+        st = cdem_outfile_end(&of, st, err);
     free(order);
     free(rgba);
     return st;

@@ -9,10 +9,12 @@
 #include "cmd_plot.h"
 #include "biaxial.h"
 #include "cdem2d.h"
+#include "outfile.h"
 #include "qexport.h"
 #include "quantity.h"
 #include "sspx.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -167,12 +169,15 @@ static int cmd_compute(const options *o) {
     FILE *f = stdout;
     cdem_qexport_h5 *h = NULL;
     cdem_status st = CDEM_OK;
-    if (strcmp(format, "h5") == 0) {
-        st = cdem_qexport_h5_create(o->out, q, &h, &err);
-    } else if (o->out) {
-        f = fopen(o->out, "w");
+    cdem_outfile of = {.active = 0}; /* -o OUT is written to OUT.tmp, renamed on success */
+    if (o->out)
+        st = cdem_outfile_begin(&of, o->out, &err);
+    if (st == CDEM_OK && strcmp(format, "h5") == 0) {
+        st = cdem_qexport_h5_create(of.tmp, q, &h, &err);
+    } else if (st == CDEM_OK && o->out) {
+        f = fopen(of.tmp, "w");
         if (!f)
-            st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s", o->out);
+            st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", of.tmp, strerror(errno));
     }
     if (st == CDEM_OK && !h)
         st = cdem_qexport_csv_header(f, all, &err);
@@ -198,7 +203,9 @@ static int cmd_compute(const options *o) {
         }
     }
     if (f && f != stdout && fclose(f) != 0 && st == CDEM_OK)
-        st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", o->out);
+        st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", of.tmp);
+    if (of.active)
+        st = cdem_outfile_end(&of, st, &err);
     cdem_analysis_close(a);
     return st == CDEM_OK ? EXIT_OK : fail_with(&err);
 }

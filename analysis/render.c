@@ -10,6 +10,8 @@
  * Draw order: fills by slot, outlines, vectors, axes, then label, scale bar, colour bar. */
 #include "render.h"
 
+#include "outfile.h"
+
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
 #include <ctype.h>
@@ -1056,25 +1058,31 @@ cdem_status cdem_render_to_file(const char *path, const cdem_render_scene *sc,
                          "render: image size %d x %d: each side must be in 16..%d (height 0 = "
                          "automatic)",
                          w, h, CDEM_RENDER_MAX_SIZE);
+    /* written to path.tmp, renamed on success (outfile.h) */
+    cdem_outfile of;
+    CDEM_TRY(cdem_outfile_begin(&of, path, err));
     cairo_surface_t *surf;
     if (fmt == CDEM_RENDER_PNG)
         surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
     else if (fmt == CDEM_RENDER_PDF)
-        surf = cairo_pdf_surface_create(path, w, h);
+        surf = cairo_pdf_surface_create(of.tmp, w, h);
     else
-        surf = cairo_svg_surface_create(path, w, h);
+        surf = cairo_svg_surface_create(of.tmp, w, h);
     cairo_status_t cs = cairo_surface_status(surf);
     if (cs != CAIRO_STATUS_SUCCESS) {
         cairo_surface_destroy(surf);
-        return CDEM_FAIL(err, CDEM_ERR_IO, "render: cannot create image file '%s': %s", path,
-                         cairo_status_to_string(cs));
+        return cdem_outfile_end(&of,
+                                CDEM_FAIL(err, CDEM_ERR_IO,
+                                          "render: cannot create image file '%s': %s", path,
+                                          cairo_status_to_string(cs)),
+                                err);
     }
     cairo_t *cr = cairo_create(surf);
     cdem_status st = cdem_render_draw(cr, w, h, sc, o, err);
     cairo_destroy(cr);
     if (st == CDEM_OK) {
         if (fmt == CDEM_RENDER_PNG)
-            cs = cairo_surface_write_to_png(surf, path);
+            cs = cairo_surface_write_to_png(surf, of.tmp);
         else {
             cairo_surface_finish(surf);
             cs = cairo_surface_status(surf);
@@ -1084,5 +1092,5 @@ cdem_status cdem_render_to_file(const char *path, const cdem_render_scene *sc,
                            cairo_status_to_string(cs));
     }
     cairo_surface_destroy(surf);
-    return st;
+    return cdem_outfile_end(&of, st, err);
 }

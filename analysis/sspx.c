@@ -1,6 +1,8 @@
 /* sspx: see sspx.h. */
 #include "sspx.h"
 
+#include "outfile.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -8,16 +10,19 @@
 #include <string.h>
 
 cdem_status cdem_sspx_write(const char *path, const cdem_state *s, cdem_error *err) {
-    FILE *f = fopen(path, "w");
+    cdem_outfile of; /* written to path.tmp, renamed on success */
+    CDEM_TRY(cdem_outfile_begin(&of, path, err));
+    FILE *f = fopen(of.tmp, "w");
     if (!f)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s", path, strerror(errno));
+        return cdem_outfile_end(
+            &of, CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s", of.tmp, strerror(errno)), err);
     for (size_t i = 0; i < s->n; i++)
         fprintf(f, "%d %.6f %.6f %.6f %d\n", (int)s->id[i], s->x[i], s->y[i], s->radius[i],
                 (int)s->layer[i]);
     int bad = ferror(f);
     if (fclose(f) != 0 || bad)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", path);
-    return CDEM_OK;
+        return cdem_outfile_end(&of, CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", of.tmp), err);
+    return cdem_outfile_end(&of, CDEM_OK, err);
 }
 
 cdem_status cdem_sspx_read(const char *path, cdem_state *s, cdem_error *err) {
@@ -69,19 +74,37 @@ cdem_status cdem_sspx_export(cdem_analysis *a, size_t first, size_t last, const 
     int dirlen = (int)strlen(dir); /* "out/" and "out" name the same directory */
     while (dirlen > 1 && dir[dirlen - 1] == '/')
         dirlen--;
-    for (size_t k = first; k <= last; k++) {
+    cdem_status st = CDEM_OK;
+    size_t k = first;
+    char path[CDEM_PATH_MAX + 128];
+    for (; k <= last; k++) { /* on failure k is the increment that failed */
         const cdem_state *s;
-        CDEM_TRY(cdem_analysis_state(a, k, &s, err));
-        char path[CDEM_PATH_MAX + 128];
+        st = cdem_analysis_state(a, k, &s, err);
+        if (st != CDEM_OK)
+            break;
         int n = snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
                          (int)cdem_analysis_info(a, k)->number);
-        if (n < 0 || (size_t)n >= sizeof path)
-            return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: output path in '%s' is too long", dir);
-        CDEM_TRY(cdem_sspx_write(path, s, err));
+        if (n < 0 || (size_t)n >= sizeof path) {
+            st = CDEM_FAIL(err, CDEM_ERR_INVALID, "export: output path in '%s' is too long", dir);
+            break;
+        }
+        st = cdem_sspx_write(path, s, err);
+        if (st != CDEM_OK)
+            break;
         if (written)
             (*written)++;
     }
-    return CDEM_OK;
+    if (st != CDEM_OK) {
+        /* no partial set that looks like a complete one: remove this call's files */
+        for (size_t j = first; j < k; j++) {
+            snprintf(path, sizeof path, "%.*s/%s%d.txt", dirlen, dir, prefix,
+                     (int)cdem_analysis_info(a, j)->number);
+            remove(path);
+        }
+        if (written)
+            *written = 0;
+    }
+    return st;
 }
 
 cdem_status cdem_sspx_parse_range(const cdem_analysis *a, const char *spec, size_t *first,

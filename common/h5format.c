@@ -44,6 +44,9 @@
 #define CKPT_CHUNK      (1 << 20) /* bytes of a checkpoint slot per chunk */
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
+/* Largest element count an increment may have to be loaded (~2 GB of state; cdem-run's
+ * largest model has ~10^5 elements): a corrupt count is refused before allocating. */
+#define READER_MAX_ELEMENTS ((hsize_t)20000000)
 
 /* ------------------------------------------------------------------ errors */
 
@@ -1869,6 +1872,10 @@ static cdem_status load_into(cdem_h5_reader *r, hid_t g, const incr_entry *e, cd
     hid_t ids = H5Dopen2(g, "id", H5P_DEFAULT);
     hid_t sp = ids >= 0 ? H5Dget_space(ids) : -1;
     hssize_t len = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    /* A dataspace can claim any length while its storage was never written (HDF5 then
+     * returns fill values): an 89 kB file claiming 2e9 elements made the reader allocate
+     * ~100 GB (fuzz_h5). A written dataset has storage. */
+    hsize_t stored = ids >= 0 && len > 0 ? H5Dget_storage_size(ids) : 0;
     if (sp >= 0)
         H5Sclose(sp);
     if (ids >= 0)
@@ -1878,6 +1885,17 @@ static cdem_status load_into(cdem_h5_reader *r, hid_t g, const incr_entry *e, cd
                          "%s: dataset /increments/%s/id is %s (attribute n = %llu)", r->path,
                          e->name, len < 0 ? "missing or unreadable" : "of another length",
                          (unsigned long long)n);
+    if (n > READER_MAX_ELEMENTS)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: /increments/%s claims %llu elements; this reader refuses more than "
+                         "%llu (corrupt file?)",
+                         r->path, e->name, (unsigned long long)n,
+                         (unsigned long long)READER_MAX_ELEMENTS);
+    if (n > 0 && stored == 0)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: dataset /increments/%s/id claims %llu elements but none was ever "
+                         "written (truncated or corrupt file)",
+                         r->path, e->name, (unsigned long long)n);
     cdem_state_free(s);
     CDEM_TRY(cdem_state_init(s, (size_t)n, nstress == 3, err));
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {

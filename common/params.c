@@ -421,6 +421,18 @@ static cdem_status assign_value(cdem_params *p, const cdem_param_def *d, const c
             return CDEM_FAIL(err, CDEM_ERR_RANGE,
                              "%s: %s = %.40s...: too long (%zu characters; at most %zu)", where,
                              d->key, value, len, d->size - 1);
+        /* A '"' inside the value or a control character could not be written back into a
+         * parameter file (cdem_params_write) and read the same (found by fuzzing). */
+        for (size_t i = 0; i < len; i++) {
+            unsigned char c = (unsigned char)value[i];
+            if (c == '"' || (c < 0x20 && c != '\t') || c == 0x7f)
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "%s: %s: character %zu of the value is %s (byte 0x%02x): quotes "
+                                 "inside a value and control characters are not allowed (quote "
+                                 "the whole value to keep '#', ';' or spaces at its ends)",
+                                 where, d->key, i + 1, c == '"' ? "a quote" : "a control character",
+                                 (unsigned)c);
+        }
         memcpy(field, value, len + 1);
         return CDEM_OK;
     }

@@ -146,6 +146,21 @@ cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_f
     FILE *f = fopen(path, "r");
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: cannot open: %s", path, strerror(errno));
+    /* A NUL byte would end a line early without notice (fgets): refuse binary files. */
+    char chunk[4096];
+    size_t got, offset = 0;
+    while ((got = fread(chunk, 1, sizeof chunk, f)) > 0) {
+        const char *nul = memchr(chunk, '\0', got);
+        if (nul) {
+            fclose(f);
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "fault file %s: byte %zu is a NUL byte: not a text file of x y "
+                             "points",
+                             path, offset + (size_t)(nul - chunk) + 1);
+        }
+        offset += got;
+    }
+    rewind(f);
     const cdem_status st = read_lines(f, path, x0, tol, pl, err);
     fclose(f);
     if (st != CDEM_OK)

@@ -303,10 +303,32 @@ static void log_removed(run_ctx *r) {
 
 /* Everything before the first step, for a fresh run and a resumed one alike: the model, the
  * assembly (regenerated from the seed), the mode, the stepper and the summary. No file yet. */
+/* Instability guard: with a stable time step no element moves its own radius in one step
+ * (free fall over the tallest assembly at the largest gravity stays below ~0.7 radius);
+ * beyond that contacts are skipped and the run is garbage even while every number is
+ * still finite (the escaping elements are removed and the run would go on). Serial and in
+ * index order, so the element reported is the same for any thread count. */
+static cdem_status check_unstable(const run_ctx *r, cdem_error *err) {
+    const cdem_state *s = &r->s;
+    const double dt = r->m.dt;
+    for (size_t i = 0; i < s->n; i++) {
+        const double d2 = (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]) * dt * dt;
+        if (d2 > s->radius[i] * s->radius[i])
+            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                             "element id %d moved %.3g m in one time step (more than its radius "
+                             "%.3g m) at step %ld: the simulation is unstable; likely cause: the "
+                             "time step is too large for the spring constants and element masses",
+                             (int)s->id[i], sqrt(d2), s->radius[i], r->step);
+    }
+    return CDEM_OK;
+}
+
 static cdem_status setup(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
     CDEM_TRY(cdem_model_derive(p, &r->m, err));
+    if (r->opt->dt_factor > 0.0)
+        r->m.dt *= r->opt->dt_factor; /* fault injection (tests): a time step too large */
     CDEM_TRY(cdem_sediment_init(&r->sed, p, &r->m, err));
     CDEM_TRY(cdem_state_init(&r->s, 1024, p->calculate_stress, err));
     CDEM_TRY(cdem_assembly_build(p, &r->m, &r->s, &r->info, err));
@@ -518,6 +540,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         if (st != CDEM_OK)
             return st;
         r->step = step;
+        CDEM_TRY(check_unstable(r, err));
         log_removed(r);
         if (step == equil) {
             assign_layers(&r->s);
@@ -675,6 +698,18 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
         end_progress_line(r);
     }
     if (r->w) {
+        if (st == CDEM_ERR_NUMERIC && err) {
+            /* the numbers behind "time step too large": what a user can change */
+            size_t len = strlen(err->msg);
+            snprintf(err->msg + len, sizeof err->msg - len,
+                     " (time step %g s, spring constant %g N/m, smallest element mass %g kg per "
+                     "metre%s)",
+                     r->m.dt, r->m.kn, r->m.min_mass,
+                     r->p->keep_constants && r->p->unit_scaling < 1000.0
+                         ? "; keep_constants = on keeps the 1000 m spring and damping constants "
+                           "at this smaller unit_scaling: try keep_constants = off"
+                         : "");
+        }
         if (st != CDEM_OK && st != CDEM_ERR_INTERRUPTED) {
             /* record the diagnosis in the file; keep the original error */
             cdem_error e2;

@@ -5,6 +5,8 @@
 BUILD=${1:-build}
 export CDEM_TEST_DATA="$(pwd)/tests/data"
 export CDEM_BUILD="$(pwd)/$BUILD"
+# Regression corpus of the fuzz harnesses, replayed by test_fuzz_corpus (tests/fuzz/).
+export CDEM_FUZZ_CORPUS="$(pwd)/tests/fuzz/corpus"
 # Third-party leaks (fontconfig) in programs the tests run under make asan.
 export LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 TMPROOT=$(mktemp -d)
