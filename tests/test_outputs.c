@@ -68,20 +68,6 @@ static int count_entries(const char *dir) {
     return n;
 }
 
-typedef struct {
-    char last[512]; /* path of the last dataset named "x" in visit (name) order */
-} find_x;
-
-static herr_t visit_x(hid_t o, const char *name, const H5O_info_t *info, void *data) {
-    (void)o;
-    find_x *f = data;
-    const char *base = strrchr(name, '/');
-    base = base ? base + 1 : name;
-    if (info->type == H5O_TYPE_DATASET && !strcmp(base, "x") && strcmp(name, f->last) > 0)
-        snprintf(f->last, sizeof f->last, "%s", name);
-    return 0;
-}
-
 /* Writes a run of NINC increments of a small packing to path. */
 static int write_run(const char *path) {
     cdem_state s = {0};
@@ -115,6 +101,48 @@ static int write_run(const char *path) {
     return rc;
 }
 
+/* Corrupts the last increment of a format-2 file so that the listing still reads and only
+ * loading that increment fails: every increment starts at a chunk boundary of the ragged
+ * element datasets, so the chunk of /increments/x holding the last row belongs to the last
+ * increment alone; its compressed bytes are overwritten (a bad sector, say). */
+static int break_last_increment(const char *path) {
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    hid_t ds = H5Dopen2(f, "/increments/x", H5P_DEFAULT);
+    hid_t sp = ds >= 0 ? H5Dget_space(ds) : H5I_INVALID_HID;
+    hid_t dcpl = ds >= 0 ? H5Dget_create_plist(ds) : H5I_INVALID_HID;
+    hsize_t dims[1] = {0}, chunk[1] = {0}, coord[1] = {0}, size = 0;
+    haddr_t addr = HADDR_UNDEF;
+    unsigned mask = 0;
+    int ok = sp >= 0 && dcpl >= 0 && H5Sget_simple_extent_dims(sp, dims, NULL) == 1 &&
+             dims[0] > 0 && H5Pget_chunk(dcpl, 1, chunk) == 1 && chunk[0] > 0;
+    if (ok) {
+        coord[0] = (dims[0] - 1) / chunk[0] * chunk[0];
+        ok = H5Dget_chunk_info_by_coord(ds, coord, &mask, &addr, &size) >= 0 &&
+             addr != HADDR_UNDEF && size > 0;
+    }
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    if (sp >= 0)
+        H5Sclose(sp);
+    if (ds >= 0)
+        H5Dclose(ds);
+    H5Fclose(f);
+    if (!ok)
+        return -1;
+    FILE *fp = fopen(path, "r+b");
+    if (!fp)
+        return -1;
+    int rc = fseek(fp, (long)addr, SEEK_SET) == 0 ? 0 : -1;
+    for (hsize_t i = 0; rc == 0 && i < size; i++)
+        if (fputc(0xA5, fp) == EOF)
+            rc = -1;
+    if (fclose(fp) != 0)
+        rc = -1;
+    return rc;
+}
+
 static int setup(void **state) {
     fixture *g = calloc(1, sizeof *g);
     if (!g)
@@ -130,15 +158,7 @@ static int setup(void **state) {
     snprintf(g->broken, sizeof g->broken, "%s/broken.h5", g->tmp);
     if (write_run(g->run) != 0 || write_run(g->broken) != 0)
         return -1;
-    /* delete the last increment's x dataset: the listing still reads, loading it fails */
-    hid_t f = H5Fopen(g->broken, H5F_ACC_RDWR, H5P_DEFAULT);
-    if (f < 0)
-        return -1;
-    find_x fx = {""};
-    H5Ovisit2(f, H5_INDEX_NAME, H5_ITER_INC, visit_x, &fx, H5O_INFO_BASIC);
-    int rc = fx.last[0] && H5Ldelete(f, fx.last, H5P_DEFAULT) >= 0 ? 0 : -1;
-    H5Fclose(f);
-    return rc;
+    return break_last_increment(g->broken);
 }
 
 static int teardown(void **state) {
