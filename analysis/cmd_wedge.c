@@ -104,6 +104,13 @@ int cdem_cmd_wedge(int argc, char **argv) {
         st = cdem_analysis_find(a, inc, &first, &err);
         last = first;
     }
+    if (cdem_analysis_params(a)->mode == CDEM_MODE_DETACHMENT &&
+        cdem_analysis_params(a)->detachment_walls == CDEM_WALLS_BOTH)
+        fprintf(stderr,
+                "cdem-strain wedge: note: %s moves both walls: the wedge is measured from "
+                "the right wall, and the wall force columns are the sum over both walls "
+                "(their x components cancel)\n",
+                file);
     cdem_wedge_row *rows = NULL;
     size_t n = 0;
     cdem_wedge_ref ref;

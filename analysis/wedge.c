@@ -266,6 +266,12 @@ cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, 
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "wedge: increments %zu..%zu (indices) outside the file's 0..%zu", first,
                          last, count ? count - 1 : 0);
+    const cdem_params *prm = cdem_analysis_params(a);
+    if (prm->mode != CDEM_MODE_DETACHMENT)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "wedge: the run is a '%s' run (boundary.mode); the wedge measurement "
+                         "needs boundary.mode = detachment",
+                         cdem_mode_name(prm->mode));
     if (first < e)
         first = e;
     if (last < e)

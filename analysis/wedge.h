@@ -82,7 +82,8 @@ void cdem_wedge_forces(const cdem_series_sample *smp, size_t n, long step_from, 
                        cdem_wedge_row *row);
 
 /* Every increment from the end of equilibration to the last (first/last as indices; first
- * below the end of equilibration is raised to it): *rows malloc'd, *n_rows set. */
+ * below the end of equilibration is raised to it): *rows malloc'd, *n_rows set. Fails
+ * unless the context's parameters say boundary.mode = detachment. */
 cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, size_t first,
                                size_t last, cdem_wedge_row **rows, size_t *n_rows,
                                cdem_wedge_ref *ref, cdem_error *err);

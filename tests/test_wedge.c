@@ -225,13 +225,19 @@ static void test_wedge_analyse_states(void **state) {
         in[k].n_elements = (int64_t)st[k].n;
     }
     cdem_params p;
-    cdem_params_defaults(&p);
+    cdem_params_defaults(&p); /* a planar-fault run: refused */
     cdem_analysis *a;
-    assert_int_equal(cdem_analysis_open_states(st, in, 3, &p, &a, &err), CDEM_OK);
     cdem_wedge_row *rows;
     size_t n;
     cdem_wedge_ref ref;
     cdem_wedge_options opt = {.threshold = 1.0};
+    assert_int_equal(cdem_analysis_open_states(st, in, 3, &p, &a, &err), CDEM_OK);
+    assert_int_equal(cdem_wedge_analyse(a, &opt, 0, 2, &rows, &n, &ref, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "'planar-fault' run"));
+    assert_non_null(strstr(err.msg, "needs boundary.mode = detachment"));
+    cdem_analysis_close(a);
+    p.mode = CDEM_MODE_DETACHMENT;
+    assert_int_equal(cdem_analysis_open_states(st, in, 3, &p, &a, &err), CDEM_OK);
     assert_int_equal(cdem_wedge_analyse(a, &opt, 0, 2, &rows, &n, &ref, &err), CDEM_OK);
     assert_int_equal(n, 2); /* increments 1 (end of equilibration) and 2 */
     assert_int_equal(rows[0].number, 1);
