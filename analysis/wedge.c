@@ -170,7 +170,7 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
         cnt[(size_t)fc]++;
     }
     double hmax = -INFINITY;
-    size_t front = SIZE_MAX;
+    size_t front = SIZE_MAX, front_t = SIZE_MAX;
     for (size_t c = 0; c < nc; c++) {
         if (top[c] == SIZE_MAX)
             continue;
@@ -181,6 +181,8 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
             top0[c] != SIZE_MAX && t - (ref->y[top0[c]] + ref->radius[top0[c]]) > r->threshold;
         if (front == SIZE_MAX && (moved || rose))
             front = c;
+        if (front_t == SIZE_MAX && rose)
+            front_t = c;
     }
     memset(row, 0, sizeof *row);
     row->wall_x = wall;
@@ -190,11 +192,15 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
     if (front != SIZE_MAX) {
         row->front_x = fmax(r->x_left + (double)front * r->column_width, e.left);
         row->length = fmax(0.0, wall - row->front_x);
+    }
+    if (front_t != SIZE_MAX) {
+        const double xt = fmax(r->x_left + (double)front_t * r->column_width, e.left);
+        row->length_thickened = fmax(0.0, wall - xt);
         double *fx = (double *)usum, *fy = malloc(nc * sizeof *fy); /* usum is free now */
         size_t m = 0;
         if (!fy)
             st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "wedge: no memory for %zu columns", nc);
-        for (size_t c = front; c < nc && fy; c++)
+        for (size_t c = front_t; c < nc && fy; c++)
             if (top[c] != SIZE_MAX) {
                 fx[m] = cur->x[top[c]];
                 fy[m] = cur->y[top[c]] + cur->radius[top[c]];
@@ -322,7 +328,8 @@ cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, 
 }
 
 static const char csv_header[] =
-    "increment,step,shortening_m,shortening_percent,height_m,length_m,taper_deg,"
+    "increment,step,shortening_m,shortening_percent,height_m,length_m,length_thickened_m,"
+    "taper_deg,"
     "area_change_m2,area_change_percent,wall_force_x_N,wall_force_y_N,base_force_x_N,"
     "base_force_y_N,front_x_m,wall_x_m,n_fitted";
 
@@ -345,19 +352,13 @@ cdem_status cdem_wedge_write_csv(FILE *f, const cdem_wedge_row *rows, size_t n, 
     for (size_t k = 0; k < n; k++) {
         const cdem_wedge_row *r = &rows[k];
         fprintf(f, "%d,%ld,", r->number, r->step);
-        const double v[] = {r->shortening,
-                            r->shortening_percent,
-                            r->height,
-                            r->length,
-                            r->taper_deg,
-                            r->area_change,
-                            r->area_change_percent,
-                            r->wall_force_x,
-                            r->wall_force_y,
-                            r->base_force_x,
-                            r->base_force_y,
-                            r->front_x,
-                            r->wall_x};
+        const double v[] = {r->shortening,       r->shortening_percent,
+                            r->height,           r->length,
+                            r->length_thickened, r->taper_deg,
+                            r->area_change,      r->area_change_percent,
+                            r->wall_force_x,     r->wall_force_y,
+                            r->base_force_x,     r->base_force_y,
+                            r->front_x,          r->wall_x};
         for (size_t j = 0; j < sizeof v / sizeof v[0]; j++)
             put(f, v[j], ",");
         fprintf(f, "%zu\n", r->n_fitted);

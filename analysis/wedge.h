@@ -50,9 +50,11 @@ typedef struct {
     double shortening_percent;  /* 100 x shortening / length0 */
     double height;              /* m, highest column top - top0 (0 at the reference) */
     double length;              /* m, wall face - front_x (0 when nothing is deformed) */
-    double taper_deg;           /* degrees, atan of the least-squares slope of the column tops
-                                   from front_x to the wall (positive: rising towards the
-                                   wall); NaN with fewer than 2 columns */
+    double length_thickened;    /* m, wall face - the left edge of the farthest column whose
+                                   top rose by more than the threshold (0: none) */
+    double taper_deg;           /* degrees, atan of the least-squares slope of the column
+                                   tops over the thickened zone (positive: rising towards
+                                   the wall); NaN with fewer than 2 columns */
     double area_change;         /* m^2 per m, area under the column tops - area0 */
     double area_change_percent; /* 100 x area_change / area0 */
     double wall_force_x;        /* N, mean boundary_force_x of the series samples of the

@@ -87,6 +87,7 @@ static void test_wedge_triangle_exact(void **state) {
     assert_near(row.height, 975.0, 1e-9);
     assert_near(row.front_x, 2000.0, 1e-9);
     assert_near(row.length, 2000.0, 1e-9);
+    assert_near(row.length_thickened, 2000.0, 1e-9);
     assert_near(row.taper_deg, atan(0.5) / deg, 1e-9);
     assert_int_equal(row.n_fitted, 20);
     /* midpoint sums of a linear rise are exact: the triangle's area 1/2 H L */
@@ -101,7 +102,36 @@ static void test_wedge_triangle_exact(void **state) {
     assert_int_equal(cdem_wedge_measure(&r, &ref, &cur, &row, &err), CDEM_OK);
     assert_near(row.front_x, 2200.0, 1e-9);
     assert_near(row.length, 1800.0, 1e-9);
+    assert_near(row.length_thickened, 1800.0, 1e-9);
     assert_near(row.taper_deg, atan(0.5) / deg, 1e-9);
+    cdem_state_free(&ref);
+    cdem_state_free(&cur);
+}
+
+/* Columns 10..19 moved (down 200 m) without thickening: the deformed zone reaches them,
+ * the thickened zone (and the taper fit) does not. */
+static void test_wedge_moved_but_not_thickened(void **state) {
+    (void)state;
+    cdem_state ref = {0}, cur = {0};
+    cdem_error err;
+    make_lattice(&ref, 40, 10);
+    assert_int_equal(cdem_state_copy(&cur, &ref, &err), CDEM_OK);
+    lift_triangle(&cur, 40, 20, 1000.0);
+    for (size_t i = 0; i < cur.n; i++)
+        if (!(cur.flags[i] & CDEM_FLAGS_BOUNDARY) && cur.x[i] > 1000.0 && cur.x[i] < 2000.0)
+            cur.y[i] -= 200.0;
+    cdem_wedge_options opt = {.threshold = 1.0};
+    cdem_wedge_ref r;
+    cdem_wedge_row row;
+    assert_int_equal(cdem_wedge_reference(&ref, &opt, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_wedge_measure(&r, &ref, &cur, &row, &err), CDEM_OK);
+    assert_near(row.front_x, 1000.0, 1e-9);
+    assert_near(row.length, 3000.0, 1e-9);
+    assert_near(row.length_thickened, 2000.0, 1e-9);
+    assert_near(row.taper_deg, atan(0.5) / deg, 1e-9);
+    assert_int_equal(row.n_fitted, 20);
+    assert_near(row.height, 975.0, 1e-9);
+    assert_near(row.area_change, 1.0e6 - 10 * 100.0 * 200.0, 1e-3);
     cdem_state_free(&ref);
     cdem_state_free(&cur);
 }
@@ -116,7 +146,7 @@ static void test_wedge_flat_state_zero(void **state) {
     assert_int_equal(cdem_wedge_reference(&ref, NULL, &r, &err), CDEM_OK);
     assert_int_equal(cdem_wedge_measure(&r, &ref, &ref, &row, &err), CDEM_OK);
     assert_true(row.height == 0.0);
-    assert_true(row.length == 0.0);
+    assert_true(row.length == 0.0 && row.length_thickened == 0.0);
     assert_true(row.area_change == 0.0);
     assert_true(isnan(row.taper_deg));
     assert_true(isnan(row.front_x));
@@ -149,6 +179,7 @@ static void test_wedge_uniform_thickening(void **state) {
     assert_near(row.wall_x, 3200.0, 1e-9);
     assert_near(row.front_x, 0.0, 1e-9); /* every column moved: the whole layer */
     assert_near(row.length, 3200.0, 1e-9);
+    assert_near(row.length_thickened, 3200.0, 1e-9);
     assert_near(row.taper_deg, 0.0, 1e-9);
     /* top row at 950 / 0.8 + 50 = 1237.5 m, 237.5 m above the initial 1000 m */
     assert_near(row.height, 237.5, 1e-9);
@@ -266,6 +297,7 @@ static void test_wedge_csv_round_trip(void **state) {
                                    .shortening_percent = 1.0 / 3.0 * k,
                                    .height = 1234.5678901 * k,
                                    .length = 2000.0 + k,
+                                   .length_thickened = 1500.0 - k,
                                    .taper_deg = k ? 7.25 * k : NAN,
                                    .area_change = -1.5e6 * k,
                                    .area_change_percent = -2.5 * k,
@@ -287,13 +319,14 @@ static void test_wedge_csv_round_trip(void **state) {
     cdem_csvtable t;
     assert_int_equal(cdem_csvtable_read(path, &t, &err), CDEM_OK);
     assert_int_equal(t.n_rows, 3);
-    assert_int_equal(t.n_cols, 16);
+    assert_int_equal(t.n_cols, 17);
     static const char *const names[] = {"increment",
                                         "step",
                                         "shortening_m",
                                         "shortening_percent",
                                         "height_m",
                                         "length_m",
+                                        "length_thickened_m",
                                         "taper_deg",
                                         "area_change_m2",
                                         "area_change_percent",
@@ -306,23 +339,16 @@ static void test_wedge_csv_round_trip(void **state) {
                                         "n_fitted"};
     for (int k = 0; k < 3; k++) {
         const cdem_wedge_row *r = &rows[k];
-        const double want[16] = {r->number,
-                                 (double)r->step,
-                                 r->shortening,
-                                 r->shortening_percent,
-                                 r->height,
-                                 r->length,
-                                 r->taper_deg,
-                                 r->area_change,
-                                 r->area_change_percent,
-                                 r->wall_force_x,
-                                 r->wall_force_y,
-                                 r->base_force_x,
-                                 r->base_force_y,
-                                 r->front_x,
-                                 r->wall_x,
+        const double want[17] = {r->number,           (double)r->step,
+                                 r->shortening,       r->shortening_percent,
+                                 r->height,           r->length,
+                                 r->length_thickened, r->taper_deg,
+                                 r->area_change,      r->area_change_percent,
+                                 r->wall_force_x,     r->wall_force_y,
+                                 r->base_force_x,     r->base_force_y,
+                                 r->front_x,          r->wall_x,
                                  (double)r->n_fitted};
-        for (int c = 0; c < 16; c++) {
+        for (int c = 0; c < 17; c++) {
             size_t col;
             assert_int_equal(cdem_csvtable_find(&t, names[c], path, &col, &err), CDEM_OK);
             const double got = t.values[(size_t)k * t.n_cols + col];
@@ -472,6 +498,7 @@ static void test_wedge_refuses_a_run_without_moving_wall(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_wedge_triangle_exact),
+        cmocka_unit_test(test_wedge_moved_but_not_thickened),
         cmocka_unit_test(test_wedge_flat_state_zero),
         cmocka_unit_test(test_wedge_uniform_thickening),
         cmocka_unit_test(test_wedge_errors_name_the_problem),
