@@ -150,6 +150,7 @@ static const struct {
 } known_labels[] = {
     {"shortening_m", "Shortening (m)"},         {"shortening_percent", "Shortening (%)"},
     {"height_m", "Wedge height (m)"},           {"length_m", "Wedge length (m)"},
+    {"length_thickened_m", "Thickened length (m)"},
     {"taper_deg", "Surface taper (deg)"},       {"area_change_m2", "Area change (m^2)"},
     {"area_change_percent", "Area change (%)"}, {"wall_force_x_N", "Wall force x (N)"},
     {"wall_force_y_N", "Wall force y (N)"},     {"base_force_x_N", "Base force x (N)"},
