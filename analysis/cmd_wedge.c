@@ -26,7 +26,11 @@ static int usage(const char *cmd, const char *what, const char *synopsis) {
 }
 
 static int fail(const char *cmd, const cdem_error *err) {
-    fprintf(stderr, "cdem-strain %s: %s\n", cmd, err->msg[0] ? err->msg : "unknown error");
+    const char *m = err->msg[0] ? err->msg : "unknown error";
+    const size_t len = strlen(cmd);
+    if (!strncmp(m, cmd, len) && m[len] == ':' && m[len + 1] == ' ')
+        m += len + 2; /* "wedge: ..." from the library: the command already names it */
+    fprintf(stderr, "cdem-strain %s: %s\n", cmd, m);
     return 1;
 }
 

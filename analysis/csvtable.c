@@ -29,7 +29,31 @@ static char *trim(char *s) {
     return s;
 }
 
+/* 1 when s is valid UTF-8 without control characters (a text header, not binary data). */
+static int is_text(const char *s) {
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int more = *p < 0x80             ? 0
+                   : (*p & 0xE0) == 0xC0 ? 1
+                   : (*p & 0xF0) == 0xE0 ? 2
+                   : (*p & 0xF8) == 0xF0 ? 3
+                                         : -1;
+        if (more < 0 || (*p < 0x20 && *p != '\t') || *p == 0x7f)
+            return 0;
+        p++;
+        for (; more > 0; more--, p++)
+            if ((*p & 0xC0) != 0x80)
+                return 0;
+    }
+    return 1;
+}
+
 static cdem_status parse_header(char *line, const char *path, cdem_csvtable *t, cdem_error *err) {
+    if (!is_text(line))
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "%s:1: the header line is not text (binary data?): a CSV file with a "
+                         "header line of column names is needed",
+                         path);
     size_t n = 1;
     for (const char *p = line; *p; p++)
         n += *p == ',';

@@ -383,6 +383,12 @@ static void test_wedge_csv_round_trip(void **state) {
     fclose(f);
     assert_int_equal(cdem_csvtable_read(path, &t, &err), CDEM_ERR_PARSE);
     assert_non_null(strstr(err.msg, "empty file"));
+    f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs("\x89HDF\r\n\x1a\n", f);
+    fclose(f);
+    assert_int_equal(cdem_csvtable_read(path, &t, &err), CDEM_ERR_PARSE);
+    assert_non_null(strstr(err.msg, "not text (binary data?)"));
     remove(path);
     assert_int_equal(cdem_csvtable_read(path, &t, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, "cannot open"));
