@@ -146,18 +146,23 @@ int cdem_cmd_wedge(int argc, char **argv) {
 /* ---------------------------------------------------------------- plot-csv */
 static const char plot_csv_synopsis[] =
     "A.csv [B.csv ...] --x COLUMN --y COLUMN[,COLUMN...] -o OUT.png|.pdf|.svg [--labels "
-    "L1,L2,...] [--columns N] [--width N] [--height N]";
+    "L1,L2,...] [--columns N] [--legend K] [--width N] [--height N]";
 
 /* Axis labels of the wedge table's columns; other columns are labelled by their name. */
 static const struct {
     const char *name, *label;
 } known_labels[] = {
-    {"shortening_m", "Shortening (m)"},         {"shortening_percent", "Shortening (%)"},
-    {"height_m", "Wedge height (m)"},           {"length_m", "Wedge length (m)"},
+    {"shortening_m", "Shortening (m)"},
+    {"shortening_percent", "Shortening (%)"},
+    {"height_m", "Wedge height (m)"},
+    {"length_m", "Wedge length (m)"},
     {"length_thickened_m", "Thickened length (m)"},
-    {"taper_deg", "Surface taper (deg)"},       {"area_change_m2", "Area change (m^2)"},
-    {"area_change_percent", "Area change (%)"}, {"wall_force_x_N", "Wall force x (N)"},
-    {"wall_force_y_N", "Wall force y (N)"},     {"base_force_x_N", "Base force x (N)"},
+    {"taper_deg", "Surface taper (deg)"},
+    {"area_change_m2", "Area change (m^2)"},
+    {"area_change_percent", "Area change (%)"},
+    {"wall_force_x_N", "Wall force x (N)"},
+    {"wall_force_y_N", "Wall force y (N)"},
+    {"base_force_x_N", "Base force x (N)"},
     {"base_force_y_N", "Base force y (N)"},
 };
 
@@ -179,8 +184,8 @@ static void base_label(const char *path, char *buf, size_t n) {
 
 cdem_status cdem_cmd_plot_csv_figure(const char *const *files, const char *const *labels,
                                      size_t n_files, const char *xcol, const char *const *ycols,
-                                     size_t n_y, int ncols, int width, int height, const char *out,
-                                     cdem_error *err) {
+                                     size_t n_y, int ncols, int legend, int width, int height,
+                                     const char *out, cdem_error *err) {
     if (!files || !xcol || !ycols || !out)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "plot-csv: NULL argument");
     if (n_files < 1 || n_files > MAX_CSV_FILES)
@@ -245,7 +250,7 @@ cdem_status cdem_cmd_plot_csv_figure(const char *const *files, const char *const
                                 .ylabel = label_of(ycols[j]),
                                 .series = ser[j],
                                 .n_series = n_files,
-                                .no_legend = j != 0}; /* one legend (first panel) */
+                                .no_legend = (int)j + 1 != legend}; /* one legend */
     }
     if (st == CDEM_OK) {
         const size_t nc = (size_t)ncols < n_y ? (size_t)ncols : n_y;
@@ -320,14 +325,14 @@ int cdem_cmd_plot_csv(int argc, char **argv) {
     const char *cmd = "plot-csv", *x = NULL, *y = NULL, *out = NULL, *labels = NULL;
     const char *files[MAX_CSV_FILES];
     size_t n_files = 0;
-    int ncols = 3, width = 0, height = 0;
+    int ncols = 3, legend = 1, width = 0, height = 0;
     for (int i = 1; i < argc; i++) {
         int missing = 0;
         const char *v;
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             printf("usage: cdem-strain plot-csv %s\n\nOne panel per --y column (a grid of "
-                   "--columns panels across, default 3), one curve per CSV file (legend: "
-                   "--labels or the file names).\n",
+                   "--columns panels across, default 3), one curve per CSV file (legend on "
+                   "panel --legend K, default 1, 0 = none: --labels or the file names).\n",
                    plot_csv_synopsis);
             return 0;
         }
@@ -340,7 +345,11 @@ int cdem_cmd_plot_csv(int argc, char **argv) {
             out = v;
         else if ((v = opt_value(argc, argv, &i, "--labels", &missing)))
             labels = v;
-        else if ((v = opt_value(argc, argv, &i, "--columns", &missing))) {
+        else if ((v = opt_value(argc, argv, &i, "--legend", &missing))) {
+            if (!parse_int_range(v, 0, MAX_Y_COLUMNS, &legend))
+                return usage(cmd, "--legend must be a panel number from 1 to 16 (0 = no legend)",
+                             plot_csv_synopsis);
+        } else if ((v = opt_value(argc, argv, &i, "--columns", &missing))) {
             if (!parse_int_range(v, 1, MAX_Y_COLUMNS, &ncols))
                 return usage(cmd, "--columns must be a whole number from 1 to 16",
                              plot_csv_synopsis);
@@ -389,8 +398,8 @@ int cdem_cmd_plot_csv(int argc, char **argv) {
     if (!height)
         height = (int)(380 * ((ny + nc - 1) / nc));
     cdem_error err;
-    if (cdem_cmd_plot_csv_figure(files, labels ? lab : NULL, n_files, x, ycols, ny, ncols, width,
-                                 height, out, &err) != CDEM_OK)
+    if (cdem_cmd_plot_csv_figure(files, labels ? lab : NULL, n_files, x, ycols, ny, ncols, legend,
+                                 width, height, out, &err) != CDEM_OK)
         return fail(cmd, &err);
     return 0;
 }

@@ -481,6 +481,17 @@ static void test_wedge_end_to_end_detachment(void **state) {
     assert_int_equal(fread(sig, 1, 8, f), 8);
     fclose(f);
     assert_memory_equal(sig, "\x89PNG\r\n\x1a\n", 8);
+    snprintf(cmd, sizeof cmd,
+             "'%s/cdem-strain' plot-csv '%s/w.csv' --x shortening_m --y height_m --legend 0 "
+             "-o '%s/g.svg'",
+             bin, dir, dir);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd,
+             "'%s/cdem-strain' plot-csv '%s/w.csv' --x shortening_m --y height_m --legend 17 "
+             "-o '%s/g.svg'",
+             bin, dir, dir);
+    assert_int_equal(run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--legend must be a panel number"));
     /* usage and column errors */
     snprintf(cmd, sizeof cmd,
              "'%s/cdem-strain' plot-csv '%s/w.csv' --x shortening_m --y nope -o '%s/g.png'", bin,
