@@ -150,7 +150,8 @@ static const char plot_csv_synopsis[] =
 
 /* Axis labels of the wedge table's columns; other columns are labelled by their name. */
 static const struct {
-    const char *name, *label;
+    const char *name;  /* CSV column name */
+    const char *label; /* axis label with unit */
 } known_labels[] = {
     {"shortening_m", "Shortening (m)"},
     {"shortening_percent", "Shortening (%)"},

@@ -24,10 +24,14 @@ static double moving_wall_face(const cdem_state *s, double x_mid) {
     return face;
 }
 
-/* Extent of the free elements: left face, right face, bottom, largest and mean radius. */
+/* Extent of the free elements of a state. */
 typedef struct {
-    double left, right, bottom, rmax, rmean;
-    size_t n;
+    double left;   /* m, min (x - r); +inf when there are none */
+    double right;  /* m, max (x + r); -inf when there are none */
+    double bottom; /* m, min (y - r); +inf when there are none */
+    double rmax;   /* m, largest radius, >= 0 */
+    double rmean;  /* m, mean radius, >= 0 */
+    size_t n;      /* free elements counted */
 } extent;
 
 static extent free_extent(const cdem_state *s) {
