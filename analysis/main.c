@@ -7,6 +7,7 @@
 #include "analysis.h"
 #include "cmd_render.h"
 #include "cmd_plot.h"
+#include "cmd_wedge.h"
 #include "biaxial.h"
 #include "cdem2d.h"
 #include "outfile.h"
@@ -415,6 +416,12 @@ static void print_help(void) {
            "RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT.png]");
     printf("  %-15s %s\n  %-15s   %s\n", "repose", "angle of repose of the free surface", "",
            "RUN.h5 [--increment K] [-o OUT.png]");
+    printf("  %-15s %s\n  %-15s   %s\n", "wedge",
+           "accretionary-wedge height, length, taper, area, forces", "",
+           "RUN.h5 [-o OUT.csv] [--increment K|last|all] [--threshold M]");
+    printf("  %-15s %s\n  %-15s   %s\n", "plot-csv",
+           "curves of CSV columns, several files per panel", "",
+           "A.csv [B.csv ...] --x COL --y COL[,COL...] -o OUT.png [--columns N]");
     printf("\nQuantities, formulas and rules: docs/analysis.md; text formats: "
            "docs/formats-text.md.\nExit status: 0 success, 1 error, 2 usage error.\n");
 }
@@ -488,6 +495,10 @@ int main(int argc, char **argv) {
         return cdem_cmd_plot_mohr(argc - 1, argv + 1);
     if (!strcmp(argv[1], "repose"))
         return cdem_cmd_plot_repose(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "wedge"))
+        return cdem_cmd_wedge(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "plot-csv"))
+        return cdem_cmd_plot_csv(argc - 1, argv + 1);
     options o;
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(argv[1], commands[i].name)) {

@@ -1,15 +1,11 @@
 /* repose: see repose.h. */
 #include "repose.h"
+#include "surface.h"
 
 #include <gsl/gsl_fit.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int free_element(const cdem_state *s, size_t i) {
-    return !(s->flags[i] & CDEM_FLAGS_BOUNDARY) && isfinite(s->x[i]) && isfinite(s->y[i]) &&
-           isfinite(s->radius[i]) && s->radius[i] > 0;
-}
 
 cdem_status cdem_repose_measure(const cdem_state *s, cdem_repose_result *res, cdem_error *err) {
     if (!s || !res)
@@ -17,7 +13,7 @@ cdem_status cdem_repose_measure(const cdem_state *s, cdem_repose_result *res, cd
     memset(res, 0, sizeof *res);
     double rmax = 0, xmin = INFINITY, xmax = -INFINITY;
     for (size_t i = 0; i < s->n; i++)
-        if (free_element(s, i)) {
+        if (cdem_surface_is_free(s, i)) {
             rmax = fmax(rmax, s->radius[i]);
             xmin = fmin(xmin, s->x[i]);
             xmax = fmax(xmax, s->x[i]);
@@ -40,17 +36,7 @@ cdem_status cdem_repose_measure(const cdem_state *s, cdem_repose_result *res, cd
         free(fy);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "repose: no memory for %zu columns", nc);
     }
-    for (size_t c = 0; c < nc; c++)
-        top[c] = SIZE_MAX;
-    for (size_t i = 0; i < s->n; i++) {
-        if (!free_element(s, i))
-            continue;
-        size_t c = (size_t)floor((s->x[i] - xmin) / cw);
-        if (c >= nc)
-            c = nc - 1;
-        if (top[c] == SIZE_MAX || s->y[i] + s->radius[i] > s->y[top[c]] + s->radius[top[c]])
-            top[c] = i;
-    }
+    cdem_surface_column_tops(s, xmin, cw, nc, -INFINITY, INFINITY, top);
     double lo = INFINITY, hi = -INFINITY;
     size_t crest = SIZE_MAX;
     for (size_t c = 0; c < nc; c++)
