@@ -3,7 +3,8 @@
 # Idempotent and quiet when everything is present. Must run as root (or with sudo).
 set -eu
 PKGS="gcc make pkg-config libhdf5-dev hdf5-tools libgsl-dev libcairo2-dev libcmocka-dev \
-libgif-dev libxml2-utils python3 python3-numpy python3-scipy python3-h5py"
+libgif-dev libxml2-utils python3 python3-numpy python3-scipy python3-h5py \
+python3-pil"  # python3-pil: examples/montage.py tiles the example figures
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

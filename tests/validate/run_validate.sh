@@ -12,7 +12,9 @@
 #     softens, and the confined peak is above the unconfined one;
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
-#  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth.
+#  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
+#  8. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
+#     analyses and pictures; a few minutes on 2 cores).
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -92,6 +94,8 @@ PYEOF
 
 check stress-run "$RUN" -q -o "$TMP/stress.h5" -s physics.calculate_stress=on -s time.runtime=410
 check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
+
+check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
