@@ -21,8 +21,12 @@ CDEM_STRAIN  := $(BUILD)/cdem-strain
 NICE         ?= 10
 PYTHON       ?= /usr/bin/python3
 
+# EXAMPLES_OUT=DIR puts this folder's results in DIR/<folder> instead (make validate uses a
+# scratch directory, so it always runs the current programs and leaves out*/ alone).
 QUICK ?=
-ifeq ($(QUICK),1)
+ifneq ($(EXAMPLES_OUT),)
+OUT := $(EXAMPLES_OUT)/$(notdir $(CURDIR))
+else ifeq ($(QUICK),1)
 OUT := out-quick
 else
 OUT := out

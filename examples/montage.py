@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """Tiles PNG pictures made by cdem-strain into one figure for a README.
 
-usage: montage.py OUT.png COLUMNS [--width PX] [--title T1] IN1.png [--title T2] IN2.png ...
+usage: montage.py OUT.png COLUMNS [--width PX] [--max-kb KB] [--title T1] IN1.png [--title T2] IN2.png ...
 
 COLUMNS is the number of pictures per row, or a comma list per row ("1,2": one picture in
 the first row, two in the next and every later row). Each input is scaled to its column
-width (total width PX, default 1000) and may carry a title line above it. The result is saved as a palette PNG (256 colours) so that it stays
-small (a few hundred KB at 1000 px). Needs Pillow (python3-pil)."""
+width (total width PX, default 1000) and may carry a title line above it. The result is
+saved as a palette PNG of at most --max-kb KB (default 300: fewer colours first, then a
+smaller size). Needs Pillow (python3-pil)."""
+import os
 import sys
 from PIL import Image, ImageDraw, ImageFont
 
@@ -14,12 +16,14 @@ def main(argv):
     if len(argv) < 4:
         sys.exit(__doc__)
     out, cols = argv[1], [int(c) for c in argv[2].split(",")]
-    width, title, items = 1000, None, []
+    width, title, items, max_kb = 1000, None, [], 300
     args = argv[3:]
     i = 0
     while i < len(args):
         if args[i] == "--width":
             width = int(args[i + 1]); i += 2; continue
+        if args[i] == "--max-kb":
+            max_kb = int(args[i + 1]); i += 2; continue
         if args[i] == "--title":
             title = args[i + 1]; i += 2; continue
         items.append((args[i], title)); title = None; i += 1
@@ -54,7 +58,13 @@ def main(argv):
         for c, t in enumerate(ts):
             sheet.paste(t, (c * colw, y))
         y += max(t.height for t in ts)
-    sheet.quantize(colors=256, method=Image.Quantize.MEDIANCUT).save(out, optimize=True)
+    # Keep README pictures small (<= max_kb): fewer colours first, then a smaller size.
+    for colors, scale in ((256, 1.0), (128, 1.0), (64, 1.0), (64, 0.85), (64, 0.7), (32, 0.6)):
+        im = sheet if scale == 1.0 else sheet.resize(
+            (round(sheet.width * scale), round(sheet.height * scale)), Image.LANCZOS)
+        im.quantize(colors=colors, method=Image.Quantize.MEDIANCUT).save(out, optimize=True)
+        if os.path.getsize(out) <= max_kb * 1024:
+            break
 
 if __name__ == "__main__":
     main(sys.argv)

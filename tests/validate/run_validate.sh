@@ -95,7 +95,7 @@ PYEOF
 check stress-run "$RUN" -q -o "$TMP/stress.h5" -s physics.calculate_stress=on -s time.runtime=410
 check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
 
-check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD"
+check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
