@@ -63,14 +63,14 @@ MONTAGE = $(PYTHON) $(EXAMPLES_DIR)/montage.py
 
 # The standard pipeline of one simulation NAME (from NAME.ini), used by the folders:
 #   $(OUT)/NAME.h5         the run (extra -s overrides: $(Q_NAME) when QUICK=1, $(S_NAME) always)
-#   $(OUT)/NAME-layers.png last increment, layer colours
+#   $(OUT)/NAME-layers.png last increment, layer colours (extra render options: $(R_NAME))
 #   $(OUT)/NAME-shear.png  last increment, total maximum shear strain
 #   $(OUT)/NAME-info.txt   summary, stop reason and increments (cdem-strain info)
 $(OUT)/%.h5: %.ini | $(TOOLS)
 	$(call simulate,$<,$@,$(S_$*) $(call quick,$(Q_$*)))
 $(OUT)/%-layers.png: $(OUT)/%.h5
-	$(RENDER) $< --increment last -o $@
+	$(RENDER) $< --increment last $(R_$*) -o $@
 $(OUT)/%-shear.png: $(OUT)/%.h5
-	$(RENDER) $< --increment last --color total-max-shear -o $@
+	$(RENDER) $< --increment last --color total-max-shear $(R_$*) -o $@
 $(OUT)/%-info.txt: $(OUT)/%.h5
 	$(CDEM_STRAIN) info $< > $@
