@@ -19,6 +19,10 @@ BUILD        ?= $(ROOT)/build
 CDEM_RUN     := $(BUILD)/cdem-run
 CDEM_STRAIN  := $(BUILD)/cdem-strain
 NICE         ?= 10
+# Idle OpenMP threads sleep instead of spinning (5x faster on a loaded machine,
+# docs/performance.md); results do not depend on it.
+OMP_WAIT_POLICY ?= passive
+export OMP_WAIT_POLICY
 PYTHON       ?= /usr/bin/python3
 
 # EXAMPLES_OUT=DIR puts this folder's results in DIR/<folder> instead (make validate uses a
