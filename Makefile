@@ -108,3 +108,8 @@ clean:
 	rm -rf build build-asan build-fuzz
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+
+# Man pages from the programs' --help text (tests/test_man.c fails when they are stale).
+.PHONY: man
+man: all
+	/usr/bin/python3 scripts/help2roff.py $(BUILD) man

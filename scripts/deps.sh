@@ -6,7 +6,8 @@ set -eu
 # clang) are for `make fuzz` only (tests/fuzz/README.md).
 PKGS="gcc make pkg-config libhdf5-dev hdf5-tools libgsl-dev libcairo2-dev libcmocka-dev \
 libgif-dev libxml2-utils python3 python3-numpy python3-scipy python3-h5py \
-clang libclang-rt-14-dev libomp-14-dev"
+clang libclang-rt-14-dev libomp-14-dev \
+    python3-pil"  # python3-pil: examples/montage.py tiles the example figures
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -15,6 +15,8 @@
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
 #  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c).
+#  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
+#     analyses and pictures; a few minutes on 2 cores).
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -105,6 +107,7 @@ check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
 #    left behind opens and every increment it lists loads (docs/reliability.md).
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
+check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1,0 +1,173 @@
+#!/usr/bin/python3
+"""Lists every error message cdem-run and cdem-strain can print, from the sources: each
+CDEM_FAIL(err, CODE, "format", ...) in common/, solver/ and analysis/, and the usage
+messages printed by the two main programs. Writes markdown to stdout (docs/errors.md is
+made with it: /usr/bin/python3 scripts/error_catalogue.py > docs/errors.md).
+
+printf conversions are shown as <...> (a file name, a value, a line number...)."""
+import glob
+import os
+import re
+import sys
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+
+GROUPS = [  # (title, source files, what to do)
+    ("Parameter files and -s overrides", ["common/params.c", "common/model.c", "common/summary.c"],
+     "The message names the file, line, key and value and says what is allowed: correct that "
+     "line (or the -s argument). `cdem-run --print-defaults` writes a valid file to start "
+     "from; docs/parameters.md lists every key, range and rule between keys."),
+    ("Fault vertex files (irregular-fault)", ["solver/fault_file.c"],
+     "Fix the named line of the vertex file: two numbers `x y` in metres per line; first point "
+     "at (fault_location x width x unit_scaling, 0); every later point at lower x and higher y. "
+     "The path is relative to the directory cdem-run runs in."),
+    ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
+      "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
+      "solver/run.c", "solver/sediment.c", "solver/integrate.c", "solver/contact.c", "solver/neighbour.c",
+      "solver/assembly.c", "solver/stress.c"],
+     "Combinations the mode cannot build are refused before the run (change the named key); "
+     "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
+     "`keep_constants = off` at small unit scaling or use the default constants; "
+     "\"settling > displacement\" gives the display_interval and equilibration that work."),
+    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c"],
+     "The file is not a cdem file, is truncated (a run killed while writing: re-run it), of "
+     "another format version (re-run with this cdem-run), or the increment/dataset asked for "
+     "does not exist (`cdem-strain info RUN.h5` lists the increments). A file left open by a "
+     "crashed writer can be cleared with `h5clear -s RUN.h5`."),
+    ("cdem2D import", ["analysis/cdem2d.c"],
+     "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
+     "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "
+     "(modelforces_N.txt); docs/formats-text.md."),
+    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/analysis.c", "analysis/strain.c",
+      "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "analysis/cellgrid.c",
+      "analysis/biaxial.c", "analysis/repose.c", "analysis/mohr.c", "analysis/qexport.c", "analysis/sspx.c"],
+     "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
+     "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "
+     "runs at two or more different confining pressures; repose needs a repose run."),
+    ("Pictures, plots and GIFs", ["analysis/render.c", "analysis/cmd_render.c", "analysis/plot.c",
+      "analysis/cmd_plot.c", "analysis/gif.c", "analysis/colormap.c"],
+     "Check the output name's extension (.png, .pdf, .svg; .gif for --gif), that the output "
+     "directory exists and is writable, the option values (sizes, colours #RRGGBB, zoom "
+     "window, ranges MIN,MAX) and, for plot-series, the column names (`h5ls RUN.h5/series`)."),
+]
+
+
+def c_strings(args):
+    """Concatenates the C string literals at the start of an argument."""
+    return "".join(re.findall(r'"((?:[^"\\]|\\.)*)"', args))
+
+
+def calls(text, token="CDEM_FAIL("):
+    i = 0
+    while True:
+        i = text.find(token, i)
+        if i < 0:
+            return
+        j, depth, in_str = i + len(token), 1, False
+        while j < len(text) and depth:
+            ch = text[j]
+            if in_str:
+                if ch == "\\":
+                    j += 1
+                elif ch == '"':
+                    in_str = False
+            elif ch == '"':
+                in_str = True
+            elif ch == "(":
+                depth += 1
+            elif ch == ")":
+                depth -= 1
+            j += 1
+        yield i, text[i + len(token):j - 1]
+        i = j
+
+
+def split_args(s):
+    out, depth, in_str, cur = [], 0, False, ""
+    k = 0
+    while k < len(s):
+        ch = s[k]
+        if in_str:
+            cur += ch
+            if ch == "\\":
+                cur += s[k + 1]; k += 1
+            elif ch == '"':
+                in_str = False
+        elif ch == '"':
+            in_str = True; cur += ch
+        elif ch in "([{":
+            depth += 1; cur += ch
+        elif ch in ")]}":
+            depth -= 1; cur += ch
+        elif ch == "," and depth == 0:
+            out.append(cur.strip()); cur = ""
+        else:
+            cur += ch
+        k += 1
+    out.append(cur.strip())
+    return out
+
+
+def show(fmt):
+    fmt = fmt.replace('\\"', '"').replace("\\n", " ").replace("\\t", " ")
+    fmt = re.sub(r"%[-+ #0]*[0-9*]*(?:\.[0-9*]+)?(?:hh|h|ll|l|z|j|t)?[diouxXeEfgGcsp]", "<…>", fmt)
+    return fmt.replace("%%", "%").replace("|", "\\|")
+
+
+def main():
+    files = sorted(glob.glob(os.path.join(ROOT, d, "*.c")) for d in ("common", "solver", "analysis"))
+    files = [f for group in files for f in group]
+    rows = {}
+    for path in files:
+        rel = os.path.relpath(path, ROOT)
+        text = open(path, encoding="utf-8").read()
+        for pos, args in calls(text):
+            a = split_args(args)
+            if len(a) < 3:
+                continue
+            line = text.count("\n", 0, pos) + 1
+            code = a[1].replace("CDEM_ERR_", "").lower()
+            fmt = c_strings(a[2])
+            if not fmt:
+                fmt = "(message built at run time: " + a[2] + ")"
+            rows.setdefault(rel, []).append((line, code, show(fmt)))
+        # parameter rules collected by cdem_params_validate and reported together
+        for pos, args in calls(text, "rule_add(&log,"):
+            fmt = c_strings(split_args(args)[0])
+            if fmt:
+                line = text.count("\n", 0, pos) + 1
+                rows.setdefault(rel, []).append((line, "rule", show(fmt)))
+    print("# Error messages of cdem-run and cdem-strain")
+    print()
+    print("Generated by `/usr/bin/python3 scripts/error_catalogue.py > docs/errors.md` from the")
+    print("`CDEM_FAIL` calls in common/, solver/ and analysis/ and the parameter rules of")
+    print("`cdem_params_validate` (kind \"rule\": reported together, one per line, after \"the")
+    print("parameters cannot be used as they are:\"); do not edit by hand. `<…>` stands")
+    print("for a value filled in at run time (a file name, line, key, value). The programs print")
+    print("`cdem-run: <message>` or `cdem-strain: <message>` and exit with status 1 (2 for usage")
+    print("errors). What to do for each group is in docs/guide.md, section Troubleshooting; the")
+    print("group's advice is repeated here.")
+    print()
+    done = set()
+    total = 0
+    for title, srcs, fix in GROUPS + [("Other", sorted(rows), "See the message; it names what is wrong.")]:
+        srcs = [s for s in srcs if s in rows and s not in done]
+        if not srcs:
+            continue
+        print(f"## {title}")
+        print()
+        print(fix)
+        print()
+        print("| source | kind | message |")
+        print("|---|---|---|")
+        for s in srcs:
+            done.add(s)
+            for line, code, msg in rows[s]:
+                print(f"| {s}:{line} | {code} | {msg} |")
+                total += 1
+        print()
+    print(f"{total} messages.")
+
+
+if __name__ == "__main__":
+    main()

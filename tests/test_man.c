@@ -1,0 +1,181 @@
+/* Tests of the man pages man/cdem-run.1 and man/cdem-strain.1: they are generated from the
+ * programs' --help text by scripts/help2roff.py (`make man`), and must not go stale.
+ * Runs from the repository root (tests/run_tests.sh); programs in $CDEM_BUILD (default
+ * build/); scratch files in $CDEM_TEST_TMP. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+typedef struct {
+    char build[1024]; /* directory of cdem-run and cdem-strain */
+    char tmp[1024];   /* private scratch directory */
+} man_ctx;
+
+static int setup(void **state) {
+    man_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return -1;
+    const char *b = getenv("CDEM_BUILD");
+    snprintf(c->build, sizeof c->build, "%s", b && b[0] ? b : "build");
+    const char *t = getenv("CDEM_TEST_TMP");
+    snprintf(c->tmp, sizeof c->tmp, "%s/test_man_XXXXXX", t && t[0] ? t : "/tmp");
+    if (!mkdtemp(c->tmp)) {
+        free(c);
+        return -1;
+    }
+    *state = c;
+    return 0;
+}
+
+static int teardown(void **state) {
+    man_ctx *c = *state;
+    char cmd[2200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
+    if (system(cmd) != 0)
+        fprintf(stderr, "test_man: could not remove %s\n", c->tmp);
+    free(c);
+    return 0;
+}
+
+/* Reads a whole file into a NUL-terminated buffer (caller frees); NULL when unreadable. */
+static char *slurp(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap);
+    size_t got;
+    while (buf && (got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+        n += got;
+        if (n + 1 == cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    fclose(f);
+    if (buf)
+        buf[n] = '\0';
+    return buf;
+}
+
+/* Runs a shell command; returns its exit status (-1 when it did not exit normally). */
+static int run(const char *cmd) {
+    int rc = system(cmd);
+    return (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : -1;
+}
+
+/* Generates the pages into DIR; returns the generator's exit status. */
+static int generate(const man_ctx *c, const char *dir) {
+    char cmd[4200];
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 scripts/help2roff.py '%s' '%s' 2>&1", c->build,
+             dir);
+    return run(cmd);
+}
+
+/* NULL when the committed page equals the generated one, else a message naming the page. */
+static const char *compare_page(const char *committed, const char *generated, char *msg,
+                                size_t cap) {
+    char *a = slurp(committed), *b = slurp(generated);
+    const char *res = NULL;
+    if (!a || !b)
+        snprintf(msg, cap, "%s or %s cannot be read", committed, generated), res = msg;
+    else if (strcmp(a, b) != 0)
+        snprintf(msg, cap, "%s is stale against --help: run `make man` and commit it", committed),
+            res = msg;
+    free(a);
+    free(b);
+    return res;
+}
+
+static void test_man_pages_match_help(void **state) {
+    man_ctx *c = *state;
+    assert_int_equal(generate(c, c->tmp), 0);
+    const char *pages[] = {"cdem-run.1", "cdem-strain.1"};
+    for (size_t i = 0; i < 2; i++) {
+        char committed[256], generated[2100], msg[2400];
+        snprintf(committed, sizeof committed, "man/%s", pages[i]);
+        snprintf(generated, sizeof generated, "%s/%s", c->tmp, pages[i]);
+        const char *err = compare_page(committed, generated, msg, sizeof msg);
+        if (err)
+            fail_msg("%s", err);
+    }
+}
+
+/* Every long option of cdem-run --help and every cdem-strain command is in the pages. */
+static void test_man_lists_every_option_and_command(void **state) {
+    man_ctx *c = *state;
+    char *run_page = slurp("man/cdem-run.1"), *strain_page = slurp("man/cdem-strain.1");
+    assert_non_null(run_page);
+    assert_non_null(strain_page);
+    const char *options[] = {
+        "\\-o OUT.h5",         "\\-s section.key=value", "\\-\\-summary",
+        "\\-\\-dry\\-run",     "\\-\\-print\\-defaults", "\\-\\-params\\-markdown",
+        "\\-\\-max\\-steps N", "\\-\\-version"};
+    for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
+        if (!strstr(run_page, options[i]))
+            fail_msg("man/cdem-run.1 lacks option %s", options[i]);
+    const char *commands[] = {"info",
+                              "compute",
+                              "element",
+                              "limits",
+                              "export\\-sspx",
+                              "export\\-biaxial",
+                              "import\\-cdem2d",
+                              "quantities",
+                              "render",
+                              "plot\\-series",
+                              "mohr",
+                              "repose"};
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
+        char row[128];
+        snprintf(row, sizeof row, ".TP\n\\fB%s\\fR\n", commands[i]);
+        if (!strstr(strain_page, row))
+            fail_msg("man/cdem-strain.1 lacks command %s", commands[i]);
+    }
+    /* the render options come from `cdem-strain render --help` */
+    assert_non_null(strstr(strain_page, "\\-\\-above\\-tenth\\-max"));
+    assert_non_null(strstr(run_page, ".SH EXIT STATUS\n0 completed, 1 error, 2 usage error"));
+    free(run_page);
+    free(strain_page);
+    (void)c;
+}
+
+/* A page that differs from the generated one is reported as stale, naming it. */
+static void test_man_detects_a_stale_page(void **state) {
+    man_ctx *c = *state;
+    assert_int_equal(generate(c, c->tmp), 0);
+    char page[2100], copy[2100], cmd[4400], msg[2400];
+    snprintf(page, sizeof page, "%s/cdem-run.1", c->tmp);
+    snprintf(copy, sizeof copy, "%s/stale-cdem-run.1", c->tmp);
+    snprintf(cmd, sizeof cmd, "sed 's/print the version and exit/print the version/' '%s' > '%s'",
+             page, copy);
+    assert_int_equal(run(cmd), 0);
+    const char *err = compare_page(copy, page, msg, sizeof msg);
+    assert_non_null(err);
+    assert_non_null(strstr(err, "stale-cdem-run.1 is stale against --help: run `make man`"));
+    assert_null(compare_page(page, page, msg, sizeof msg));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_man_pages_match_help, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_man_lists_every_option_and_command, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_man_detects_a_stale_page, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
