@@ -1973,24 +1973,6 @@ cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_
     return CDEM_OK;
 }
 
-/* Reads `len` leading values of a 1-D numeric dataset, converted to mtype. */
-static int read_prefix(hid_t ds, hid_t mtype, hsize_t len, void *dst) {
-    if (len == 0)
-        return 0;
-    hsize_t start = 0;
-    hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(1, &len, NULL);
-    int ok = fs >= 0 && ms >= 0 &&
-             H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &len, NULL) >= 0 &&
-             H5Dread(ds, mtype, ms, fs, H5P_DEFAULT, dst) >= 0;
-    hid_t es = keep_errors(!ok);
-    if (fs >= 0)
-        H5Sclose(fs);
-    if (ms >= 0)
-        H5Sclose(ms);
-    restore_errors(es);
-    return ok ? 0 : -1;
-}
-
 cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **samples,
                                        size_t *count, cdem_error *err) {
     if (!r || !samples || !count)
@@ -2063,7 +2045,7 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
     for (size_t c = 0; st == CDEM_OK && c < N_SERIES && len > 0; c++) {
         const series_column *sc = &series_columns[c];
         hid_t mt = sc->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
-        if (read_prefix(ds[c], mt, len, col) < 0) {
+        if (read_all_rows(ds[c], mt, len, col) < 0) {
             st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read dataset /series/%s (corrupt?)",
                         r->path, sc->name);
             break;
