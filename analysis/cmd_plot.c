@@ -8,9 +8,6 @@
 
 #include "outfile.h"
 
-#include <cairo-pdf.h>
-#include <cairo-svg.h>
-
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -503,22 +500,9 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
         CDEM_TRY(cdem_render_auto_height(&sc, &o, &h, err));
     cdem_render_layout lay;
     CDEM_TRY(cdem_render_layout_compute(&sc, &o, o.width, h, &lay, err));
-    /* written to OUT.tmp, renamed on success (outfile.h) */
-    cdem_outfile of;
-    CDEM_TRY(cdem_outfile_begin(&of, a->out, err));
-    cairo_surface_t *surf = fmt == CDEM_RENDER_PNG
-                                ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, o.width, h)
-                            : fmt == CDEM_RENDER_PDF ? cairo_pdf_surface_create(of.tmp, o.width, h)
-                                                     : cairo_svg_surface_create(of.tmp, o.width, h);
-    cairo_status_t cs = cairo_surface_status(surf);
-    if (cs != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(surf);
-        return cdem_outfile_end(&of,
-                                CDEM_FAIL(err, CDEM_ERR_IO, "cannot create image file '%s': %s",
-                                          a->out, cairo_status_to_string(cs)),
-                                err);
-    }
-    cairo_t *cr = cairo_create(surf);
+    cdem_render_target t;
+    CDEM_TRY(cdem_render_target_open(&t, a->out, fmt, o.width, h, a->cmd, err));
+    cairo_t *cr = cairo_create(t.surf);
     cdem_status st = cdem_render_draw(cr, o.width, h, &sc, &o, err);
     for (int side = 0; side < 2 && st == CDEM_OK; side++) {
         /* each fitted flank's line, extended by one column at both ends */
@@ -536,19 +520,7 @@ static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int nu
         cairo_stroke(cr);
     }
     cairo_destroy(cr);
-    if (st == CDEM_OK) {
-        if (fmt == CDEM_RENDER_PNG)
-            cs = cairo_surface_write_to_png(surf, of.tmp);
-        else {
-            cairo_surface_finish(surf);
-            cs = cairo_surface_status(surf);
-        }
-        if (cs != CAIRO_STATUS_SUCCESS)
-            st = CDEM_FAIL(err, CDEM_ERR_IO, "cannot write image file '%s': %s", a->out,
-                           cairo_status_to_string(cs));
-    }
-    cairo_surface_destroy(surf);
-    return cdem_outfile_end(&of, st, err);
+    return cdem_render_target_close(&t, st, err);
 }
 
 int cdem_cmd_plot_repose(int argc, char **argv) {

@@ -7,8 +7,6 @@
 #include "render.h"
 #include "wedge.h"
 
-#include <cairo-pdf.h>
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <errno.h>
@@ -256,16 +254,11 @@ cdem_status cdem_cmd_plot_csv_figure(const char *const *files, const char *const
     if (st == CDEM_OK) {
         const size_t nc = (size_t)ncols < n_y ? (size_t)ncols : n_y;
         const size_t nrow = (n_y + nc - 1) / nc;
-        cairo_surface_t *surf =
-            fmt == CDEM_RENDER_PNG ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height)
-            : fmt == CDEM_RENDER_PDF ? cairo_pdf_surface_create(out, width, height)
-                                     : cairo_svg_surface_create(out, width, height);
-        cairo_status_t cs = cairo_surface_status(surf);
-        if (cs != CAIRO_STATUS_SUCCESS)
-            st = CDEM_FAIL(err, CDEM_ERR_IO, "plot-csv: cannot create image file '%s': %s", out,
-                           cairo_status_to_string(cs));
-        cairo_t *cr = st == CDEM_OK ? cairo_create(surf) : NULL;
-        if (cr) {
+        /* written to OUT.tmp, renamed on success (outfile.h) */
+        cdem_render_target t;
+        st = cdem_render_target_open(&t, out, fmt, width, height, "plot-csv", err);
+        if (st == CDEM_OK) {
+            cairo_t *cr = cairo_create(t.surf);
             cairo_set_source_rgb(cr, 1, 1, 1);
             cairo_paint(cr);
             const double pw = (double)width / (double)nc, ph = (double)height / (double)nrow;
@@ -273,19 +266,8 @@ cdem_status cdem_cmd_plot_csv_figure(const char *const *files, const char *const
                 st = cdem_plot_draw(cr, &panels[j], (double)(j % nc) * pw, (double)(j / nc) * ph,
                                     pw, ph, NULL, err);
             cairo_destroy(cr);
+            st = cdem_render_target_close(&t, st, err);
         }
-        if (st == CDEM_OK) {
-            if (fmt == CDEM_RENDER_PNG)
-                cs = cairo_surface_write_to_png(surf, out);
-            else {
-                cairo_surface_finish(surf);
-                cs = cairo_surface_status(surf);
-            }
-            if (cs != CAIRO_STATUS_SUCCESS)
-                st = CDEM_FAIL(err, CDEM_ERR_IO, "plot-csv: cannot write image file '%s': %s", out,
-                               cairo_status_to_string(cs));
-        }
-        cairo_surface_destroy(surf);
     }
     for (size_t f = 0; f < n_files; f++) {
         free(xs[f]);

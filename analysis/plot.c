@@ -5,8 +5,6 @@
 
 #include "outfile.h"
 
-#include <cairo-pdf.h>
-#include <cairo-svg.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -330,23 +328,9 @@ cdem_status cdem_plot_to_file(const char *path, const cdem_plot *panels, size_t 
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "plot: %s: no panel to draw", path);
     for (size_t i = 0; i < n_panels; i++)
         CDEM_TRY(check_panel(&panels[i], err));
-    /* written to path.tmp, renamed on success (outfile.h) */
-    cdem_outfile of;
-    CDEM_TRY(cdem_outfile_begin(&of, path, err));
-    cairo_surface_t *surf =
-        fmt == CDEM_RENDER_PNG   ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height)
-        : fmt == CDEM_RENDER_PDF ? cairo_pdf_surface_create(of.tmp, width, height)
-                                 : cairo_svg_surface_create(of.tmp, width, height);
-    cairo_status_t cs = cairo_surface_status(surf);
-    if (cs != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(surf);
-        return cdem_outfile_end(&of,
-                                CDEM_FAIL(err, CDEM_ERR_IO,
-                                          "plot: cannot create image file '%s': %s", path,
-                                          cairo_status_to_string(cs)),
-                                err);
-    }
-    cairo_t *cr = cairo_create(surf);
+    cdem_render_target t;
+    CDEM_TRY(cdem_render_target_open(&t, path, fmt, width, height, "plot", err));
+    cairo_t *cr = cairo_create(t.surf);
     cairo_set_source_rgb(cr, 1, 1, 1);
     cairo_paint(cr);
     cdem_status st = CDEM_OK;
@@ -354,17 +338,5 @@ cdem_status cdem_plot_to_file(const char *path, const cdem_plot *panels, size_t 
     for (size_t i = 0; i < n_panels && st == CDEM_OK; i++)
         st = cdem_plot_draw(cr, &panels[i], i * pw, 0, pw, height, NULL, err);
     cairo_destroy(cr);
-    if (st == CDEM_OK) {
-        if (fmt == CDEM_RENDER_PNG)
-            cs = cairo_surface_write_to_png(surf, of.tmp);
-        else {
-            cairo_surface_finish(surf);
-            cs = cairo_surface_status(surf);
-        }
-        if (cs != CAIRO_STATUS_SUCCESS)
-            st = CDEM_FAIL(err, CDEM_ERR_IO, "plot: cannot write image file '%s': %s", path,
-                           cairo_status_to_string(cs));
-    }
-    cairo_surface_destroy(surf);
-    return cdem_outfile_end(&of, st, err);
+    return cdem_render_target_close(&t, st, err);
 }

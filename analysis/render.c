@@ -1058,39 +1058,53 @@ cdem_status cdem_render_to_file(const char *path, const cdem_render_scene *sc,
                          "render: image size %d x %d: each side must be in 16..%d (height 0 = "
                          "automatic)",
                          w, h, CDEM_RENDER_MAX_SIZE);
-    /* written to path.tmp, renamed on success (outfile.h) */
-    cdem_outfile of;
-    CDEM_TRY(cdem_outfile_begin(&of, path, err));
-    cairo_surface_t *surf;
-    if (fmt == CDEM_RENDER_PNG)
-        surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
-    else if (fmt == CDEM_RENDER_PDF)
-        surf = cairo_pdf_surface_create(of.tmp, w, h);
-    else
-        surf = cairo_svg_surface_create(of.tmp, w, h);
-    cairo_status_t cs = cairo_surface_status(surf);
-    if (cs != CAIRO_STATUS_SUCCESS) {
-        cairo_surface_destroy(surf);
-        return cdem_outfile_end(&of,
-                                CDEM_FAIL(err, CDEM_ERR_IO,
-                                          "render: cannot create image file '%s': %s", path,
-                                          cairo_status_to_string(cs)),
-                                err);
-    }
-    cairo_t *cr = cairo_create(surf);
+    cdem_render_target t;
+    CDEM_TRY(cdem_render_target_open(&t, path, fmt, w, h, "render", err));
+    cairo_t *cr = cairo_create(t.surf);
     cdem_status st = cdem_render_draw(cr, w, h, sc, o, err);
     cairo_destroy(cr);
+    return cdem_render_target_close(&t, st, err);
+}
+
+cdem_status cdem_render_target_open(cdem_render_target *t, const char *path, cdem_render_format fmt,
+                                    int w, int h, const char *what, cdem_error *err) {
+    t->fmt = fmt;
+    t->path = path;
+    t->what = what;
+    t->surf = NULL;
+    CDEM_TRY(cdem_outfile_begin(&t->of, path, err));
+    if (fmt == CDEM_RENDER_PNG)
+        t->surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
+    else if (fmt == CDEM_RENDER_PDF)
+        t->surf = cairo_pdf_surface_create(t->of.tmp, w, h);
+    else
+        t->surf = cairo_svg_surface_create(t->of.tmp, w, h);
+    cairo_status_t cs = cairo_surface_status(t->surf);
+    if (cs != CAIRO_STATUS_SUCCESS) {
+        cairo_surface_destroy(t->surf);
+        t->surf = NULL;
+        return cdem_outfile_end(&t->of,
+                                CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot create image file '%s': %s",
+                                          what, path, cairo_status_to_string(cs)),
+                                err);
+    }
+    return CDEM_OK;
+}
+
+cdem_status cdem_render_target_close(cdem_render_target *t, cdem_status st, cdem_error *err) {
     if (st == CDEM_OK) {
-        if (fmt == CDEM_RENDER_PNG)
-            cs = cairo_surface_write_to_png(surf, of.tmp);
+        cairo_status_t cs;
+        if (t->fmt == CDEM_RENDER_PNG)
+            cs = cairo_surface_write_to_png(t->surf, t->of.tmp);
         else {
-            cairo_surface_finish(surf);
-            cs = cairo_surface_status(surf);
+            cairo_surface_finish(t->surf);
+            cs = cairo_surface_status(t->surf);
         }
         if (cs != CAIRO_STATUS_SUCCESS)
-            st = CDEM_FAIL(err, CDEM_ERR_IO, "render: cannot write image file '%s': %s", path,
-                           cairo_status_to_string(cs));
+            st = CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot write image file '%s': %s", t->what,
+                           t->path, cairo_status_to_string(cs));
     }
-    cairo_surface_destroy(surf);
-    return cdem_outfile_end(&of, st, err);
+    cairo_surface_destroy(t->surf);
+    t->surf = NULL;
+    return cdem_outfile_end(&t->of, st, err);
 }

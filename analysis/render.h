@@ -16,6 +16,7 @@
 
 #include "cdem_error.h"
 #include "colormap.h"
+#include "outfile.h"
 #include "state.h"
 
 #include <cairo.h>
@@ -130,6 +131,26 @@ cdem_status cdem_render_parse_colour(const char *text, cdem_rgba *out, cdem_erro
 /* Output format from the extension of path (.png, .pdf, .svg, case-insensitive). */
 cdem_status cdem_render_format_from_path(const char *path, cdem_render_format *fmt,
                                          cdem_error *err);
+
+/* A picture file being written: the cairo surface (an image for PNG; for PDF and SVG a
+ * vector surface streaming into the temporary file) and the outfile it is committed to
+ * (outfile.h: path.tmp renamed on success, removed on failure). */
+typedef struct {
+    cairo_surface_t *surf;  /* draw on this */
+    cdem_outfile of;        /* the temporary file and its destination */
+    cdem_render_format fmt; /* PNG, PDF or SVG */
+    const char *path;       /* destination, for messages (caller's string) */
+    const char *what;       /* command or module named in messages, e.g. "render" */
+} cdem_render_target;
+
+/* Starts writing a w x h picture to path. Fails with CDEM_ERR_IO naming the path when the
+ * file cannot be created; nothing is left behind then. */
+cdem_status cdem_render_target_open(cdem_render_target *t, const char *path, cdem_render_format fmt,
+                                    int w, int h, const char *what, cdem_error *err);
+
+/* Finishes the picture: when st is CDEM_OK writes it (PNG encoding or vector flush) and
+ * renames it into place, otherwise discards it. Returns st, or the write error. */
+cdem_status cdem_render_target_close(cdem_render_target *t, cdem_status st, cdem_error *err);
 
 /* Bounding box of all elements (discs, finite ones only) grown by margin x the larger
  * side; a unit box around the origin when there are none. box = {xmin, xmax, ymin, ymax}.
