@@ -118,13 +118,21 @@ int cdem_cmd_wedge(int argc, char **argv) {
     cdem_wedge_ref ref;
     if (st == CDEM_OK)
         st = cdem_wedge_analyse(a, &opt, first, last, &rows, &n, &ref, &err);
-    FILE *f = stdout;
-    if (st == CDEM_OK && out && !(f = fopen(out, "w")))
-        st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", out, strerror(errno));
-    if (st == CDEM_OK)
-        st = cdem_wedge_write_csv(f, rows, n, &err);
-    if (f && f != stdout && fclose(f) != 0 && st == CDEM_OK)
-        st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", out);
+    if (st == CDEM_OK && !out)
+        st = cdem_wedge_write_csv(stdout, rows, n, &err);
+    else if (st == CDEM_OK) {
+        /* written to OUT.tmp, renamed on success (outfile.h) */
+        cdem_outfile of;
+        st = cdem_outfile_begin(&of, out, &err);
+        FILE *f = NULL;
+        if (st == CDEM_OK && !(f = fopen(of.tmp, "w")))
+            st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", out, strerror(errno));
+        if (st == CDEM_OK)
+            st = cdem_wedge_write_csv(f, rows, n, &err);
+        if (f && fclose(f) != 0 && st == CDEM_OK)
+            st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", out);
+        st = cdem_outfile_end(&of, st, &err); /* nothing to do if begin failed */
+    }
     if (st == CDEM_OK && n > 0) {
         const cdem_wedge_row *r = &rows[n - 1];
         fprintf(stderr,
