@@ -247,7 +247,7 @@ static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, d
     c->sheet -= sgn * du;
     const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
     const long n = (long)s->n;
-#pragma omp parallel for schedule(static) if (n > 20000)
+#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
     for (long i = 0; i < n; i++) {
         const uint32_t f = s->flags[i];
         if (!(f & CDEM_FLAG_MOVING))
@@ -285,7 +285,7 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > 20000)
+#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
             (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {

@@ -95,7 +95,7 @@ static cdem_status vert_apply(void *vctx, cdem_state *s, long k, double du, doub
     const long n = (long)s->n;
     double *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > 20000)
+#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             y[i] += uy;

@@ -15,6 +15,7 @@
 #include <math.h>
 #include <omp.h>
 #include <sched.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -478,38 +479,62 @@ typedef struct {
     const uint32_t *flags;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
-    int nchunk;  /* chunks of this pass */
-    long gen;    /* generation of this pass */
-    long *ready; /* per-chunk generation flags (it->cross_ready) */
+    const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
+    int nchunk;            /* chunks of this pass */
+    const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (integrate.h) */
+    cdem_integrator *it;   /* cross_done progress slots */
+    long unstable[CDEM_MAX_CHUNKS]; /* per chunk: lowest unstable element index, or -1 */
 } force_pass;
 
-/* Waits until every chunk after c has evaluated its cross pairs of this pass (their slots
- * are read by chunk c). Usually already done: each thread evaluates its few cross pairs
- * first, while chunk c meets its first cross pair only well into its own pass. */
-static void wait_cross(const force_pass *fp, int c) {
-    for (int d = c + 1; d < fp->nchunk; d++) {
-        for (long spins = 0;; spins++) {
-            long v;
-#pragma omp atomic read seq_cst
-            v = fp->ready[d];
-            if (v == fp->gen)
-                break;
-            if (spins > 1000)
-                sched_yield(); /* the other thread may be descheduled (shared machine) */
-        }
-    }
+/* How many cross pairs a chunk evaluates between two publications of its progress: small
+ * enough that an earlier chunk seldom waits, large enough that the shared line is rarely
+ * written. */
+#define CROSS_PUBLISH_EVERY 32
+
+static int32_t cross_progress(const force_pass *fp, int d) {
+    return atomic_load_explicit(&fp->it->cross_done[d].slot, memory_order_acquire);
 }
 
-/* Evaluates the cross pairs into chunk c (their slots only; no sums). */
-static void cross_eval(const force_pass *fp, const int32_t *restrict list, int32_t a, int32_t b) {
+/* Waits until every chunk after c has evaluated its cross pairs at slots below `slot` (their
+ * slots are read by chunk c) and returns the lowest slot below which all of them are done,
+ * so that the caller need not look again before it. Usually no wait at all: the later
+ * chunks' threads go through their few cross pairs in ascending slot order, ahead of chunk
+ * c's scan through all of its pairs. */
+static int32_t wait_cross(const force_pass *fp, int c, int32_t slot) {
+    int32_t safe = INT32_MAX;
+    for (int d = c + 1; d < fp->nchunk; d++) {
+        int32_t v = cross_progress(fp, d);
+        for (long spins = 0; v < slot; spins++) {
+            if (spins > 1000)
+                sched_yield(); /* the other thread may be descheduled (shared machine) */
+            v = cross_progress(fp, d);
+        }
+        if (v < safe)
+            safe = v;
+    }
+    return safe;
+}
+
+static void publish_cross(const force_pass *fp, int c, int32_t slot) {
+    atomic_store_explicit(&fp->it->cross_done[c].slot, slot, memory_order_release);
+}
+
+/* Evaluates the cross pairs into chunk c (their slots only; no sums), in ascending slot
+ * order, publishing the progress every CROSS_PUBLISH_EVERY pairs. */
+static void cross_eval(const force_pass *fp, int c) {
     const double *restrict x = fp->x, *restrict y = fp->y;
     const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict list = fp->cross;
+    const int32_t a = fp->cross_start[c], b = fp->cross_start[c + 1];
     for (int32_t k = a; k < b; k++) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
         pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
                    fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+        if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
+            publish_cross(fp, c, list[k + 1]);
     }
+    publish_cross(fp, c, INT32_MAX);
 }
 
 /* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
@@ -521,8 +546,10 @@ static void cross_eval(const force_pass *fp, const int32_t *restrict list, int32
  * finished. (A loop nested per element, accumulating each pi range in registers and
  * finishing the element right after it, was measured slower: the short inner loops
  * mispredict their exits.) */
-static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
-                       const int32_t *restrict list, int32_t ca, int32_t cb) {
+static void chunk_pass(force_pass *fp, int chunk) {
+    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
+    const int32_t *restrict list = fp->cross;
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
     const cdem_contact_law *restrict law = fp->law;
     const double *restrict x = fp->x, *restrict y = fp->y;
     double *restrict vx = fp->vx, *restrict vy = fp->vy;
@@ -539,7 +566,8 @@ static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
     }
     const int32_t *restrict pi = fp->pi;
     const long p0 = istart[lo], pe = istart[hi];
-    int ready = chunk + 1 >= fp->nchunk; /* the last chunk has no cross pairs out */
+    /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
+    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
@@ -551,25 +579,58 @@ static void chunk_pass(const force_pass *fp, int chunk, long lo, long hi,
             fy[i] += pfy[p];
         } else {
             /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
-            if (!ready) {
-                wait_cross(fp, chunk);
-                ready = 1;
-            }
+            if (p >= safe)
+                safe = wait_cross(fp, chunk, (int32_t)p + 1);
             fx[i] += fp->pfx[p];
             fy[i] += fp->pfy[p];
         }
     }
-    if (!ready)
-        wait_cross(fp, chunk); /* the cross pairs read these velocities: kick after them */
+    /* the cross pairs out of this chunk read its velocities: kick only after all of them */
+    if (pe > safe)
+        wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->flags, vx, vy, fx, fy, fp->hdt, fp->c, fp->g,
                        fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y, fp->aff);
+    fp->unstable[chunk] = -1;
+    if (fp->radius) {
+        /* the run loop's guard (integrate.h): here, while the velocities are in cache */
+        const double *restrict rad = fp->radius;
+        const double dt2 = fp->dt * fp->dt;
+        for (long i = lo; i < hi; i++) {
+            const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
+            if (d2 > rad[i] * rad[i]) {
+                fp->unstable[chunk] = i;
+                break;
+            }
+        }
+    }
 }
 
-/* Splits the elements into nchunk ranges of about equal pair counts and lists the cross
- * pairs of each chunk. Falls back to one chunk when the buffer is too small (never after a
- * build through rebuild/remove_marked, which reserve it). */
-static void make_chunks(cdem_integrator *it, size_t n, int nchunk) {
+/* Relative costs of the work of a step (measured at 9,000 elements: a touching pair's law
+ * ~10 ns, a list pair that does not touch ~3 ns, a free element's drift, rebuild test and
+ * finish ~4 ns, a boundary element's ~1 ns); only their ratios matter. */
+enum { WORK_TOUCH = 10, WORK_APART = 3, WORK_FREE = 4, WORK_BOUNDARY = 1 };
+
+/* Work of element e in a threaded step: its drift and finish, and the pairs whose pj it is
+ * (each pair is evaluated by the chunk of its pj). The touch flags are those of the last
+ * evaluation (carried over by the build). */
+static uint64_t element_work(const cdem_neighbour *nb, const uint32_t *flags, size_t e) {
+    uint64_t w = (flags[e] & CDEM_FLAGS_BOUNDARY) ? WORK_BOUNDARY : WORK_FREE;
+    for (int32_t k = nb->jstart[e]; k < nb->jstart[e + 1]; k++)
+        w += (nb->hist[nb->jslot[k]] & CDEM_PAIR_TOUCH) ? WORK_TOUCH : WORK_APART;
+    return w;
+}
+
+/* Splits the elements into nchunk ranges of about equal work (element_work) and lists the
+ * cross pairs of each chunk. A pair is evaluated by the chunk of its pj: its own pairs and
+ * the cross pairs coming in from earlier chunks, e.g. every element-wall pair goes to the
+ * chunk of the walls, which are sorted to the end; cutting at equal pair counts by pi
+ * instead overloaded that chunk (20 % more pairs at 9,000 elements), and equal pair counts
+ * by pj still left the lower chunk, with more touching pairs and free elements, 10 % more
+ * to do. The cut does not change any result (every element sum has the same additions in
+ * the same order for any cut). Falls back to one chunk when the buffer is too small (never
+ * after a build through rebuild/remove_marked, which reserve it). */
+static void make_chunks(cdem_integrator *it, const uint32_t *flags, size_t n, int nchunk) {
     const cdem_neighbour *nb = &it->nb;
     const size_t np = nb->np;
     if (nchunk > CDEM_MAX_CHUNKS)
@@ -580,18 +641,20 @@ static void make_chunks(cdem_integrator *it, size_t n, int nchunk) {
     it->chunk_build = nb->n_builds;
     it->chunk_n = n;
     it->chunk_elem[0] = 0;
-    for (int c = 1; c < nchunk; c++) {
-        /* first element whose pi range starts at or after c/nchunk of the pairs */
-        const size_t want = np * (size_t)c / (size_t)nchunk;
-        size_t lo = (size_t)it->chunk_elem[c - 1], hi = n;
-        while (lo < hi) {
-            const size_t mid = lo + (hi - lo) / 2;
-            if ((size_t)nb->istart[mid] < want)
-                lo = mid + 1;
-            else
-                hi = mid;
+    if (nchunk > 1) {
+        uint64_t total = 0;
+        for (size_t e = 0; e < n; e++)
+            total += element_work(nb, flags, e);
+        /* chunk c starts at the first element with at least c/nchunk of the work before it */
+        uint64_t before = 0;
+        int c = 1;
+        for (size_t e = 0; e < n && c < nchunk; e++) {
+            while (c < nchunk && before >= total * (uint64_t)c / (uint64_t)nchunk)
+                it->chunk_elem[c++] = (int32_t)e;
+            before += element_work(nb, flags, e);
         }
-        it->chunk_elem[c] = (int32_t)lo;
+        while (c < nchunk)
+            it->chunk_elem[c++] = (int32_t)n;
     }
     it->chunk_elem[nchunk] = (int32_t)n;
     for (int c = 0; c <= nchunk; c++)
@@ -624,11 +687,24 @@ static void make_chunks(cdem_integrator *it, size_t n, int nchunk) {
     }
 }
 
+/* Chunks (threads) wanted for a pass over n elements and the current pair list. */
+static int wanted_chunks(const cdem_integrator *it, long n) {
+    const long np = (long)it->nb.np;
+    const int want = (np > it->par_min || n > it->par_min) ? omp_get_max_threads() : 1;
+    return want < 1 ? 1 : (want > CDEM_MAX_CHUNKS ? CDEM_MAX_CHUNKS : want);
+}
+
 /* Pair forces, per-element sums and the second half kick, in one pass over the elements
- * (chunk_pass). Threaded: one parallel region, each thread evaluates the cross pairs of its
- * chunks, one barrier, then runs its chunks; every element sum has the same additions in
- * the same order for any chunking, so the bits do not depend on the thread count. */
-static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
+ * (chunk_pass). Threaded: one parallel region, each thread evaluates the cross pairs into
+ * its chunks (publishing its progress), then runs its chunks, waiting only where it meets a
+ * cross pair not yet evaluated; every element sum has the same additions in the same order
+ * for any chunking, so the bits do not depend on the thread count. */
+/* check_moved: first test whether some element moved more than half the skin since the
+ * last build (cdem_neighbour_moved over each chunk, in the same parallel region, while the
+ * positions are in the cache of the thread that just drifted them); if so nothing is
+ * computed and 1 is returned: the caller rebuilds and calls again without the test. The
+ * list must match the state's element count. Returns 0 when the forces were computed. */
+static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved) {
     cdem_neighbour *nb = &it->nb;
     const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
     const long np = (long)nb->np, n = (long)s->n;
@@ -661,36 +737,63 @@ static void forces_and_kick(cdem_integrator *it, cdem_state *s, int kick) {
         .vx = s->vx,
         .vy = s->vy,
     };
-    const int want = (np > it->par_min || n > it->par_min) ? omp_get_max_threads() : 1;
-    const int nch = want < 1 ? 1 : (want > CDEM_MAX_CHUNKS ? CDEM_MAX_CHUNKS : want);
+    (void)np;
+    const int nch = wanted_chunks(it, n);
     if (it->nchunk != nch || it->chunk_build != nb->n_builds || it->chunk_n != (size_t)n)
-        make_chunks(it, (size_t)n, nch);
+        make_chunks(it, s->flags, (size_t)n, nch);
     const int nchunk = it->nchunk;
-    const int32_t *ce = it->chunk_elem, *cs = it->cross_start, *list = it->cross;
     fp.nchunk = nchunk;
+    fp.chunk_elem = it->chunk_elem;
+    fp.cross_start = it->cross_start;
+    fp.cross = it->cross;
+    fp.it = it;
+    fp.radius = it->unstable_guard ? s->radius : NULL;
     if (nchunk == 1) {
-        chunk_pass(&fp, 0, 0, n, list, 0, 0);
-        return;
-    }
-    fp.gen = ++it->cross_gen;
-    if (fp.gen <= 0)
-        fp.gen = it->cross_gen = 1; /* after a wrap-around (or a foreign restore) */
-    for (int c = 0; c < nchunk; c++)
-        it->cross_ready[c] = 0; /* no stale flag can match: reset before every pass */
-    fp.ready = it->cross_ready;
+        if (check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
+            return 1;
+        chunk_pass(&fp, 0);
+    } else {
+        for (int c = 0; c < nchunk; c++)
+            atomic_store_explicit(&it->cross_done[c].slot, 0, memory_order_relaxed); /* nothing
+                                                evaluated yet: reset before every pass */
+        int moved = 0;
 #pragma omp parallel num_threads(nchunk)
-    {
-        /* each thread first evaluates the cross pairs into its chunks and flags them, then
-         * runs its chunks (no barrier: wait_cross spins on the flags when needed) */
-        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-        for (int c = t; c < nchunk; c += nt) {
-            cross_eval(&fp, list, cs[c], cs[c + 1]);
-#pragma omp atomic write seq_cst
-            it->cross_ready[c] = fp.gen;
+        {
+            const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+            int go = 1;
+            if (check_moved) {
+                int mine = 0;
+                for (int c = t; c < nchunk; c += nt)
+                    mine |= cdem_neighbour_moved(nb, s, (size_t)fp.chunk_elem[c],
+                                                 (size_t)fp.chunk_elem[c + 1]);
+                if (mine) {
+#pragma omp atomic write
+                    moved = 1;
+                }
+#pragma omp barrier
+                int any;
+#pragma omp atomic read
+                any = moved;
+                go = !any;
+            }
+            /* each thread first evaluates the cross pairs into its chunks, then runs them */
+            if (go) {
+                for (int c = t; c < nchunk; c += nt)
+                    cross_eval(&fp, c);
+                for (int c = t; c < nchunk; c += nt)
+                    chunk_pass(&fp, c);
+            }
         }
-        for (int c = t; c < nchunk; c += nt)
-            chunk_pass(&fp, c, ce[c], ce[c + 1], list, cs[c], cs[c + 1]);
+        if (moved)
+            return 1;
     }
+    it->unstable_index = -1;
+    for (int c = 0; c < nchunk; c++)
+        if (fp.unstable[c] >= 0) {
+            it->unstable_index = fp.unstable[c]; /* the lowest index: chunks are in order */
+            break;
+        }
+    return 0;
 }
 
 cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error *err) {
@@ -708,9 +811,43 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0);
+    forces_and_kick(it, s, 0, 0);
     it->dt = dt;
     return CDEM_OK;
+}
+
+/* First half kick and drift of the free elements. Threaded over the force pass's chunks
+ * when they are current (each thread then moves the elements whose forces it computed and
+ * whose rebuild test it makes next: they stay in its cache), else over equal ranges. */
+static void drift(cdem_integrator *it, cdem_state *s) {
+    const long n = (long)s->n;
+    const double dt = it->dt, hdt = 0.5 * it->dt;
+    double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
+    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
+    const uint32_t *restrict flags = s->flags;
+    const int nchunk = wanted_chunks(it, n);
+    const int chunked = nchunk > 1 && it->nchunk == nchunk && it->chunk_n == (size_t)n &&
+                        it->chunk_build == it->nb.n_builds;
+    const int32_t *ce = it->chunk_elem;
+#pragma omp parallel num_threads(nchunk) if (nchunk > 1)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const int parts = chunked ? nchunk : nt;
+        for (int c = t; c < parts; c += nt) {
+            const long lo = chunked ? ce[c] : n * c / parts;
+            const long hi = chunked ? ce[c + 1] : n * (c + 1) / parts;
+            for (long i = lo; i < hi; i++) {
+                if (flags[i] & CDEM_FLAGS_BOUNDARY)
+                    continue;
+                const double a = hdt / mass[i];
+                const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
+                vx[i] = hvx;
+                vy[i] = hvy;
+                x[i] += dt * hvx;
+                y[i] += dt * hvy;
+            }
+        }
+    }
 }
 
 cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
@@ -718,38 +855,24 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     it->n_removed_last = 0;
     if (it->nb.n_builds == 0)
         CDEM_TRY(cdem_integrator_prime(it, s, err));
-    const long n = (long)s->n;
-    const double dt = it->dt, hdt = 0.5 * it->dt;
-    {
-        double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
-        const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
-        const uint32_t *restrict flags = s->flags;
-#pragma omp parallel for schedule(static) if (n > it->par_min)
-        for (long i = 0; i < n; i++) {
-            if (flags[i] & CDEM_FLAGS_BOUNDARY)
-                continue;
-            const double a = hdt / mass[i];
-            const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
-            vx[i] = hvx;
-            vy[i] = hvy;
-            x[i] += dt * hvx;
-            y[i] += dt * hvy;
-        }
-    }
+    drift(it, s);
     it->step++;
     if (it->confining_pressure > 0.0)
         it->confining_factor = cdem_bc_confining_ramp(it->step, it->confining_equil);
     if (bc)
-        CDEM_TRY(cdem_bc_apply(bc, s, k, du, dt, err));
-    if (cdem_neighbour_needs_rebuild(&it->nb, s)) {
-        CDEM_TRY(check_finite(it, s, err));
-        CDEM_TRY(rebuild(it, s, err));
-    }
+        CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
     if (it->affine_damping)
         fit_affine(it, s);
     else
         it->aff[0] = it->aff[1] = 0.0; /* plain damping (also after switching it off) */
-    forces_and_kick(it, s, 1);
+    /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
+    if (it->nb.n == s->n && forces_and_kick(it, s, 1, 1) == 0)
+        return CDEM_OK;
+    CDEM_TRY(check_finite(it, s, err));
+    CDEM_TRY(rebuild(it, s, err));
+    if (it->affine_damping)
+        fit_affine(it, s); /* again: the rebuild may have removed escaping elements */
+    forces_and_kick(it, s, 1, 0);
     return CDEM_OK;
 }
 
@@ -770,7 +893,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
         CDEM_TRY(cdem_integrator_find_edges(it, s, err));
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0);
+    forces_and_kick(it, s, 0, 0);
     it->dt = dt;
     return CDEM_OK;
 }

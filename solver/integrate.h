@@ -48,7 +48,9 @@ typedef struct {
     /* force pass decomposition (scratch derived from the pair list, not state: rebuilt
      * whenever the list or the thread count changes; never serialised). Chunk c owns the
      * elements chunk_elem[c]..chunk_elem[c+1]-1 and their pi ranges; a cross pair has its
-     * pj in a later chunk than its pi. */
+     * pj in a later chunk than its pi and is evaluated by the chunk of its pj, so every pair
+     * is evaluated by the chunk of its pj and the chunks are cut at equal counts of pairs by
+     * pj (jstart) plus a share per element. */
     int nchunk;                              /* chunks of the last force pass, 1..CDEM_MAX_CHUNKS */
     long chunk_build;                        /* nb.n_builds the chunks were derived for */
     size_t chunk_n;                          /* element count the chunks were derived for */
@@ -57,11 +59,21 @@ typedef struct {
                                                  .. cross_start[c+1]-1], ascending slots */
     int32_t *cross;                           /* pair slots of the cross pairs (crosscap) */
     size_t crosscap;                          /* capacity of cross, >= nb.pcap after builds */
-    long cross_gen;                           /* threaded force passes so far (generation count) */
-    long cross_ready[CDEM_MAX_CHUNKS];        /* 0 at the start of every threaded pass, then
-                                                 cross_gen once chunk c's cross pairs are
-                                                 evaluated (atomic; spun on by the earlier
-                                                 chunks instead of a barrier) */
+    /* progress of each chunk's cross-pair evaluation in the current threaded pass: every
+     * cross pair of chunk c at a slot below cross_done[c].slot is evaluated (atomic; reset to
+     * 0 before every pass, raised in steps as the chunk's thread goes through its ascending
+     * list, INT32_MAX when done). An earlier chunk meeting a cross pair at slot p waits only
+     * until every later chunk is past p. One cache line each: the owner writes while the
+     * others read. */
+    struct {
+        _Atomic int32_t slot;
+        char pad[64 - sizeof(int32_t)];
+    } cross_done[CDEM_MAX_CHUNKS];
+    /* unstable-motion guard (0 = off; the run loop sets it): after each step,
+     * unstable_index is the lowest index whose element moved more than its radius in the
+     * step's velocity (|v| dt > r), or -1; found in the force pass's element loop */
+    int unstable_guard;
+    long unstable_index;
 
     /* escape bounds (enabled when bounds_set): removed when x < xmin - r, x > xmax + r or
      * y < ymin - max_radius; x bounds follow the moving lateral walls */

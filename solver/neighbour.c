@@ -80,20 +80,27 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     memset(nb, 0, sizeof *nb);
 }
 
-int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s) {
-    if (nb->n_builds == 0 || nb->n != s->n)
-        return 1;
+int cdem_neighbour_moved(const cdem_neighbour *nb, const cdem_state *s, size_t lo, size_t hi) {
     const double lim2 = 0.25 * nb->skin * nb->skin;
     const double *restrict x = s->x, *restrict y = s->y;
     const double *restrict x0 = nb->x0, *restrict y0 = nb->y0;
     int out = 0;
-    const long n = (long)s->n;
-#pragma omp parallel for schedule(static) reduction(| : out) if (n > 20000)
-    for (long i = 0; i < n; i++) {
+    for (size_t i = lo; i < hi; i++) {
         const double dx = x[i] - x0[i], dy = y[i] - y0[i];
         /* written so that NaN also triggers a rebuild (which then reports it) */
         out |= !(dx * dx + dy * dy <= lim2);
     }
+    return out;
+}
+
+int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s) {
+    if (nb->n_builds == 0 || nb->n != s->n)
+        return 1;
+    int out = 0;
+    const long n = (long)s->n, block = 4096;
+#pragma omp parallel for schedule(static) reduction(| : out) if (n > 20000)
+    for (long b = 0; b < n; b += block)
+        out |= cdem_neighbour_moved(nb, s, (size_t)b, (size_t)(b + block < n ? b + block : n));
     return out;
 }
 
@@ -315,11 +322,13 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
                              "simulation blew up; the time step is probably too large for the "
                              "spring constants and masses",
                              (int)s->id[i], s->x[i], s->y[i]);
-        xmin = fmin(xmin, s->x[i]);
-        xmax = fmax(xmax, s->x[i]);
-        ymin = fmin(ymin, s->y[i]);
-        ymax = fmax(ymax, s->y[i]);
-        rmax = fmax(rmax, s->radius[i]);
+        /* plain comparisons (the values are finite here): fmin/fmax are library calls */
+        const double xi = s->x[i], yi = s->y[i], ri = s->radius[i];
+        xmin = xi < xmin ? xi : xmin;
+        xmax = xi > xmax ? xi : xmax;
+        ymin = yi < ymin ? yi : ymin;
+        ymax = yi > ymax ? yi : ymax;
+        rmax = ri > rmax ? ri : rmax;
     }
     if (n == 0) {
         xmin = xmax = ymin = ymax = 0.0;

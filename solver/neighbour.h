@@ -102,6 +102,11 @@ void cdem_neighbour_free(cdem_neighbour *nb);
  * than skin/2 since the last build (or there was no build yet). */
 int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s);
 
+/* 1 when some element lo..hi-1 (all < the state's n, which must equal the list's n) moved
+ * more than skin/2 since the last build (or has a NaN position): the per-element test of
+ * cdem_neighbour_needs_rebuild, for callers that split the elements among threads. */
+int cdem_neighbour_moved(const cdem_neighbour *nb, const cdem_state *s, size_t lo, size_t hi);
+
 /* Rebuilds the list. keep (optional, length s->n): elements with keep[i] == 0 are removed
  * from the state first (histories of the rest kept). resort: 1 forces a re-sort into cell
  * order, 0 lets resort_every decide, -1 never. Fails with CDEM_ERR_NUMERIC naming the
