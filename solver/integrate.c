@@ -43,6 +43,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
                          "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
                          m->radius[0]);
     it->par_min = PAR_MIN_DEFAULT;
+    it->unstable_index = -1;
     it->boundary_forces = 1;
     it->dt = m->dt;
     it->damping = m->damping;

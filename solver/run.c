@@ -301,28 +301,29 @@ static void log_removed(run_ctx *r) {
                 (int)r->it.removed_ids[k], r->step, r->removed);
 }
 
-/* Everything before the first step, for a fresh run and a resumed one alike: the model, the
- * assembly (regenerated from the seed), the mode, the stepper and the summary. No file yet. */
 /* Instability guard: with a stable time step no element moves its own radius in one step
  * (free fall over the tallest assembly at the largest gravity stays below ~0.7 radius);
  * beyond that contacts are skipped and the run is garbage even while every number is
- * still finite (the escaping elements are removed and the run would go on). Serial and in
- * index order, so the element reported is the same for any thread count. */
+ * still finite (the escaping elements are removed and the run would go on). The test
+ * (|v| dt > r) is made by the integrator's force pass (unstable_guard, set up in setup)
+ * while the velocities are in cache; it reports the lowest such index, so the element
+ * reported is the same for any thread count. */
 static cdem_status check_unstable(const run_ctx *r, cdem_error *err) {
     const cdem_state *s = &r->s;
+    const long i = r->it.unstable_index;
+    if (i < 0 || (size_t)i >= s->n)
+        return CDEM_OK;
     const double dt = r->m.dt;
-    for (size_t i = 0; i < s->n; i++) {
-        const double d2 = (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]) * dt * dt;
-        if (d2 > s->radius[i] * s->radius[i])
-            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
-                             "element id %d moved %.3g m in one time step (more than its radius "
-                             "%.3g m) at step %ld: the simulation is unstable; likely cause: the "
-                             "time step is too large for the spring constants and element masses",
-                             (int)s->id[i], sqrt(d2), s->radius[i], r->step);
-    }
-    return CDEM_OK;
+    const double d2 = (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]) * dt * dt;
+    return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                     "element id %d moved %.3g m in one time step (more than its radius %.3g m) "
+                     "at step %ld: the simulation is unstable; likely cause: the time step is "
+                     "too large for the spring constants and element masses",
+                     (int)s->id[i], sqrt(d2), s->radius[i], r->step);
 }
 
+/* Everything before the first step, for a fresh run and a resumed one alike: the model, the
+ * assembly (regenerated from the seed), the mode, the stepper and the summary. No file yet. */
 static cdem_status setup(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
@@ -344,6 +345,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     r->base_tol_y = ywall + 0.5 * r->m.radius[0];
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
+    r->it.unstable_guard = 1; /* check_unstable */
     if (opt->par_min > 0)
         r->it.par_min = opt->par_min;
     cdem_bc_adjust_law(&r->bc, &r->it.law); /* e.g. the biaxial test's smooth platens */

@@ -206,12 +206,56 @@ static void run_box(int threads, int nsteps, cdem_state *out) {
     cdem_integrator_free(&it);
 }
 
+/* The unstable-motion guard (unstable_index, read by the run loop): the lowest index whose
+ * |v| dt exceeds its radius after the step, the same for 1 and 3 threads; -1 when no element
+ * does or the guard is off. */
+static void test_integrate_unstable_guard(void **st) {
+    (void)st;
+    for (int threads = 1; threads <= 3; threads += 2) {
+        omp_set_num_threads(threads);
+        const double dt = 0.028;
+        cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+        cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+        cdem_integrator it;
+        cdem_error err;
+        cdem_state s;
+        make_box(&s, 50, 40, 99);
+        assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+        assert_int_equal(it.unstable_index, -1);
+        it.par_min = 0;
+        it.unstable_guard = 1;
+        for (int k = 0; k < 5; k++)
+            assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        assert_int_equal(it.unstable_index, -1); /* a quiet box */
+        /* two free elements far apart thrown at 3 radii per step */
+        size_t hit[2] = {s.n / 3, (2 * s.n) / 3};
+        for (int h = 0; h < 2; h++) {
+            while (s.flags[hit[h]] & CDEM_FLAGS_BOUNDARY)
+                hit[h]++;
+            s.vx[hit[h]] = 3.0 * s.radius[hit[h]] / dt;
+        }
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        long want = -1;
+        for (size_t i = 0; i < s.n && want < 0; i++)
+            if ((s.vx[i] * s.vx[i] + s.vy[i] * s.vy[i]) * dt * dt > s.radius[i] * s.radius[i])
+                want = (long)i;
+        assert_true(want >= 0);
+        assert_int_equal(it.unstable_index, want);
+        it.unstable_guard = 0;
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        assert_int_equal(it.unstable_index, -1);
+        cdem_integrator_free(&it);
+        cdem_state_free(&s);
+    }
+}
+
 static void test_integrate_deterministic_threads(void **st) {
     (void)st;
     cdem_state a, b;
     run_box(1, 200, &a);
-    /* 2 threads: two chunks; 3 threads: three chunks (more threads than cores here) */
-    for (int threads = 2; threads <= 3; threads++) {
+    /* 2 threads: two chunks; 3 and 5 threads: more chunks than cores here, with cross pairs
+     * reaching over several chunks (the chunks are cut by work, whatever the thread count) */
+    for (int threads = 2; threads <= 5; threads += threads == 2 ? 1 : 2) {
         run_box(threads, 200, &b);
         assert_int_equal(a.n, b.n);
         assert_memory_equal(a.id, b.id, a.n * sizeof *a.id);
@@ -221,7 +265,7 @@ static void test_integrate_deterministic_threads(void **st) {
         assert_memory_equal(a.vy, b.vy, a.n * sizeof *a.vy);
         assert_memory_equal(a.fx, b.fx, a.n * sizeof *a.fx);
         assert_memory_equal(a.fy, b.fy, a.n * sizeof *a.fy);
-        if (threads < 3)
+        if (threads < 5)
             cdem_state_free(&b);
     }
     /* and the elements actually moved and settled under gravity: nothing fell through */
@@ -294,6 +338,7 @@ int main(void) {
         cmocka_unit_test(test_integrate_free_fall),
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
+        cmocka_unit_test(test_integrate_unstable_guard),
         cmocka_unit_test(test_integrate_nan_and_escape),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
