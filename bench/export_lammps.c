@@ -134,6 +134,7 @@ int main(int argc, char **argv) {
     }
     cdem_integrator_enable_escape(&it);
     it.boundary_forces = 0;
+    it.unstable_guard = 1; /* as cdem-run */
     const long equil = argc > 7 ? atol(argv[7]) : m.equil_steps;
     double t0 = now_s();
     for (long k = 0; k < equil; k++)

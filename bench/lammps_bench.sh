@@ -7,7 +7,7 @@
 # equilibrates it (untimed), zeroes the shear springs, writes the packing and constants for
 # LAMMPS, runs NPHYS static steps and then REPS timed runs of NTIME steps on 1 and 2 OpenMP
 # threads. LAMMPS (bench/lammps_bench.in) reads the same packing and constants and runs the
-# same NPHYS + REPS x NTIME steps on 1 rank and on 2 MPI ranks.
+# same NPHYS + REPS x NTIME steps on 1 rank, on 2 MPI ranks and on 2 OpenMP threads (-sf omp).
 #   Physics check: after NPHYS steps, kinetic energy of the free elements and mean overlap of
 #   the touching pairs (bench/lammps_overlap.py on both dumps) must agree within KE_TOL and
 #   OV_TOL (relative); printed as PASS/FAIL.
@@ -30,7 +30,7 @@ KE_TOL=${KE_TOL:-0.02}
 OV_TOL=${OV_TOL:-0.01}
 PY=/usr/bin/python3
 set -e
-export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
+# OMP_WAIT_POLICY: as the caller has it (run_bench.sh explains why it is not forced)
 
 if [ ! -x /usr/bin/lmp ] || [ ! -x /usr/bin/time ]; then
     echo "lammps_bench: installing lammps/time with apt-get"
@@ -74,6 +74,13 @@ for size in $SIZES; do
     OMP_NUM_THREADS=1 /usr/bin/time -v -o "$dir/lmp2.time" $MPIRUN lmp -in bench/lammps_bench.in \
         -var dir "$dir" -var nphys "$NPHYS" -var ntime "$ntime" -var reps "$REPS" \
         -log "$dir/lmp2.log" -screen none
+    # the OPENMP package's styles on 2 threads (gran/hooke/history/omp, ...), where this
+    # LAMMPS has them (Debian 12's lammps 20210929 does not: "Using suffix omp without
+    # OPENMP package installed"); then 2 MPI ranks is LAMMPS' 2-core figure
+    omp_ok=1
+    OMP_NUM_THREADS=2 /usr/bin/time -v -o "$dir/lmpomp.time" lmp -sf omp -pk omp 2 \
+        -in bench/lammps_bench.in -var dir "$dir" -var nphys "$NPHYS" -var ntime "$ntime" \
+        -var reps "$REPS" -log "$dir/lmpomp.log" -screen none >/dev/null 2>&1 || omp_ok=0
 
     n=$(awk '/^CDEM_EXPORT/ {print $3}' "$dir/cdem.out")
     nfree=$(awk '/^CDEM_EXPORT/ {print $5}' "$dir/cdem.out")
@@ -100,7 +107,17 @@ for size in $SIZES; do
     c1=$(awk '/^CDEM_TIME threads 1/ {print $11}' "$dir/cdem.out" | median)
     c2=$(awk '/^CDEM_TIME threads 2/ {print $11}' "$dir/cdem.out" | median)
     l1=$(grep '^Loop time' "$dir/lmp1.log" | tail -n "$REPS" | awk '{print $4}' | median)
-    l2=$(grep '^Loop time' "$dir/lmp2.log" | tail -n "$REPS" | awk '{print $4}' | median)
+    l2m=$(grep '^Loop time' "$dir/lmp2.log" | tail -n "$REPS" | awk '{print $4}' | median)
+    l2o=nan
+    [ "$omp_ok" = 1 ] && l2o=$(grep '^Loop time' "$dir/lmpomp.log" | tail -n "$REPS" | awk '{print $4}' | median)
+    # LAMMPS on 2 cores: the faster of 2 MPI ranks and 2 OpenMP threads
+    if [ "$omp_ok" = 1 ] && awk -v a="$l2o" -v b="$l2m" 'BEGIN {exit !(a < b)}'; then
+        l2=$l2o
+        l2how="2 OpenMP threads"
+    else
+        l2=$l2m
+        l2how="2 MPI ranks"
+    fi
     nb=$(grep '^Neighbor list builds' "$dir/lmp1.log" | tail -n "$REPS" | awk '{s += $NF} END {print s}')
     cb=$(awk '/^CDEM_TIME threads 1/ {s += $13} END {print s}' "$dir/cdem.out")
     # CPU seconds: cdem from CLOCK_PROCESS_CPUTIME_ID; LAMMPS = Loop time x its "% CPU use"
@@ -114,12 +131,21 @@ for size in $SIZES; do
     echo "     cdem   1 thread : $c1 s  $(rate "$c1") el-steps/s  (list builds in the $REPS runs: $cb)"
     echo "     cdem   2 threads: $c2 s  $(rate "$c2") el-steps/s"
     echo "     LAMMPS 1 rank   : $l1 s  $(rate "$l1") el-steps/s  (list builds in the $REPS runs: $nb)"
-    echo "     LAMMPS 2 ranks  : $l2 s  $(rate "$l2") el-steps/s"
+    echo "     LAMMPS 2 ranks  : $l2m s  $(rate "$l2m") el-steps/s"
+    if [ "$omp_ok" = 1 ]; then
+        echo "     LAMMPS 2 threads: $l2o s  $(rate "$l2o") el-steps/s  (-sf omp -pk omp 2)"
+    else
+        echo "     LAMMPS 2 threads: not available ($(grep -m1 ERROR "$dir/lmpomp.log" || echo 'lmp -sf omp failed'))"
+    fi
     echo "     per CPU-second, 1 core: cdem $u1 s $(rate "$u1") el-steps/s, LAMMPS $v1 s $(rate "$v1") el-steps/s"
-    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x"
+    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x (against LAMMPS' faster: $l2how)"
+    echo "     speed-up 1 -> 2 cores: cdem $(ratio "$c2" "$c1")x, LAMMPS $(ratio "$l2" "$l1")x"
     echo "     load average after the size: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
     echo "   peak memory: cdem $(peak_mb "$dir/cdem.time") MB (whole process incl. equilibration)," \
-        "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)"
+        "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)," \
+        "2 threads $([ "$omp_ok" = 1 ] && peak_mb "$dir/lmpomp.time" || echo '-') MB"
+    echo "   memory per element: cdem $(awk -v m="$(peak_mb "$dir/cdem.time")" -v n="$n" 'BEGIN {printf "%.2f", m * 1048576 / n / 1000}') kB," \
+        "LAMMPS 1 rank $(awk -v m="$(peak_mb "$dir/lmp1.time")" -v n="$n" 'BEGIN {printf "%.2f", m * 1048576 / n / 1000}') kB (peak RSS / N, start-up included)"
 done
 if [ -n "$failed" ]; then
     echo "lammps_bench: physics check FAILED for$failed: the timings do not compare the same run"

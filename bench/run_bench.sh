@@ -18,10 +18,13 @@
 #   ELSTEPS=2e7 element-steps per timed run;  SETTLE=3000 untimed settling steps
 #   PARTS="scale full lammps analysis"  the parts to run
 #   WORK=/tmp/cdem_bench  scratch directory (the default run's file is kept there)
-# OMP_WAIT_POLICY defaults to passive: on a shared machine a spinning idle thread takes the
-# CPU the working one needs. Every figure is printed with the load average beside it: on a
-# loaded machine the wall-clock figures measure the other jobs too; the CPU-time figures
-# are steadier but also inflated (shared caches and cores).
+# OMP_WAIT_POLICY is left as the caller has it: unset, libgomp's default (an idle thread spins
+# for a while, then sleeps), which is what a user of cdem-run gets. OMP_WAIT_POLICY=passive
+# makes every parallel region wake a sleeping thread (~40 us on a VM against ~0.5 us; a step
+# has two): use it, or OMP_NUM_THREADS=1, only on a machine shared with other CPU-bound jobs.
+# Every figure is printed with the load average beside it: on a loaded machine the
+# wall-clock figures measure the other jobs too; the CPU-time figures are steadier but also
+# inflated (shared caches and cores).
 BUILD=${1:-build}
 SIZES=${SIZES:-"10:5:0 10:5:1 40:5:1 100:7.5:1"}
 [ "${LARGE:-0}" = 1 ] && SIZES="$SIZES 200:7.5:1"
@@ -33,7 +36,6 @@ WORK=${WORK:-/tmp/cdem_bench}
 PKGS="hdf5 gsl"
 CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon -Isolver"
 set -e
-export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-passive}
 mkdir -p "$WORK"
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_scale" bench/bench_scale.c \
     "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
@@ -51,7 +53,7 @@ field() { awk -v pat="$2" -v name="$1" '$0 ~ pat {for (i = 1; i < NF; i++) if ($
 echo "cdem bench: $(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')"
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores," \
     "$(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo); load average $(load)"
-echo "OMP_WAIT_POLICY=$OMP_WAIT_POLICY; compiler flags -O2 (the project's)"
+echo "OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-(unset: libgomp default, spin then sleep)}; compiler flags -O2 (the project's)"
 
 if has scale; then
     echo
