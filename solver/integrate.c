@@ -66,6 +66,8 @@ void cdem_integrator_free(cdem_integrator *it) {
     free(it->band_lo);
     free(it->band_hi);
     free(it->cross);
+    free(it->kick_drift);
+    free(it->kick_finish);
     memset(it, 0, sizeof *it);
 }
 
@@ -155,6 +157,43 @@ static cdem_status reserve_cross(cdem_integrator *it, cdem_error *err) {
     return CDEM_OK;
 }
 
+/* Grows the kick factors to n elements (after a list build, outside the step's hot loops). */
+static cdem_status reserve_kick(cdem_integrator *it, size_t n, cdem_error *err) {
+    if (it->kickcap >= n)
+        return CDEM_OK;
+    const size_t c = n + n / 2 + 16;
+    double *a = realloc(it->kick_drift, c * sizeof *a);
+    if (a)
+        it->kick_drift = a;
+    double *b = a ? realloc(it->kick_finish, c * sizeof *b) : NULL;
+    if (!a || !b)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+    it->kick_finish = b;
+    it->kickcap = c;
+    return CDEM_OK;
+}
+
+/* The kick factors for the current masses, dt and damping (integrate.h), when stale. The
+ * expressions are those the kicks used to evaluate every step, so the bits are the same.
+ * Returns 0 when they cannot be had without allocating (elements appended since the last
+ * build): the kicks then divide as before. */
+static int update_kick(cdem_integrator *it, const cdem_state *s) {
+    if (it->kickcap < s->n)
+        return 0;
+    if (it->kick_build == it->nb.n_builds && it->kick_n == s->n && it->kick_dt == it->dt)
+        return 1;
+    const double hdt = 0.5 * it->dt, c = it->damping;
+    for (size_t i = 0; i < s->n; i++) {
+        const double m = s->mass[i];
+        it->kick_drift[i] = hdt / m;
+        it->kick_finish[i] = 1.0 / (m + c * hdt);
+    }
+    it->kick_build = it->nb.n_builds;
+    it->kick_n = s->n;
+    it->kick_dt = it->dt;
+    return 1;
+}
+
 static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
     size_t nrem = 0;
     CDEM_TRY(find_escapes(it, s, &nrem, err));
@@ -163,6 +202,7 @@ static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) 
     it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err));
     CDEM_TRY(reserve_cross(it, err));
+    CDEM_TRY(reserve_kick(it, s->n, err));
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
@@ -411,6 +451,7 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
  * kick (when kick), and the total force stored in fx, fy. Boundary elements keep the sum. */
 static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
+                                  const double *restrict kick_finish,
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
                                   double hdt, double c, double g, double ob, int kick,
@@ -429,8 +470,9 @@ static inline void finish_element(long i, double sx, double sy, const double *re
     /* damping acts on v - v_aff (v_aff = 0 exactly unless affine damping is on) */
     const double rx = aff[0] * (x[i] - aff[2]), ry = aff[1] * (y[i] - aff[3]);
     if (kick) {
-        /* v = (v_half + hdt/m (F + c v_aff)) / (1 + c hdt/m) with a single division */
-        const double inv = 1.0 / (m + c * hdt);
+        /* v = (v_half + hdt/m (F + c v_aff)) / (1 + c hdt/m), with 1 / (m + c hdt) from
+         * kick_finish */
+        const double inv = kick_finish ? kick_finish[i] : 1.0 / (m + c * hdt);
         vxw[i] = (m * vxw[i] + hdt * (sx + c * rx)) * inv;
         vyw[i] = (m * vyw[i] + hdt * (sy + c * ry)) * inv;
     }
@@ -475,6 +517,7 @@ typedef struct {
     double dt, hdt, c, g, ob, ef, exmid;
     double aff[4]; /* affine damping field (integrate.h), zeros when off */
     const double *x, *y, *mass, *Rp;
+    const double *kick_finish; /* it->kick_finish (integrate.h) */
     const int32_t *pi, *pj, *istart;
     const uint8_t *cls;
     const uint32_t *flags;
@@ -590,7 +633,8 @@ static void chunk_pass(force_pass *fp, int chunk) {
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
-        finish_element(i, fx[i], fy[i], fp->mass, fp->flags, vx, vy, fx, fy, fp->hdt, fp->c, fp->g,
+        finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
+                       fp->hdt, fp->c, fp->g,
                        fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y, fp->aff);
     fp->unstable[chunk] = -1;
     if (fp->radius) {
@@ -723,6 +767,7 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .x = s->x,
         .y = s->y,
         .mass = s->mass,
+        .kick_finish = (kick && update_kick(it, s)) ? it->kick_finish : NULL,
         .Rp = nb->R,
         .pi = nb->pi,
         .pj = nb->pj,
@@ -826,6 +871,7 @@ static void drift(cdem_integrator *it, cdem_state *s) {
     double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
     const uint32_t *restrict flags = s->flags;
+    const double *restrict kd = update_kick(it, s) ? it->kick_drift : NULL;
     const int nchunk = wanted_chunks(it, n);
     const int chunked = nchunk > 1 && it->nchunk == nchunk && it->chunk_n == (size_t)n &&
                         it->chunk_build == it->nb.n_builds;
@@ -840,7 +886,7 @@ static void drift(cdem_integrator *it, cdem_state *s) {
             for (long i = lo; i < hi; i++) {
                 if (flags[i] & CDEM_FLAGS_BOUNDARY)
                     continue;
-                const double a = hdt / mass[i];
+                const double a = kd ? kd[i] : hdt / mass[i]; /* the same bits */
                 const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
                 vx[i] = hvx;
                 vy[i] = hvy;
@@ -887,6 +933,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     it->nb.par_min = it->par_min;
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
     CDEM_TRY(reserve_cross(it, err));
+    CDEM_TRY(reserve_kick(it, s->n, err));
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
@@ -1023,6 +1070,8 @@ cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapsho
     CDEM_TRY(cdem_ckpt_get_f64(snap, P, "edge_x_mid", &exmid, err));
     CDEM_TRY(cdem_neighbour_snapshot_get(&it->nb, snap, s, err));
     CDEM_TRY(reserve_keep(it, s->n, err));
+    CDEM_TRY(reserve_cross(it, err));
+    CDEM_TRY(reserve_kick(it, s->n, err));
     it->step = (long)step;
     it->boundary_forces = (int)bf;
     it->bounds_set = (int)bounds;

@@ -69,6 +69,17 @@ typedef struct {
         _Atomic int32_t slot;
         char pad[64 - sizeof(int32_t)];
     } cross_done[CDEM_MAX_CHUNKS];
+    /* per-element factors of the two half kicks, derived from mass, dt and damping at every
+     * list build (so masses may change only between builds: at set-up, or by appending
+     * elements): kick_drift[i] = (dt/2) / m, kick_finish[i] = 1 / (m + c dt/2); the same
+     * values the kicks would divide out each step, one division per element and build
+     * instead of two per element and step. Valid for kick_build == nb.n_builds, kick_n ==
+     * the element count and kick_dt == dt; scratch, not state (never serialised). */
+    double *kick_drift, *kick_finish;
+    size_t kickcap;
+    long kick_build;
+    size_t kick_n;
+    double kick_dt;
     /* unstable-motion guard (0 = off; the run loop sets it): after each step,
      * unstable_index is the lowest index whose element moved more than its radius in the
      * step's velocity (|v| dt > r), or -1; found in the force pass's element loop */
