@@ -15,17 +15,17 @@
 #   run (cdem: clock around the step loop; LAMMPS: its "Loop time"), median of REPS; the
 #   ratio cdem/LAMMPS; peak memory (/usr/bin/time -v "Maximum resident set size").
 # Usage: sh bench/lammps_bench.sh [BUILD]
-#   env: SIZES="10:0 10:1" (width_units:half_radii; add 40:1 for ~35,000 elements, which
-#        costs 1.5-3.5 more minutes, mostly cdem equilibration), REPS=3, NPHYS=2000,
-#        WORK=/tmp/cdem_lammps_bench, ELSTEPS=1e7 (element-steps per timed run),
-#        KE_TOL=0.02, OV_TOL=0.01
+#   env: SIZES="10:0 10:1 40:1" (width_units:half_radii: ~2,500, ~9,100 and ~35,000
+#        elements; 40:1 is most of the 3-4 minutes, mostly cdem's equilibration), REPS=3,
+#        NPHYS=2000, WORK=/tmp/cdem_lammps_bench, ELSTEPS=2e7 (element-steps per timed
+#        run), KE_TOL=0.02, OV_TOL=0.01
 # Installs Debian's lammps (and time) with apt-get when missing (needs root).
 BUILD=${1:-build}
-SIZES=${SIZES:-"10:0 10:1"}
+SIZES=${SIZES:-"10:0 10:1 40:1"}
 REPS=${REPS:-3}
 NPHYS=${NPHYS:-2000}
 WORK=${WORK:-/tmp/cdem_lammps_bench}
-ELSTEPS=${ELSTEPS:-1e7}
+ELSTEPS=${ELSTEPS:-2e7}
 KE_TOL=${KE_TOL:-0.02}
 OV_TOL=${OV_TOL:-0.01}
 PY=/usr/bin/python3
