@@ -450,11 +450,13 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
                 for (int q = 0; q < t; q++)
                     off += nb->tbuf[q].n;
                 const size_t m = b->n;
-                memcpy(nb->pi + off, b->pi, m * sizeof *b->pi);
-                memcpy(nb->pj + off, b->pj, m * sizeof *b->pj);
-                memcpy(nb->R + off, b->R, m * sizeof *b->R);
-                memcpy(nb->cls + off, b->cls, m * sizeof *b->cls);
-                memset(nb->hist + off, 0, m * sizeof *nb->hist);
+                if (m > 0) { /* a thread with no pairs may never have allocated its buffer */
+                    memcpy(nb->pi + off, b->pi, m * sizeof *b->pi);
+                    memcpy(nb->pj + off, b->pj, m * sizeof *b->pj);
+                    memcpy(nb->R + off, b->R, m * sizeof *b->R);
+                    memcpy(nb->cls + off, b->cls, m * sizeof *b->cls);
+                    memset(nb->hist + off, 0, m * sizeof *nb->hist);
+                }
                 for (size_t k = 0; k < m; k++) {
                     nb->xs[off + k] = 0.0;
                     nb->pfx[off + k] = 0.0;
