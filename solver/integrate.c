@@ -68,6 +68,7 @@ void cdem_integrator_free(cdem_integrator *it) {
     free(it->cross);
     free(it->kick_drift);
     free(it->kick_finish);
+    free(it->elem_work);
     memset(it, 0, sizeof *it);
 }
 
@@ -119,9 +120,11 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
     for (size_t i = 0; i < s->n; i++) {
         if (!(s->flags[i] & CDEM_FLAG_WALL))
             continue;
-        xmin = fmin(xmin, s->x[i]);
-        xmax = fmax(xmax, s->x[i]);
-        ymin = fmin(ymin, s->y[i]);
+        /* plain comparisons, not the fmin/fmax library calls (this runs at every build) */
+        const double xi = s->x[i], yi = s->y[i];
+        xmin = xi < xmin ? xi : xmin;
+        xmax = xi > xmax ? xi : xmax;
+        ymin = yi < ymin ? yi : ymin;
     }
     if (!isfinite(xmin))
         return CDEM_OK; /* no walls: nothing to escape from */
@@ -166,9 +169,12 @@ static cdem_status reserve_kick(cdem_integrator *it, size_t n, cdem_error *err) 
     if (a)
         it->kick_drift = a;
     double *b = a ? realloc(it->kick_finish, c * sizeof *b) : NULL;
-    if (!a || !b)
+    if (b)
+        it->kick_finish = b;
+    uint32_t *w = b ? realloc(it->elem_work, c * sizeof *w) : NULL;
+    if (!w)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
-    it->kick_finish = b;
+    it->elem_work = w;
     it->kickcap = c;
     return CDEM_OK;
 }
@@ -183,10 +189,13 @@ static int update_kick(cdem_integrator *it, const cdem_state *s) {
     if (it->kick_build == it->nb.n_builds && it->kick_n == s->n && it->kick_dt == it->dt)
         return 1;
     const double hdt = 0.5 * it->dt, c = it->damping;
-    for (size_t i = 0; i < s->n; i++) {
-        const double m = s->mass[i];
-        it->kick_drift[i] = hdt / m;
-        it->kick_finish[i] = 1.0 / (m + c * hdt);
+    const long n = (long)s->n;
+    const double *restrict mass = s->mass;
+    double *restrict kd = it->kick_drift, *restrict kf = it->kick_finish;
+#pragma omp parallel for schedule(static) if (n > it->par_min)
+    for (long i = 0; i < n; i++) {
+        kd[i] = hdt / mass[i];
+        kf[i] = 1.0 / (mass[i] + c * hdt);
     }
     it->kick_build = it->nb.n_builds;
     it->kick_n = s->n;
@@ -528,6 +537,7 @@ typedef struct {
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (integrate.h) */
     cdem_integrator *it;   /* cross_done progress slots */
     long unstable[CDEM_MAX_CHUNKS]; /* per chunk: lowest unstable element index, or -1 */
+    double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
 
 /* How many cross pairs a chunk evaluates between two publications of its progress: small
@@ -659,11 +669,44 @@ enum { WORK_TOUCH = 10, WORK_APART = 3, WORK_FREE = 4, WORK_BOUNDARY = 1 };
 /* Work of element e in a threaded step: its drift and finish, and the pairs whose pj it is
  * (each pair is evaluated by the chunk of its pj). The touch flags are those of the last
  * evaluation (carried over by the build). */
-static uint64_t element_work(const cdem_neighbour *nb, const uint32_t *flags, size_t e) {
-    uint64_t w = (flags[e] & CDEM_FLAGS_BOUNDARY) ? WORK_BOUNDARY : WORK_FREE;
+static uint32_t element_work(const cdem_neighbour *nb, const uint32_t *flags, size_t e) {
+    uint32_t w = (flags[e] & CDEM_FLAGS_BOUNDARY) ? WORK_BOUNDARY : WORK_FREE;
     for (int32_t k = nb->jstart[e]; k < nb->jstart[e + 1]; k++)
         w += (nb->hist[nb->jslot[k]] & CDEM_PAIR_TOUCH) ? WORK_TOUCH : WORK_APART;
     return w;
+}
+
+/* The work shares of the next cut: equal for a new chunk count; else each share scaled by
+ * the speed its thread showed since the last cut (share / mean time), so that the times
+ * even out, smoothed (half way) and kept above a tenth of an equal share. */
+static void update_shares(cdem_integrator *it, int nchunk) {
+    if (it->share_n != nchunk) {
+        it->share_n = nchunk;
+        for (int c = 0; c < nchunk; c++) {
+            it->chunk_share[c] = 1.0 / nchunk;
+            it->chunk_time[c] = 0.0;
+        }
+        return;
+    }
+    double speed[CDEM_MAX_CHUNKS], sum = 0.0;
+    for (int c = 0; c < nchunk; c++) {
+        if (!(it->chunk_time[c] > 0.0))
+            return; /* a chunk without a measurement: keep the shares */
+        speed[c] = it->chunk_share[c] / it->chunk_time[c];
+        sum += speed[c];
+    }
+    double total = 0.0;
+    for (int c = 0; c < nchunk; c++) {
+        double share = 0.5 * (it->chunk_share[c] + speed[c] / sum);
+        if (share < 0.1 / nchunk)
+            share = 0.1 / nchunk;
+        it->chunk_share[c] = share;
+        total += share;
+    }
+    for (int c = 0; c < nchunk; c++) {
+        it->chunk_share[c] /= total;
+        it->chunk_time[c] = 0.0;
+    }
 }
 
 /* Splits the elements into nchunk ranges of about equal work (element_work) and lists the
@@ -687,16 +730,32 @@ static void make_chunks(cdem_integrator *it, const uint32_t *flags, size_t n, in
     it->chunk_n = n;
     it->chunk_elem[0] = 0;
     if (nchunk > 1) {
+        update_shares(it, nchunk);
+        /* each element's work once (in parallel when there is room to keep it), then the
+         * running sum */
+        uint32_t *restrict work = it->kickcap >= n ? it->elem_work : NULL;
+        if (work) {
+#pragma omp parallel for schedule(static) if ((long)n > it->par_min)
+            for (long e = 0; e < (long)n; e++)
+                work[e] = element_work(nb, flags, (size_t)e);
+        }
         uint64_t total = 0;
         for (size_t e = 0; e < n; e++)
-            total += element_work(nb, flags, e);
-        /* chunk c starts at the first element with at least c/nchunk of the work before it */
+            total += work ? work[e] : element_work(nb, flags, e);
+        /* chunk c starts at the first element with at least the shares of chunks 0..c-1 of
+         * the work before it */
+        double cum = 0.0;
+        uint64_t want[CDEM_MAX_CHUNKS];
+        for (int c = 1; c < nchunk; c++) {
+            cum += it->chunk_share[c - 1];
+            want[c] = (uint64_t)(cum * (double)total);
+        }
         uint64_t before = 0;
         int c = 1;
         for (size_t e = 0; e < n && c < nchunk; e++) {
-            while (c < nchunk && before >= total * (uint64_t)c / (uint64_t)nchunk)
+            while (c < nchunk && before >= want[c])
                 it->chunk_elem[c++] = (int32_t)e;
-            before += element_work(nb, flags, e);
+            before += work ? work[e] : element_work(nb, flags, e);
         }
         while (c < nchunk)
             it->chunk_elem[c++] = (int32_t)n;
@@ -803,6 +862,8 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
             atomic_store_explicit(&it->cross_done[c].slot, 0, memory_order_relaxed); /* nothing
                                                 evaluated yet: reset before every pass */
         int moved = 0;
+        for (int c = 0; c < nchunk; c++)
+            fp.seconds[c] = -1.0; /* no time: a thread that did not run */
 #pragma omp parallel num_threads(nchunk)
         {
             const int t = omp_get_thread_num(), nt = omp_get_num_threads();
@@ -824,14 +885,25 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
             }
             /* each thread first evaluates the cross pairs into its chunks, then runs them */
             if (go) {
+                const double t0 = omp_get_wtime();
                 for (int c = t; c < nchunk; c += nt)
                     cross_eval(&fp, c);
                 for (int c = t; c < nchunk; c += nt)
                     chunk_pass(&fp, c);
+                fp.seconds[t] = omp_get_wtime() - t0; /* for the load balance */
+                if (nt != nchunk)
+                    fp.seconds[t] = -1.0;
             }
         }
         if (moved)
             return 1;
+        /* running means of the chunks' times (one chunk per thread), for the next cut */
+        for (int c = 0; c < nchunk; c++) {
+            const double sec = fp.seconds[c];
+            if (!(sec >= 0.0))
+                continue;
+            it->chunk_time[c] = it->chunk_time[c] > 0.0 ? 0.9 * it->chunk_time[c] + 0.1 * sec : sec;
+        }
     }
     it->unstable_index = -1;
     for (int c = 0; c < nchunk; c++)

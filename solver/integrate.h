@@ -69,6 +69,14 @@ typedef struct {
         _Atomic int32_t slot;
         char pad[64 - sizeof(int32_t)];
     } cross_done[CDEM_MAX_CHUNKS];
+    /* load balance: chunk c is cut to receive chunk_share[c] of the estimated work
+     * (make_chunks); chunk_time[c] is the running mean of the seconds its thread spent in
+     * the force passes since the last cut. At every cut the shares move toward equal
+     * times, so a thread on a slower or busier core gets less to do. Any cut gives the same
+     * bits (the sums do not depend on it), so the shares only change the speed. */
+    int share_n;                          /* nchunk the shares are for (0: none yet) */
+    double chunk_share[CDEM_MAX_CHUNKS];  /* fractions of the work, sum 1 */
+    double chunk_time[CDEM_MAX_CHUNKS];   /* s per force pass, running mean (0: none yet) */
     /* per-element factors of the two half kicks, derived from mass, dt and damping at every
      * list build (so masses may change only between builds: at set-up, or by appending
      * elements): kick_drift[i] = (dt/2) / m, kick_finish[i] = 1 / (m + c dt/2); the same
@@ -76,6 +84,7 @@ typedef struct {
      * instead of two per element and step. Valid for kick_build == nb.n_builds, kick_n ==
      * the element count and kick_dt == dt; scratch, not state (never serialised). */
     double *kick_drift, *kick_finish;
+    uint32_t *elem_work; /* scratch of make_chunks: each element's work (kickcap) */
     size_t kickcap;
     long kick_build;
     size_t kick_n;

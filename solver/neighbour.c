@@ -167,7 +167,10 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
 /* Restores the saved histories: old indices -> new through oldmap, then the slot of
  * (lo, hi) is found in lo's contiguous pi range. O(pairs). */
 static void restore_carry(cdem_neighbour *nb) {
-    for (size_t k = 0; k < nb->ncarry; k++) {
+    const long ncarry = (long)nb->ncarry;
+    /* every carried pair has its own slot: the iterations write disjoint slots */
+#pragma omp parallel for schedule(static) if (ncarry > nb->par_min)
+    for (long k = 0; k < ncarry; k++) {
         const cdem_pair_carry *c = &nb->carry[k];
         const size_t a = nb->oldmap[c->i], b = nb->oldmap[c->j];
         if (a == SIZE_MAX || b == SIZE_MAX)
