@@ -1,5 +1,7 @@
 #!/bin/sh
 # make bench: the performance report of docs/performance.md, in one self-explanatory output.
+#   0. The machine now: 2-thread speed-up of a compute-bound loop and of a streaming triad
+#      at 6, 24 and 240 MB (bench/bench_machine.c), the ceiling for the solver's own.
 #   1. Solver scaling: ns per element-step at ~2k, ~9k, ~35k and ~125k elements (the 100 x
 #      7.5 half-radii assembly), 1 and 2 threads interleaved in one process, medians of REPS,
 #      wall clock and CPU time, 2-thread speed-up (bench/bench_scale.c, "scale").
@@ -16,7 +18,7 @@
 #   LARGE=1     adds 200 x 7.5 half radii (~250,000 elements; ~1.5 more minutes)
 #   REPS=3      timed runs per size and thread count (medians)
 #   ELSTEPS=2e7 element-steps per timed run;  SETTLE=3000 untimed settling steps
-#   PARTS="scale full lammps analysis"  the parts to run
+#   PARTS="machine scale full lammps analysis"  the parts to run
 #   WORK=/tmp/cdem_bench  scratch directory (the default run's file is kept there)
 # OMP_WAIT_POLICY is left as the caller has it: unset, libgomp's default (an idle thread spins
 # for a while, then sleeps), which is what a user of cdem-run gets. OMP_WAIT_POLICY=passive
@@ -31,7 +33,7 @@ SIZES=${SIZES:-"10:5:0 10:5:1 40:5:1 100:7.5:1"}
 REPS=${REPS:-3}
 ELSTEPS=${ELSTEPS:-2e7}
 SETTLE=${SETTLE:-3000}
-PARTS=${PARTS:-"scale full lammps analysis"}
+PARTS=${PARTS:-"machine scale full lammps analysis"}
 WORK=${WORK:-/tmp/cdem_bench}
 PKGS="hdf5 gsl"
 CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon -Isolver"
@@ -41,6 +43,7 @@ cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_scale" bench/bench_scal
     "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_io" bench/bench_io.c \
     "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
+cc $CFLAGS -o "$BUILD/bench_machine" bench/bench_machine.c -lm
 
 has() { case " $PARTS " in *" $1 "*) return 0 ;; esac; return 1; }
 load() { cut -d' ' -f1-3 /proc/loadavg; }
@@ -54,6 +57,16 @@ echo "cdem bench: $(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git rev-parse --sho
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores," \
     "$(awk '/MemTotal/ {printf "%.0f GiB", $2/1048576}' /proc/meminfo); load average $(load)"
 echo "OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-(unset: libgomp default, spin then sleep)}; compiler flags -O2 (the project's)"
+
+if has machine; then
+    echo
+    echo "== 0. The machine now (bench/bench_machine.c): what 2 threads can gain over 1, compute-bound and streaming"
+    "$BUILD/bench_machine" | awk '
+        / compute / {printf "   compute (square roots, divisions; no memory): 2 threads %.2fx 1 thread\n", $8}
+        / triad /   {printf "   triad over %4s MB: %5.1f GB/s on 1 thread, %5.1f on 2: %.2fx\n", $4, $6, $8, $10}'
+    echo "   (on a shared virtual machine the streaming ratios vary from run to run; the solver's 2-thread speed-up"
+    echo "   at ~35,000 elements and above follows the 6 and 24 MB ones)"
+fi
 
 if has scale; then
     echo
