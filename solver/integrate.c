@@ -1,13 +1,16 @@
 /* integrate: see integrate.h. The step is: (1) half kick + drift of the free elements
- * (fused with nothing else, so the boundary mode can move its elements after it), (2) one
- * force pass (chunk_pass): the pair loop computes each pair force once into its slot and
- * scatters it to its two elements, then the elements are finished (second half kick).
- * Threads: the elements are cut into one chunk per thread (equal pair counts); a pair
- * whose two elements lie in different chunks (a cross pair, ~1-3 % of them with the state
- * in cell order) is evaluated first, then after one barrier every chunk sums and finishes
- * its own elements. Each element's sum has the same additions in the same order (ascending
- * pair index) for any chunking, so any thread count gives identical bits, the same as the
- * serial scatter. One parallel region per force pass. */
+ * (over the force pass's chunks; the boundary mode moves its elements after it), (2) one
+ * force pass (forces_and_kick): the rebuild test, then the pair loop (chunk_pass) computes
+ * each pair force once into its slot and scatters it to its two elements, then the
+ * elements are finished (second half kick, instability guard).
+ * Threads: the elements are cut into one chunk per thread, by estimated work and then by
+ * measured thread times (make_chunks, update_shares); a pair is evaluated by the chunk of
+ * its second element, so a pair whose two elements lie in different chunks (a cross pair)
+ * is evaluated first by the later chunk, which publishes its progress; the earlier chunk
+ * waits only if it reaches a cross pair not yet evaluated. Each element's sum has the same
+ * additions in the same order (ascending pair index) for any cut, so any thread count and
+ * any cut give identical bits, the same as the serial scatter. Two parallel regions and one
+ * barrier per step. */
 #include "integrate.h"
 
 #include "checkpoint.h"
@@ -533,10 +536,10 @@ typedef struct {
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
     const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
-    int nchunk;            /* chunks of this pass */
+    int nchunk;           /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (integrate.h) */
-    cdem_integrator *it;   /* cross_done progress slots */
-    long unstable[CDEM_MAX_CHUNKS]; /* per chunk: lowest unstable element index, or -1 */
+    cdem_integrator *it;                             /* cross_done progress slots */
+    long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
 
@@ -644,8 +647,8 @@ static void chunk_pass(force_pass *fp, int chunk) {
         wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
-                       fp->hdt, fp->c, fp->g,
-                       fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y, fp->aff);
+                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y,
+                       fp->aff);
     fp->unstable[chunk] = -1;
     if (fp->radius) {
         /* the run loop's guard (integrate.h): here, while the velocities are in cache */

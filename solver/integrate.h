@@ -74,9 +74,9 @@ typedef struct {
      * the force passes since the last cut. At every cut the shares move toward equal
      * times, so a thread on a slower or busier core gets less to do. Any cut gives the same
      * bits (the sums do not depend on it), so the shares only change the speed. */
-    int share_n;                          /* nchunk the shares are for (0: none yet) */
-    double chunk_share[CDEM_MAX_CHUNKS];  /* fractions of the work, sum 1 */
-    double chunk_time[CDEM_MAX_CHUNKS];   /* s per force pass, running mean (0: none yet) */
+    int share_n;                         /* nchunk the shares are for (0: none yet) */
+    double chunk_share[CDEM_MAX_CHUNKS]; /* fractions of the work, sum 1 */
+    double chunk_time[CDEM_MAX_CHUNKS];  /* s per force pass, running mean (0: none yet) */
     /* per-element factors of the two half kicks, derived from mass, dt and damping at every
      * list build (so masses may change only between builds: at set-up, or by appending
      * elements): kick_drift[i] = (dt/2) / m, kick_finish[i] = 1 / (m + c dt/2); the same
