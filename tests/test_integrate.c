@@ -249,6 +249,53 @@ static void test_integrate_unstable_guard(void **st) {
     }
 }
 
+/* The rebuild test made inside the force pass: a boundary element moved between steps (as
+ * a boundary mode moves it, after the drift) or a free element drifting more than half the
+ * skin triggers a list build in that very step, on 1 and on 2 threads (chunked test); a
+ * smaller move does not. */
+static void test_integrate_rebuild_test_in_force_pass(void **st) {
+    (void)st;
+    for (int threads = 1; threads <= 2; threads++) {
+        omp_set_num_threads(threads);
+        const double dt = 0.028;
+        cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+        cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+        cdem_integrator it;
+        cdem_error err;
+        cdem_state s;
+        make_box(&s, 50, 40, 7);
+        assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+        it.par_min = 0;
+        for (int k = 0; k < 3; k++)
+            assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        const double half_skin = 0.5 * it.nb.skin;
+        /* a wall element (never drifted) moved by 0.9 and then by 1.2 half skins */
+        size_t w = 0;
+        while (!(s.flags[w] & CDEM_FLAG_WALL))
+            w++;
+        long builds = it.nb.n_builds;
+        s.y[w] = it.nb.y0[w] + 0.9 * half_skin;
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        assert_int_equal(it.nb.n_builds, builds);
+        s.y[w] = it.nb.y0[w] + 1.2 * half_skin;
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        assert_int_equal(it.nb.n_builds, builds + 1);
+        assert_true(fabs(it.nb.y0[w] - s.y[w]) == 0.0); /* built at the moved position */
+        /* a free element given a velocity that drifts it 1.5 half skins in one step */
+        size_t f = s.n - 1;
+        while (s.flags[f] & CDEM_FLAGS_BOUNDARY)
+            f--;
+        builds = it.nb.n_builds;
+        s.vx[f] = 1.5 * half_skin / dt;
+        s.fx[f] = 0.0;
+        s.fy[f] = 0.0;
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        assert_int_equal(it.nb.n_builds, builds + 1);
+        cdem_integrator_free(&it);
+        cdem_state_free(&s);
+    }
+}
+
 static void test_integrate_deterministic_threads(void **st) {
     (void)st;
     cdem_state a, b;
@@ -339,6 +386,7 @@ int main(void) {
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
         cmocka_unit_test(test_integrate_unstable_guard),
+        cmocka_unit_test(test_integrate_rebuild_test_in_force_pass),
         cmocka_unit_test(test_integrate_nan_and_escape),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
