@@ -206,6 +206,21 @@ static void run_box(int threads, int nsteps, cdem_state *out) {
     cdem_integrator_free(&it);
 }
 
+/* A settled-looking box stepper for the threaded tests: make_box(seed), granular law, dt
+ * 0.028 s, every loop threaded (par_min 0), `steps` steps taken. */
+static void open_box(cdem_integrator *it, cdem_state *s, uint64_t seed, int steps) {
+    const double dt = 0.028;
+    cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    cdem_error err;
+    make_box(s, 50, 40, seed);
+    assert_int_equal(cdem_integrator_init(it, &p, &m, &err), CDEM_OK);
+    assert_int_equal(it->unstable_index, -1);
+    it->par_min = 0;
+    for (int k = 0; k < steps; k++)
+        assert_int_equal(cdem_integrator_step(it, s, NULL, 0, 0.0, &err), CDEM_OK);
+}
+
 /* The unstable-motion guard (unstable_index, read by the run loop): the lowest index whose
  * |v| dt exceeds its radius after the step, the same for 1 and 3 threads; -1 when no element
  * does or the guard is off. */
@@ -214,15 +229,10 @@ static void test_integrate_unstable_guard(void **st) {
     for (int threads = 1; threads <= 3; threads += 2) {
         omp_set_num_threads(threads);
         const double dt = 0.028;
-        cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
-        cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
         cdem_integrator it;
         cdem_error err;
         cdem_state s;
-        make_box(&s, 50, 40, 99);
-        assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
-        assert_int_equal(it.unstable_index, -1);
-        it.par_min = 0;
+        open_box(&it, &s, 99, 0);
         it.unstable_guard = 1;
         for (int k = 0; k < 5; k++)
             assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
@@ -258,16 +268,10 @@ static void test_integrate_rebuild_test_in_force_pass(void **st) {
     for (int threads = 1; threads <= 2; threads++) {
         omp_set_num_threads(threads);
         const double dt = 0.028;
-        cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
-        cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
         cdem_integrator it;
         cdem_error err;
         cdem_state s;
-        make_box(&s, 50, 40, 7);
-        assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
-        it.par_min = 0;
-        for (int k = 0; k < 3; k++)
-            assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+        open_box(&it, &s, 7, 3);
         const double half_skin = 0.5 * it.nb.skin;
         /* a wall element (never drifted) moved by 0.9 and then by 1.2 half skins */
         size_t w = 0;
