@@ -16,7 +16,7 @@
  * computes the mass of atom_style sphere from the 3-D volume even in 2-D; the bench script
  * checks that LAMMPS's total free mass equals ours.
  * Usage: export_lammps OUTDIR [width_units=10] [half_radii=0] [nphys=2000] [ntime=5000]
- *                      [reps=3] [equil_steps=model] */
+ *                      [reps=3] [equil_steps=model] [height_units=5] */
 #include "assembly.h"
 #include "bc.h"
 #include "integrate.h"
@@ -108,7 +108,7 @@ static void free_stats(const cdem_state *s, double *ke, double *mass, size_t *nf
 int main(int argc, char **argv) {
     if (argc < 2) {
         fprintf(stderr, "usage: export_lammps OUTDIR [width] [half_radii] [nphys] [ntime] [reps] "
-                        "[equil_steps]\n");
+                        "[equil_steps] [height]\n");
         return 2;
     }
     const char *dir = argv[1];
@@ -118,6 +118,8 @@ int main(int argc, char **argv) {
         p.width = atof(argv[2]);
     if (argc > 3)
         p.half_radii = atoi(argv[3]);
+    if (argc > 8)
+        p.height = atof(argv[8]);
     const long nphys = argc > 4 ? atol(argv[4]) : 2000;
     const long ntime = argc > 5 ? atol(argv[5]) : 5000;
     const int reps = argc > 6 ? atoi(argv[6]) : 3;
@@ -134,8 +136,8 @@ int main(int argc, char **argv) {
     }
     cdem_integrator_enable_escape(&it);
     it.boundary_forces = 0;
-    it.unstable_guard = 1; /* as cdem-run */
-    const long equil = argc > 7 ? atol(argv[7]) : m.equil_steps;
+    it.unstable_guard = 1;                                                     /* as cdem-run */
+    const long equil = argc > 7 && argv[7][0] ? atol(argv[7]) : m.equil_steps; /* "": model */
     double t0 = now_s();
     for (long k = 0; k < equil; k++)
         if (cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err)) {

@@ -15,8 +15,9 @@
 #   run (cdem: clock around the step loop; LAMMPS: its "Loop time"), median of REPS; the
 #   ratio cdem/LAMMPS; peak memory (/usr/bin/time -v "Maximum resident set size").
 # Usage: sh bench/lammps_bench.sh [BUILD]
-#   env: SIZES="10:0 10:1 40:1" (width_units:half_radii: ~2,500, ~9,100 and ~35,000
-#        elements; 40:1 is most of the 3-4 minutes, mostly cdem's equilibration), REPS=3,
+#   env: SIZES="10:0 10:1 40:1" (width_units:half_radii[:height_units, default 5]: ~2,500,
+#        ~9,100 and ~35,000 elements; 40:1 is most of the 3-4 minutes, mostly cdem's
+#        equilibration; add 100:1:7.5 for ~125,000 elements, about 6 more minutes), REPS=3,
 #        NPHYS=2000, WORK=/tmp/cdem_lammps_bench, ELSTEPS=2e7 (element-steps per timed
 #        run), KE_TOL=0.02, OV_TOL=0.01
 # Installs Debian's lammps (and time) with apt-get when missing (needs root).
@@ -56,18 +57,19 @@ echo "lammps_bench: $(lmp -h | grep -m1 '^Large-scale' || true) $(lmp -h | grep 
 echo "lammps_bench: machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
 failed=""
 for size in $SIZES; do
-    width=${size%%:*}
-    half=${size##*:}
-    dir="$WORK/w${width}_h${half}"
+    width=$(echo "$size" | cut -d: -f1)
+    half=$(echo "$size" | cut -d: -f2)
+    height=$(echo "$size:5" | cut -d: -f3)
+    dir="$WORK/w${width}_h${half}_y${height}"
     mkdir -p "$dir"
     # N is known only after the assembly is built: estimate the step count from the default
     # element count (2,500 at 10 x 5; x4 for half radii; x width/10)
-    n_est=$(awk -v w="$width" -v h="$half" 'BEGIN {print 2500 * w / 10 * (h ? 4 : 1)}')
+    n_est=$(awk -v w="$width" -v h="$half" -v y="$height" 'BEGIN {print 2500 * w / 10 * y / 5 * (h ? 4 : 1)}')
     ntime=$(awk -v e="$ELSTEPS" -v n="$n_est" 'BEGIN {s = int(e / n); print (s < 50 ? 50 : s)}')
-    echo "== size ${width} x 5 units, half_radii ${half}: ${NPHYS} physics steps, ${REPS} x ${ntime} timed steps"
+    echo "== size ${width} x ${height} units, half_radii ${half}: ${NPHYS} physics steps, ${REPS} x ${ntime} timed steps"
 
     OMP_NUM_THREADS=2 /usr/bin/time -v -o "$dir/cdem.time" "$BUILD/export_lammps" "$dir" \
-        "$width" "$half" "$NPHYS" "$ntime" "$REPS" >"$dir/cdem.out"
+        "$width" "$half" "$NPHYS" "$ntime" "$REPS" "" "$height" >"$dir/cdem.out"
     OMP_NUM_THREADS=1 /usr/bin/time -v -o "$dir/lmp1.time" lmp -in bench/lammps_bench.in \
         -var dir "$dir" -var nphys "$NPHYS" -var ntime "$ntime" -var reps "$REPS" \
         -log "$dir/lmp1.log" -screen none
@@ -102,7 +104,7 @@ for size in $SIZES; do
     echo "   physics after $NPHYS steps: kinetic energy cdem $kc J/m, LAMMPS $kl (2 ranks: $kl2), rel. diff $ek (tol $KE_TOL)"
     echo "   physics after $NPHYS steps: mean overlap cdem $oc m, LAMMPS $ol m, rel. diff $eo (tol $OV_TOL); largest position difference $dpos m"
     echo "   physics check: $ok"
-    [ "$ok" = PASS ] || failed="$failed ${width}:${half}"
+    [ "$ok" = PASS ] || failed="$failed ${width}:${half}:${height}"
 
     c1=$(awk '/^CDEM_TIME threads 1/ {print $11}' "$dir/cdem.out" | median)
     c2=$(awk '/^CDEM_TIME threads 2/ {print $11}' "$dir/cdem.out" | median)
