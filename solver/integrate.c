@@ -428,11 +428,11 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
  * pairs a chunk owns, the position in the cross list and its buffers for a cross pair.
  * (A branch-free variant of the granular law, evaluating every list pair and selecting the
  * result, was measured 40-50 % slower: gcc -O2 still branches and does more work.) */
-static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, long q,
-                                   double dx, double dy, double dvx, double dvy,
-                                   const double *restrict Rp, const uint8_t *restrict cls,
-                                   uint8_t *restrict hist, double *restrict xs,
-                                   double *restrict pfx, double *restrict pfy, double dt) {
+static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, long q, double dx,
+                                   double dy, double dvx, double dvy, const double *restrict Rp,
+                                   const uint8_t *restrict cls, uint8_t *restrict hist,
+                                   double *restrict xs, double *restrict pfx, double *restrict pfy,
+                                   double dt) {
     const double R = Rp[p];
     const uint8_t h = hist[q];
     const double r2 = dx * dx + dy * dy;
@@ -560,9 +560,9 @@ typedef struct {
     int nchunk;           /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (integrate.h) */
     const int32_t *cross_out, *cross_out_start;      /* outgoing cross pairs per chunk */
-    double *cross_fx, *cross_fy, *cross_xs;           /* cross-pair results (integrate.h) */
+    double *cross_fx, *cross_fy, *cross_xs;          /* cross-pair results (integrate.h) */
     uint8_t *cross_hist;
-    cdem_integrator *it;                             /* cross_done progress slots */
+    cdem_integrator *it;             /* cross_done progress slots */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
@@ -614,9 +614,8 @@ static void cross_eval(const force_pass *fp, int c) {
          * arrays around p belong to the chunk of pi, which copies the results back */
         fp->cross_hist[k] = fp->hist[p];
         fp->cross_xs[k] = fp->xs[p];
-        pair_force(fp->law, p, k, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i],
-                   fp->Rp, fp->cls, fp->cross_hist, fp->cross_xs, fp->cross_fx, fp->cross_fy,
-                   fp->dt);
+        pair_force(fp->law, p, k, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                   fp->cls, fp->cross_hist, fp->cross_xs, fp->cross_fx, fp->cross_fy, fp->dt);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
@@ -658,8 +657,8 @@ static void chunk_pass(force_pass *fp, int chunk) {
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
-            pair_force(law, p, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i],
-                       fp->Rp, fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+            pair_force(law, p, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                       fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
             fx[i] += pfx[p];
