@@ -69,11 +69,6 @@ void cdem_integrator_free(cdem_integrator *it) {
     free(it->band_lo);
     free(it->band_hi);
     free(it->cross);
-    free(it->cross_fx);
-    free(it->cross_fy);
-    free(it->cross_xs);
-    free(it->cross_hist);
-    free(it->cross_out);
     free(it->kick_drift);
     free(it->kick_finish);
     free(it->elem_work);
@@ -159,25 +154,11 @@ static cdem_status find_escapes(cdem_integrator *it, const cdem_state *s, size_t
 static cdem_status reserve_cross(cdem_integrator *it, cdem_error *err) {
     if (it->crosscap >= it->nb.pcap)
         return CDEM_OK;
-    const size_t c = it->nb.pcap ? it->nb.pcap : 1;
-    int ok = 1;
-#define GROW_CROSS(field)                                                                          \
-    do {                                                                                           \
-        void *q_ = ok ? realloc(it->field, c * sizeof *it->field) : NULL;                          \
-        if (q_)                                                                                    \
-            it->field = q_;                                                                        \
-        else                                                                                       \
-            ok = 0;                                                                                \
-    } while (0)
-    GROW_CROSS(cross);
-    GROW_CROSS(cross_fx);
-    GROW_CROSS(cross_fy);
-    GROW_CROSS(cross_xs);
-    GROW_CROSS(cross_hist);
-    GROW_CROSS(cross_out);
-#undef GROW_CROSS
-    if (!ok)
+    const size_t c = it->nb.pcap;
+    int32_t *q = realloc(it->cross, (c ? c : 1) * sizeof *q);
+    if (!q)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu cross pairs)", c);
+    it->cross = q;
     it->crosscap = c;
     return CDEM_OK;
 }
@@ -423,26 +404,24 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
 #define CDEM_INLINE inline
 #endif
 
-/* Force of pair p on its pi into pfx[q], pfy[q] (zero when it does not touch), with the
- * contact history in hist[q], xs[q] (read and updated): q = p and the slot arrays for the
- * pairs a chunk owns, the position in the cross list and its buffers for a cross pair.
+/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch).
  * (A branch-free variant of the granular law, evaluating every list pair and selecting the
  * result, was measured 40-50 % slower: gcc -O2 still branches and does more work.) */
-static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, long q, double dx,
+static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
                                    double dy, double dvx, double dvy, const double *restrict Rp,
                                    const uint8_t *restrict cls, uint8_t *restrict hist,
                                    double *restrict xs, double *restrict pfx, double *restrict pfy,
                                    double dt) {
     const double R = Rp[p];
-    const uint8_t h = hist[q];
+    const uint8_t h = hist[p];
     const double r2 = dx * dx + dy * dy;
     if (!(h & CDEM_PAIR_BONDED) && (r2 >= R * R || r2 <= 0.0)) {
         /* the common case: a list pair that does not touch (xs != 0 only with h != 0) */
-        pfx[q] = 0.0;
-        pfy[q] = 0.0;
+        pfx[p] = 0.0;
+        pfy[p] = 0.0;
         if (h) {
-            hist[q] = 0;
-            xs[q] = 0.0;
+            hist[p] = 0;
+            xs[p] = 0.0;
         }
         return;
     }
@@ -458,7 +437,7 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
         uint8_t hn = (uint8_t)(h | CDEM_PAIR_TOUCH);
         if (law->ks > 0.0) {
             const double tx = -ny, ty = nx;
-            double sv = xs[q] + (dvx * tx + dvy * ty) * dt;
+            double sv = xs[p] + (dvx * tx + dvy * ty) * dt;
             double fs = law->ks * sv;
             double limit = law->friction[c] * fn;
             if (hn & CDEM_PAIR_COHESIVE)
@@ -469,16 +448,16 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
                 if (law->first_slip)
                     hn &= (uint8_t)~CDEM_PAIR_COHESIVE;
             }
-            xs[q] = sv;
+            xs[p] = sv;
             ftx = fs * tx;
             fty = fs * ty;
         }
-        pfx[q] = -fn * nx + ftx;
-        pfy[q] = -fn * ny + fty;
-        hist[q] = hn;
+        pfx[p] = -fn * nx + ftx;
+        pfy[p] = -fn * ny + fty;
+        hist[p] = hn;
         return;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[q], &hist[q], &pfx[q], &pfy[q]);
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
 }
 
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
@@ -559,10 +538,7 @@ typedef struct {
     const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
     int nchunk;           /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (integrate.h) */
-    const int32_t *cross_out, *cross_out_start;      /* outgoing cross pairs per chunk */
-    double *cross_fx, *cross_fy, *cross_xs;          /* cross-pair results (integrate.h) */
-    uint8_t *cross_hist;
-    cdem_integrator *it;             /* cross_done progress slots */
+    cdem_integrator *it;                             /* cross_done progress slots */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
@@ -600,8 +576,8 @@ static void publish_cross(const force_pass *fp, int c, int32_t slot) {
     atomic_store_explicit(&fp->it->cross_done[c].slot, slot, memory_order_release);
 }
 
-/* Evaluates the cross pairs into chunk c (into the cross buffers; no sums), in ascending
- * slot order, publishing the progress every CROSS_PUBLISH_EVERY pairs. */
+/* Evaluates the cross pairs into chunk c (their slots only; no sums), in ascending slot
+ * order, publishing the progress every CROSS_PUBLISH_EVERY pairs. */
 static void cross_eval(const force_pass *fp, int c) {
     const double *restrict x = fp->x, *restrict y = fp->y;
     const double *restrict vx = fp->vx, *restrict vy = fp->vy;
@@ -610,12 +586,8 @@ static void cross_eval(const force_pass *fp, int c) {
     for (int32_t k = a; k < b; k++) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
-        /* the history in, the results out, through this chunk's own buffers: the slot
-         * arrays around p belong to the chunk of pi, which copies the results back */
-        fp->cross_hist[k] = fp->hist[p];
-        fp->cross_xs[k] = fp->xs[p];
-        pair_force(fp->law, p, k, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                   fp->cls, fp->cross_hist, fp->cross_xs, fp->cross_fx, fp->cross_fy, fp->dt);
+        pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                   fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
@@ -646,10 +618,9 @@ static void chunk_pass(force_pass *fp, int chunk) {
     memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
     for (int32_t k = ca; k < cb; k++) {
         const long p = list[k];
-        fx[pj[p]] -= fp->cross_fx[k];
-        fy[pj[p]] -= fp->cross_fy[k];
+        fx[pj[p]] -= pfx[p];
+        fy[pj[p]] -= pfy[p];
     }
-    const int32_t *restrict out = fp->cross_out + fp->cross_out_start[chunk];
     const int32_t *restrict pi = fp->pi;
     const long p0 = istart[lo], pe = istart[hi];
     /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
@@ -657,24 +628,18 @@ static void chunk_pass(force_pass *fp, int chunk) {
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
-            pair_force(law, p, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+            pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
                        fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
             fx[i] += pfx[p];
             fy[i] += pfy[p];
         } else {
-            /* a cross pair: evaluated by the chunk of j into the cross buffers; its results
-             * go to the sum and, copied, to the slots (so only this chunk writes them) */
+            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
             if (p >= safe)
                 safe = wait_cross(fp, chunk, (int32_t)p + 1);
-            const int32_t k = *out++;
-            fx[i] += fp->cross_fx[k];
-            fy[i] += fp->cross_fy[k];
-            pfx[p] = fp->cross_fx[k];
-            pfy[p] = fp->cross_fy[k];
-            fp->xs[p] = fp->cross_xs[k];
-            fp->hist[p] = fp->cross_hist[k];
+            fx[i] += fp->pfx[p];
+            fy[i] += fp->pfy[p];
         }
     }
     /* the cross pairs out of this chunk read its velocities: kick only after all of them */
@@ -800,7 +765,7 @@ static void make_chunks(cdem_integrator *it, const uint32_t *flags, size_t n, in
     }
     it->chunk_elem[nchunk] = (int32_t)n;
     for (int c = 0; c <= nchunk; c++)
-        it->cross_start[c] = it->cross_out_start[c] = 0;
+        it->cross_start[c] = 0;
     if (nchunk == 1)
         return;
     /* count, then fill, the cross pairs by the chunk of pj (ascending slots in each) */
@@ -808,9 +773,7 @@ static void make_chunks(cdem_integrator *it, const uint32_t *flags, size_t n, in
         int32_t cursor[CDEM_MAX_CHUNKS + 1];
         for (int c = 0; c <= nchunk; c++)
             cursor[c] = it->cross_start[c];
-        int32_t n_out = 0; /* outgoing cross pairs so far, chunk by chunk in slot order */
         for (int ci = 0; ci < nchunk; ci++) {
-            it->cross_out_start[ci] = n_out;
             const int32_t end = it->chunk_elem[ci + 1];
             for (int32_t p = nb->istart[it->chunk_elem[ci]]; p < nb->istart[end]; p++) {
                 const int32_t j = nb->pj[p];
@@ -819,16 +782,12 @@ static void make_chunks(cdem_integrator *it, const uint32_t *flags, size_t n, in
                 int cj = ci + 1;
                 while (j >= it->chunk_elem[cj + 1])
                     cj++;
-                if (pass == 0) {
+                if (pass == 0)
                     cursor[cj + 1]++;
-                } else {
-                    it->cross_out[n_out] = cursor[cj];
+                else
                     it->cross[cursor[cj]++] = p;
-                }
-                n_out++;
             }
         }
-        it->cross_out_start[nchunk] = n_out;
         if (pass == 0)
             for (int c = 0; c < nchunk; c++)
                 it->cross_start[c + 1] = it->cross_start[c] + cursor[c + 1];
@@ -895,12 +854,6 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
     fp.chunk_elem = it->chunk_elem;
     fp.cross_start = it->cross_start;
     fp.cross = it->cross;
-    fp.cross_out = it->cross_out;
-    fp.cross_out_start = it->cross_out_start;
-    fp.cross_fx = it->cross_fx;
-    fp.cross_fy = it->cross_fy;
-    fp.cross_xs = it->cross_xs;
-    fp.cross_hist = it->cross_hist;
     fp.it = it;
     fp.radius = it->unstable_guard ? s->radius : NULL;
     if (nchunk == 1) {

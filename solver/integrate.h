@@ -58,16 +58,7 @@ typedef struct {
     int32_t cross_start[CDEM_MAX_CHUNKS + 1]; /* cross pairs into chunk c: cross[cross_start[c]
                                                  .. cross_start[c+1]-1], ascending slots */
     int32_t *cross;                           /* pair slots of the cross pairs (crosscap) */
-    /* results of the cross pairs, by position in cross[]: written by the evaluating (later)
-     * chunk, copied into the pair slots by the chunk of pi when its scan reaches them, so
-     * that each thread writes only its own chunk's slots (no cache line of the slot arrays
-     * is written by two threads in a pass) */
-    double *cross_fx, *cross_fy, *cross_xs; /* N, N, m (crosscap) */
-    uint8_t *cross_hist;                    /* CDEM_PAIR_* (crosscap) */
-    int32_t *cross_out; /* per chunk, its outgoing cross pairs in slot order, as positions in
-                           cross[]: cross_out[cross_out_start[c] .. cross_out_start[c+1]-1] */
-    int32_t cross_out_start[CDEM_MAX_CHUNKS + 1];
-    size_t crosscap; /* capacity of cross and the arrays above, >= nb.pcap after builds */
+    size_t crosscap;                          /* capacity of cross, >= nb.pcap after builds */
     /* progress of each chunk's cross-pair evaluation in the current threaded pass: every
      * cross pair of chunk c at a slot below cross_done[c].slot is evaluated (atomic; reset to
      * 0 before every pass, raised in steps as the chunk's thread goes through its ascending
