@@ -163,8 +163,9 @@ static cdem_status reserve_cross(cdem_integrator *it, cdem_error *err) {
     return CDEM_OK;
 }
 
-/* Grows the kick factors to n elements (after a list build, outside the step's hot loops). */
-static cdem_status reserve_kick(cdem_integrator *it, size_t n, cdem_error *err) {
+/* Grows the per-element scratch (kick factors, chunk work) to n elements (after a list
+ * build, outside the step's hot loops). */
+static cdem_status reserve_per_element(cdem_integrator *it, size_t n, cdem_error *err) {
     if (it->kickcap >= n)
         return CDEM_OK;
     const size_t c = n + n / 2 + 16;
@@ -206,21 +207,29 @@ static int update_kick(cdem_integrator *it, const cdem_state *s) {
     return 1;
 }
 
-static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
-    size_t nrem = 0;
-    CDEM_TRY(find_escapes(it, s, &nrem, err));
-    it->n_removed_last = nrem;
-    it->n_removed += (long)nrem;
+/* A list build (removing the elements with keep[i] == 0 when keep is given) and what is
+ * derived from the list and the state at every build: the scratch grown to the new sizes,
+ * the pair classes, the surface and edge elements. */
+static cdem_status build_list(cdem_integrator *it, cdem_state *s, const unsigned char *keep,
+                              cdem_error *err) {
     it->nb.par_min = it->par_min;
-    CDEM_TRY(cdem_neighbour_build(&it->nb, s, nrem ? it->keep : NULL, 0, err));
+    CDEM_TRY(cdem_neighbour_build(&it->nb, s, keep, 0, err));
     CDEM_TRY(reserve_cross(it, err));
-    CDEM_TRY(reserve_kick(it, s->n, err));
+    CDEM_TRY(reserve_per_element(it, s->n, err));
     cdem_integrator_classify(it, s);
     if (it->overburden_force > 0.0)
         CDEM_TRY(cdem_integrator_find_surface(it, s, err));
     if (it->confining_pressure > 0.0)
         CDEM_TRY(cdem_integrator_find_edges(it, s, err));
     return CDEM_OK;
+}
+
+static cdem_status rebuild(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    size_t nrem = 0;
+    CDEM_TRY(find_escapes(it, s, &nrem, err));
+    it->n_removed_last = nrem;
+    it->n_removed += (long)nrem;
+    return build_list(it, s, nrem ? it->keep : NULL, err);
 }
 
 void cdem_integrator_classify(cdem_integrator *it, const cdem_state *s) {
@@ -805,8 +814,8 @@ static int wanted_chunks(const cdem_integrator *it, long n) {
  * (chunk_pass). Threaded: one parallel region, each thread evaluates the cross pairs into
  * its chunks (publishing its progress), then runs its chunks, waiting only where it meets a
  * cross pair not yet evaluated; every element sum has the same additions in the same order
- * for any chunking, so the bits do not depend on the thread count. */
-/* check_moved: first test whether some element moved more than half the skin since the
+ * for any chunking, so the bits do not depend on the thread count.
+ * check_moved: first test whether some element moved more than half the skin since the
  * last build (cdem_neighbour_moved over each chunk, in the same parallel region, while the
  * positions are in the cache of the thread that just drifted them); if so nothing is
  * computed and 1 is returned: the caller rebuilds and calls again without the test. The
@@ -814,7 +823,7 @@ static int wanted_chunks(const cdem_integrator *it, long n) {
 static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved) {
     cdem_neighbour *nb = &it->nb;
     const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
-    const long np = (long)nb->np, n = (long)s->n;
+    const long n = (long)s->n;
     force_pass fp = {
         .law = &lawc,
         .kick = kick,
@@ -845,7 +854,6 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .vx = s->vx,
         .vy = s->vy,
     };
-    (void)np;
     const int nch = wanted_chunks(it, n);
     if (it->nchunk != nch || it->chunk_build != nb->n_builds || it->chunk_n != (size_t)n)
         make_chunks(it, s->flags, (size_t)n, nch);
@@ -1005,15 +1013,7 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
 static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem, cdem_error *err) {
     CDEM_TRY(collect_removed(it, s, nrem, err));
     it->n_removed_last = nrem;
-    it->nb.par_min = it->par_min;
-    CDEM_TRY(cdem_neighbour_build(&it->nb, s, it->keep, 0, err));
-    CDEM_TRY(reserve_cross(it, err));
-    CDEM_TRY(reserve_kick(it, s->n, err));
-    cdem_integrator_classify(it, s);
-    if (it->overburden_force > 0.0)
-        CDEM_TRY(cdem_integrator_find_surface(it, s, err));
-    if (it->confining_pressure > 0.0)
-        CDEM_TRY(cdem_integrator_find_edges(it, s, err));
+    CDEM_TRY(build_list(it, s, it->keep, err));
     const double dt = it->dt;
     it->dt = 0.0;
     forces_and_kick(it, s, 0, 0);
@@ -1146,7 +1146,7 @@ cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapsho
     CDEM_TRY(cdem_neighbour_snapshot_get(&it->nb, snap, s, err));
     CDEM_TRY(reserve_keep(it, s->n, err));
     CDEM_TRY(reserve_cross(it, err));
-    CDEM_TRY(reserve_kick(it, s->n, err));
+    CDEM_TRY(reserve_per_element(it, s->n, err));
     it->step = (long)step;
     it->boundary_forces = (int)bf;
     it->bounds_set = (int)bounds;

@@ -48,9 +48,9 @@ typedef struct {
     /* force pass decomposition (scratch derived from the pair list, not state: rebuilt
      * whenever the list or the thread count changes; never serialised). Chunk c owns the
      * elements chunk_elem[c]..chunk_elem[c+1]-1 and their pi ranges; a cross pair has its
-     * pj in a later chunk than its pi and is evaluated by the chunk of its pj, so every pair
-     * is evaluated by the chunk of its pj and the chunks are cut at equal counts of pairs by
-     * pj (jstart) plus a share per element. */
+     * pj in a later chunk than its pi; every pair is evaluated by the chunk of its pj, and
+     * the chunks are cut by estimated work (pairs by pj, elements) scaled by the shares
+     * below. */
     int nchunk;                              /* chunks of the last force pass, 1..CDEM_MAX_CHUNKS */
     long chunk_build;                        /* nb.n_builds the chunks were derived for */
     size_t chunk_n;                          /* element count the chunks were derived for */
@@ -85,7 +85,7 @@ typedef struct {
      * the element count and kick_dt == dt; scratch, not state (never serialised). */
     double *kick_drift, *kick_finish;
     uint32_t *elem_work; /* scratch of make_chunks: each element's work (kickcap) */
-    size_t kickcap;
+    size_t kickcap;      /* capacity of kick_drift, kick_finish and elem_work */
     long kick_build;
     size_t kick_n;
     double kick_dt;
