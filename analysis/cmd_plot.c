@@ -5,6 +5,7 @@
 #include "plot.h"
 #include "render.h"
 #include "repose.h"
+#include "voids.h"
 
 #include "outfile.h"
 
@@ -103,6 +104,7 @@ typedef struct {
     const char *increment;        /* --increment K (repose) */
     int width, height;            /* --width, --height; 0 = default */
     int fix_x, fix_y;             /* 1: --xrange / --yrange given */
+    double window;                /* --window M (voids); 0 = default */
     double range[4];              /* xmin, xmax, ymin, ymax of --xrange, --yrange */
 } plot_args;
 
@@ -150,7 +152,7 @@ static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis)
     const char *cmd = a->cmd;
     static const char *const names[] = {"--y",      "--x",         "-o",      "--output",
                                         "--data",   "--increment", "--width", "--height",
-                                        "--xrange", "--yrange"};
+                                        "--xrange", "--yrange",    "--window"};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
@@ -198,6 +200,16 @@ static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis)
                 }
                 *(f == 8 ? &a->fix_x : &a->fix_y) = 1;
                 break;
+            case 10: {
+                char *end;
+                errno = 0;
+                a->window = strtod(val, &end);
+                if (errno || end == val || *end || !(a->window > 0.0) || !isfinite(a->window)) {
+                    snprintf(msg, sizeof msg, "--window '%.60s': need a length in m > 0", val);
+                    return usage(cmd, msg, synopsis);
+                }
+                break;
+            }
             default:
                 if (!parse_size(val, f == 6 ? &a->width : &a->height)) {
                     snprintf(msg, sizeof msg, "%s '%.60s': need a whole number in 16..20000",
@@ -565,6 +577,49 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
     }
     if (st == CDEM_OK && a.out)
         st = repose_figure(&a, &s, (int)info.number, &res, &err);
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    return st == CDEM_OK ? 0 : fail(a.cmd, &err);
+}
+
+/* ---------------------------------------------------------------- voids */
+static const char voids_synopsis[] = "RUN.h5 [--increment K|last|equil|first] [--window M]";
+
+int cdem_cmd_plot_voids(int argc, char **argv) {
+    plot_args a = {.cmd = "voids"};
+    int rc = parse_args(argc, argv, &a, voids_synopsis);
+    if (rc)
+        return rc < 0 ? 0 : rc;
+    if (a.n_files != 1)
+        return usage(a.cmd, "need exactly one run file (RUN.h5)", voids_synopsis);
+    if (a.out)
+        return usage(a.cmd, "prints numbers only (no -o)", voids_synopsis);
+    cdem_error err;
+    cdem_h5_reader *r;
+    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
+        return fail(a.cmd, &err);
+    cdem_state s = {0};
+    cdem_increment_info info;
+    size_t idx;
+    cdem_voids_result res;
+    cdem_status st =
+        cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &idx, &err);
+    if (st == CDEM_OK)
+        st = cdem_h5_reader_load_increment(r, idx, &s, &info, &err);
+    if (st == CDEM_OK)
+        st = cdem_voids_measure(&s, a.window > 0.0 ? a.window : 1000.0, &res, &err);
+    if (st == CDEM_OK) {
+        printf("increment %d\n", (int)info.number);
+        printf("steepest surface slope = %.2f deg over %.4g m (columns at x = %.6g and %.6g m)\n",
+               res.steepest_deg, res.window, res.steepest_x0, res.steepest_x1);
+        printf("voids = %zu (closed-off room for the largest element, radius %.4g m), their room "
+               "%.4g m^2\n",
+               res.n_voids, res.min_clearance, res.void_area);
+        printf("largest clearance inside = %.4g m (%.2f x the largest radius) at x = %.6g m, y = "
+               "%.6g m\n",
+               res.largest_clearance, res.largest_clearance / res.min_clearance, res.largest_x,
+               res.largest_y);
+    }
     cdem_state_free(&s);
     cdem_h5_reader_close(r);
     return st == CDEM_OK ? 0 : fail(a.cmd, &err);

@@ -2,6 +2,7 @@
  *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT
  *   mohr RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT]   (Mohr-Coulomb fit, see mohr.h)
  *   repose RUN.h5 [--increment K] [-o OUT]             (angle of repose, see repose.h)
+ *   voids RUN.h5 [--increment K] [--window M]          (open space and cliffs, see voids.h)
  * Each returns the process exit code (0 ok, 1 error, 2 usage) and prints its own messages
  * ("cdem-strain <command>: ..." on stderr); argv[0] is the subcommand word.
  * cdem_cmd_plot_column extracts a named time-series column (library style, no printing).
@@ -24,5 +25,6 @@ cdem_status cdem_cmd_plot_column(const cdem_series_sample *samples, size_t n, co
 int cdem_cmd_plot_series(int argc, char **argv);
 int cdem_cmd_plot_mohr(int argc, char **argv);
 int cdem_cmd_plot_repose(int argc, char **argv);
+int cdem_cmd_plot_voids(int argc, char **argv);
 
 #endif

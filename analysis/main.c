@@ -416,6 +416,9 @@ static void print_help(void) {
            "RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT.png]");
     printf("  %-15s %s\n  %-15s   %s\n", "repose", "angle of repose of the free surface", "",
            "RUN.h5 [--increment K] [-o OUT.png]");
+    printf("  %-15s %s\n  %-15s   %s\n", "voids",
+           "steepest surface slope and open voids (cliffs, chasms, cavities)", "",
+           "RUN.h5 [--increment K] [--window M]");
     printf("  %-15s %s\n  %-15s   %s\n", "wedge",
            "accretionary-wedge height, length, taper, area, forces", "",
            "RUN.h5 [-o OUT.csv] [--increment K|last|all] [--threshold M]");
@@ -495,6 +498,8 @@ int main(int argc, char **argv) {
         return cdem_cmd_plot_mohr(argc - 1, argv + 1);
     if (!strcmp(argv[1], "repose"))
         return cdem_cmd_plot_repose(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "voids"))
+        return cdem_cmd_plot_voids(argc - 1, argv + 1);
     if (!strcmp(argv[1], "wedge"))
         return cdem_cmd_wedge(argc - 1, argv + 1);
     if (!strcmp(argv[1], "plot-csv"))

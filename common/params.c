@@ -29,6 +29,8 @@
 #define NOMAX HUGE_VAL
 
 static const char *const material_words[] = {"granular", "bonded", NULL};
+static const char *const law_words[] = {"normal-cohesion", "coulomb", "spring-cohesion", NULL};
+static const char *const cohesive_words[] = {"equilibrated", "formed", NULL};
 static const char *const mode_words[] = {
     "planar-fault", "listric-fault", "irregular-fault", "vertical-faults",
     "detachment",   "repose",        "biaxial",         NULL};
@@ -84,6 +86,12 @@ static const cdem_param_def param_table[] = {
      "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)"},
     {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
      "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
+    {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
+     "granular: shear strength mu (Fn + C0) (normal-cohesion), mu Fn + C0 (coulomb), or Fs = Ks Xs + C0 capped at mu Fn (spring-cohesion)"},
+    {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "equilibrated", 0, 0, 0, 0, cohesive_words,
+     "granular: C0 on the contacts of the end of equilibration (equilibrated), or also on every contact formed later (formed)"},
+    {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "1", 0, 1, 0, 0, NULL,
+     "granular: friction multiplier during equilibration (packing); the full friction acts from deformation on"},
     {"material", "element_friction", CDEM_PTYPE_DOUBLE, P_OFF(element.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
      "element-element friction coefficient"},
     {"material", "element_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(element.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,

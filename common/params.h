@@ -21,6 +21,21 @@
 
 typedef enum { CDEM_MATERIAL_GRANULAR = 0, CDEM_MATERIAL_BONDED = 1 } cdem_material_model;
 
+/* Granular contact laws: how the cohesion C0 enters the shear strength of a contact
+ * (docs/solver.md section 1; one file each, solver/law_*.h). */
+typedef enum {
+    CDEM_LAW_NORMAL_COHESION = 0, /* |Fs| <= mu (Fn + C0): C0 in parallel with the normal force */
+    CDEM_LAW_COULOMB = 1,         /* |Fs| <= mu Fn + C0: a Mohr-Coulomb contact */
+    CDEM_LAW_SPRING_COHESION = 2, /* Fs = Ks Xs + C0, |Fs| <= mu Fn: manual Eq. 2 as printed */
+    CDEM_LAW_COUNT = 3
+} cdem_granular_law;
+
+/* Granular: which contacts carry the cohesion C0. */
+typedef enum {
+    CDEM_COHESIVE_EQUILIBRATED = 0, /* contacts touching at the end of equilibration */
+    CDEM_COHESIVE_FORMED = 1,       /* those, and every contact formed after it */
+} cdem_cohesive_contacts;
+
 typedef enum {
     CDEM_MODE_PLANAR_FAULT = 0, /* planar normal/reverse fault, optional inversion */
     CDEM_MODE_LISTRIC_FAULT,    /* left wall sculpted into a listric fault, footwall removed */
@@ -76,8 +91,11 @@ typedef struct {
     int calculate_stress; /* 0/1: store per-element stress in every increment */
 
     /* [material] */
-    cdem_material_model material;  /* granular (frictional-cohesive) or bonded */
-    int first_slip;                /* 0/1: cohesion lost at first slip (1) or at separation (0) */
+    cdem_material_model material;   /* granular (frictional-cohesive) or bonded */
+    int first_slip;                 /* 0/1: cohesion lost at first slip (1) or at separation (0) */
+    cdem_granular_law granular_law; /* how C0 enters the shear strength */
+    cdem_cohesive_contacts cohesive_contacts; /* which contacts carry C0 */
+    double settling_friction;      /* friction multiplier during equilibration (packing), 0-1 */
     cdem_contact_material element; /* element-element contacts */
     cdem_contact_material wall;    /* element-wall contacts (base, lateral walls, platens) */
     cdem_contact_material fault;   /* element-fault contacts */

@@ -58,11 +58,6 @@ typedef struct {
      * (cdem_bc_apply with k = 0), after the drift, with s->fx/fy of the boundary elements
      * holding their contact forces of the previous step; du, dt as for apply */
     cdem_status (*equilibrate)(void *ctx, cdem_state *s, double du, double dt, cdem_error *err);
-    /* may be NULL: adjusts the contact law once after it is built (e.g. smooth platens) */
-    void (*adjust_law)(const void *ctx, cdem_contact_law *law);
-    /* 0 (default): plain viscous damping; 1: the solver damps the free elements' velocities
-     * relative to their homogeneous (affine) strain-rate field (integrate.h affine_damping) */
-    int affine_damping;
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
@@ -87,10 +82,6 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
                           cdem_error *err);
 /* 1 when the mode moves boundaries during equilibration (has an equilibrate hook). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
-/* 1 when the mode asks for affine damping (cdem_bc_ops.affine_damping); 0 without bc. */
-int cdem_bc_affine_damping(const cdem_bc *bc);
-/* Runs the mode's adjust_law hook on law (nothing without one or without bc). */
-void cdem_bc_adjust_law(const cdem_bc *bc, cdem_contact_law *law);
 double cdem_bc_net_displacement(const cdem_bc *bc);
 /* Runs the mode's begin_deformation hook (none: *n_remove = 0, keep untouched). */
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,

@@ -1,8 +1,8 @@
 /* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (common/model.c).
  * Init: the base row is the bottom platen; a top platen of wall elements (base radius r,
  * spaced r) is added one radius above the highest free element; both platens extend 25% of
- * the base length beyond each end and are CDEM_FLAG_MOVING. Platens are smooth (adjust_law:
- * wall-class friction, cohesion and breaking strain 0). Equilibration: the lateral walls
+ * the base length beyond each end and are CDEM_FLAG_MOVING. Platen contacts are wall-class
+ * contacts (material.wall_*), as in every mode. Equilibration: the lateral walls
  * hold the sample while the solver ramps the confining pressure p on the free edges from 0 at
  * mid-equilibration to full at its end; the platens are servo-controlled (equilibrate) to
  * carry the same ramped pressure, so the sample starts isotropic. Deformation: the lateral
@@ -11,8 +11,8 @@
  * (H0 = gap between the platens' inner faces at the start of deformation); differential
  * stress = F / L - p x ramp, F = mean |contact force y| of the two platens, L = span of the
  * free elements, both averaged over the samples of the last 5 increments (v3.1), minus the
- * value at the end of equilibration (v2.6). Asks for affine damping (integrate.h: damping
- * does not resist the imposed strain). Single-threaded; units m, N, N/m. */
+ * value at the end of equilibration (v2.6). The material, its damping included, is the
+ * same as in every other mode. Single-threaded; units m, N, N/m. */
 #include "bc.h"
 #include "checkpoint.h"
 
@@ -199,15 +199,6 @@ static cdem_status biaxial_equilibrate(void *vctx, cdem_state *s, double du, dou
     return CDEM_OK;
 }
 
-/* Smooth platens: element-wall contacts (the platens; the lateral walls until they are
- * removed) carry no friction, no cohesion and no bond. */
-static void biaxial_law(const void *vctx, cdem_contact_law *law) {
-    (void)vctx;
-    law->friction[CDEM_CLASS_WALL] = 0.0;
-    law->cohesion[CDEM_CLASS_WALL] = 0.0;
-    law->breaking_strain[CDEM_CLASS_WALL] = 0.0;
-}
-
 static cdem_status biaxial_begin(void *vctx, const cdem_state *s, unsigned char *keep,
                                  size_t *n_remove, cdem_error *err) {
     biaxial_ctx *c = vctx;
@@ -280,12 +271,11 @@ static void biaxial_view(const void *vctx, FILE *out) {
     fprintf(out,
             "Boundary mode: biaxial test, confining pressure %.6g N/m on the free edges (ramped "
             "from 0 at mid-equilibration to full at its end); top platen of %ld elements added "
-            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); smooth "
-            "platens (no friction, cohesion or bond with the sample; material.wall_* not used); "
-            "in equilibration the platens are servo-controlled to carry the same ramped "
+            "at y = %.6g m, bottom platen = base (+%ld elements beyond its ends); platen "
+            "contacts use material.wall_*; in equilibration the platens are servo-controlled to "
+            "carry the same ramped "
             "pressure (isotropic start), then move toward each other at half the boundary "
-            "speed each; damping acts on the velocity relative to the sample's homogeneous "
-            "strain-rate field; the %ld lateral wall elements are removed at the start of "
+            "speed each; the %ld lateral wall elements are removed at the start of "
             "deformation; initial sample height %.6g m (re-measured at the start of "
             "deformation); axial strain = closure / height; differential stress averaged over "
             "%zu samples (5 increments) and corrected to 0 at the end of equilibration.\n",
@@ -370,8 +360,6 @@ static const cdem_bc_ops biaxial_ops = {
     .save = biaxial_save,                 /* checkpoint: platens, window, reference */
     .restore = biaxial_restore,           /* resume */
     .equilibrate = biaxial_equilibrate,   /* servo platens: isotropic start */
-    .adjust_law = biaxial_law,            /* smooth platens */
-    .affine_damping = 1,                  /* damping does not resist the imposed strain */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

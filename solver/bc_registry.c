@@ -75,15 +75,6 @@ int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
     return bc && bc->ops && bc->ops->equilibrate;
 }
 
-int cdem_bc_affine_damping(const cdem_bc *bc) {
-    return bc && bc->ops && bc->ops->affine_damping;
-}
-
-void cdem_bc_adjust_law(const cdem_bc *bc, cdem_contact_law *law) {
-    if (bc && bc->ops && bc->ops->adjust_law)
-        bc->ops->adjust_law(bc->ctx, law);
-}
-
 double cdem_bc_net_displacement(const cdem_bc *bc) {
     return (bc && bc->ops) ? bc->ops->net_displacement(bc->ctx) : 0.0;
 }

@@ -55,6 +55,25 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
     const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault};
     law->model = p->material;
     law->first_slip = p->first_slip ? 1 : 0;
+    if ((int)p->granular_law < 0 || p->granular_law >= CDEM_LAW_COUNT)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "contact law: material.granular_law = %d: must be normal-cohesion, "
+                         "coulomb or spring-cohesion",
+                         (int)p->granular_law);
+    if (p->cohesive_contacts != CDEM_COHESIVE_EQUILIBRATED &&
+        p->cohesive_contacts != CDEM_COHESIVE_FORMED)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "contact law: material.cohesive_contacts = %d: must be equilibrated or "
+                         "formed",
+                         (int)p->cohesive_contacts);
+    if (!(p->settling_friction >= 0.0 && p->settling_friction <= 1.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "contact law: material.settling_friction = %g: must be 0..1",
+                         p->settling_friction);
+    law->granular = p->granular_law;
+    law->cohesive_rule = p->cohesive_contacts;
+    law->settling_friction = p->settling_friction;
+    law->cohesive_new = 0;
     law->kn = kn;
     law->ks = ks;
     law->max_breaking_strain = 0.0;
@@ -185,10 +204,13 @@ static size_t law_values(const cdem_contact_law *law, double *v) {
     v[k++] = law->max_breaking_strain;
     v[k++] = (double)law->flexural_slip;
     v[k++] = (double)law->layered_friction;
+    v[k++] = (double)law->granular;
+    v[k++] = (double)law->cohesive_rule;
+    v[k++] = law->settling_friction;
     return k;
 }
 
-#define LAW_VALUES (4 + 3 * CDEM_CLASS_TOTAL + 3)
+#define LAW_VALUES (4 + 3 * CDEM_CLASS_TOTAL + 6)
 
 cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot *snap,
                                       cdem_error *err) {

@@ -24,6 +24,11 @@
 #include "snapshot.h"
 #include "state.h"
 
+#include "law.h"
+#include "law_coulomb.h"
+#include "law_normal_cohesion.h"
+#include "law_spring_cohesion.h"
+
 #include <math.h>
 #include <stdint.h>
 
@@ -49,8 +54,13 @@ enum {
 };
 
 typedef struct {
-    cdem_material_model model;         /* granular or bonded */
-    int first_slip;                    /* 1: cohesion lost at the first slip; 0: at separation */
+    cdem_material_model model;            /* granular or bonded */
+    int first_slip;                       /* 1: cohesion lost at the first slip; 0: at separation */
+    cdem_granular_law granular;           /* granular: how C0 enters the strength (law_*.h) */
+    cdem_cohesive_contacts cohesive_rule; /* granular: which contacts carry C0 */
+    double settling_friction;             /* friction multiplier while equilibrating, 0..1 */
+    int cohesive_new;                  /* 1 on the steps where a forming contact is cohesive (set by
+                                          cdem_contact_law_phase from cohesive_rule; 0 in the material) */
     double kn;                         /* N/m, normal spring stiffness, > 0 */
     double ks;                         /* N/m, shear spring stiffness, >= 0 */
     double friction[CDEM_CLASS_TOTAL]; /* Coulomb coefficient mu per class, >= 0 */
@@ -105,6 +115,68 @@ cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot
 cdem_status cdem_contact_snapshot_check(const cdem_contact_law *law, const cdem_snapshot *snap,
                                         cdem_error *err);
 
+/* The law in force on one step (the integrator copies it for every force pass):
+ * equilibrating = 1 (the packing phase, steps 1..equilibration): every class's friction
+ * times settling_friction, and no contact becomes cohesive as it forms; otherwise the
+ * material as given, and with cohesive_contacts = formed every contact that forms is
+ * cohesive from its first step. Pure. */
+static inline void cdem_contact_law_phase(const cdem_contact_law *law, int equilibrating,
+                                          cdem_contact_law *out) {
+    *out = *law;
+    out->cohesive_new = !equilibrating && law->cohesive_rule == CDEM_COHESIVE_FORMED;
+    if (equilibrating && law->settling_friction != 1.0)
+        for (int c = 0; c < CDEM_CLASS_TOTAL; c++)
+            out->friction[c] = law->friction[c] * law->settling_friction;
+}
+
+/* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
+ * for the granular material, the tangential spring limited by the pair's law. The one
+ * kernel of the granular laws: the integrator, the tests and everything else call it (or
+ * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
+static inline void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2, double dx,
+                                         double dy, double R, double dvx, double dvy, double dt,
+                                         double *xs, uint8_t *hist, double *fx, double *fy) {
+    uint8_t h = *hist;
+    const double r = sqrt(r2);
+    const double inv = 1.0 / r;
+    const double nx = dx * inv, ny = dy * inv;
+    const double fn = law->kn * (R - r); /* compressive normal force magnitude, > 0 */
+    double ftx = 0.0, fty = 0.0;
+    if (!(h & CDEM_PAIR_TOUCH) && law->cohesive_new)
+        h |= CDEM_PAIR_COHESIVE; /* a contact forming now (cohesive_contacts = formed) */
+    h |= CDEM_PAIR_TOUCH;
+    if (law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0) {
+        const double tx = -ny, ty = nx;
+        double sv = *xs + (dvx * tx + dvy * ty) * dt;
+        const double spring = law->ks * sv;
+        const double mu = law->friction[cls];
+        const double c0 = (h & CDEM_PAIR_COHESIVE) ? law->cohesion[cls] : 0.0;
+        cdem_shear sh;
+        switch (law->granular) {
+        case CDEM_LAW_COULOMB:
+            sh = cdem_law_coulomb(spring, fn, mu, c0);
+            break;
+        case CDEM_LAW_SPRING_COHESION:
+            sh = cdem_law_spring_cohesion(spring, fn, mu, c0);
+            break;
+        default:
+            sh = cdem_law_normal_cohesion(spring, fn, mu, c0);
+            break;
+        }
+        if (sh.slid) {
+            sv = sh.spring / law->ks;
+            if (law->first_slip)
+                h &= (uint8_t)~CDEM_PAIR_COHESIVE;
+        }
+        *xs = sv;
+        ftx = sh.force * tx;
+        fty = sh.force * ty;
+    }
+    *fx = -fn * nx + ftx;
+    *fy = -fn * ny + fty;
+    *hist = h;
+}
+
 /* Evaluates one pair. dx, dy = xj - xi; R = ri + rj; dvx, dvy = vj - vi (mid-step velocities,
  * so dv * dt is the relative displacement of the step). Updates *xs and *hist; writes the
  * force on i. Cost: no sqrt unless the pair is within reach (touching or a bond). */
@@ -120,6 +192,7 @@ static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, doubl
         const double reach = law->breaking_strain[cls] * R;
         if (r - R >= reach) {
             h &= (uint8_t)~CDEM_PAIR_BONDED;
+            *hist = h;
         } else {
             const double f = law->kn * (r - R) / r;
             *fx = f * dx;
@@ -134,36 +207,10 @@ static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, doubl
         *fx = 0.0;
         *fy = 0.0;
         *xs = 0.0;
-        *hist = (uint8_t)(h & CDEM_PAIR_BONDED); /* bonded flag already cleared above */
+        *hist = 0; /* a broken bond never comes back */
         return;
     }
-    const double r = sqrt(r2);
-    const double inv = 1.0 / r;
-    const double nx = dx * inv, ny = dy * inv;
-    const double fn = law->kn * (R - r); /* compressive normal force magnitude, > 0 */
-    double ftx = 0.0, fty = 0.0;
-    h |= CDEM_PAIR_TOUCH;
-    if (law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0) {
-        const double tx = -ny, ty = nx;
-        double s = *xs + (dvx * tx + dvy * ty) * dt;
-        double fs = law->ks * s;
-        double limit = law->friction[cls] * fn;
-        if (h & CDEM_PAIR_COHESIVE)
-            limit += law->cohesion[cls];
-        if (fabs(fs) > limit) {
-            /* Slip: scale the spring back to the strength. */
-            fs = fs > 0.0 ? limit : -limit;
-            s = fs / law->ks;
-            if (law->first_slip)
-                h &= (uint8_t)~CDEM_PAIR_COHESIVE;
-        }
-        *xs = s;
-        ftx = fs * tx;
-        fty = fs * ty;
-    }
-    *fx = -fn * nx + ftx;
-    *fy = -fn * ny + fty;
-    *hist = h;
+    cdem_contact_touching(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, fx, fy);
 }
 
 #endif

@@ -413,9 +413,11 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
 #define CDEM_INLINE inline
 #endif
 
-/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch).
- * (A branch-free variant of the granular law, evaluating every list pair and selecting the
- * result, was measured 40-50 % slower: gcc -O2 still branches and does more work.) */
+/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
+ * the common case of a list pair that does not touch is settled here, everything else by
+ * the one contact kernel (contact.h). (A branch-free variant of the granular law,
+ * evaluating every list pair and selecting the result, was measured 40-50 % slower: gcc -O2
+ * still branches and does more work.) */
 static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
                                    double dy, double dvx, double dvy, const double *restrict Rp,
                                    const uint8_t *restrict cls, uint8_t *restrict hist,
@@ -424,46 +426,19 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
     const double R = Rp[p];
     const uint8_t h = hist[p];
     const double r2 = dx * dx + dy * dy;
-    if (!(h & CDEM_PAIR_BONDED) && (r2 >= R * R || r2 <= 0.0)) {
-        /* the common case: a list pair that does not touch (xs != 0 only with h != 0) */
-        pfx[p] = 0.0;
-        pfy[p] = 0.0;
-        if (h) {
-            hist[p] = 0;
-            xs[p] = 0.0;
-        }
-        return;
-    }
-    if (law->model == CDEM_MATERIAL_GRANULAR) {
-        /* a touching granular pair: cdem_contact_eval's arithmetic, operation for operation
-         * (same bits), without the call and the re-tests */
-        const int c = cls[p];
-        const double r = sqrt(r2);
-        const double inv = 1.0 / r;
-        const double nx = dx * inv, ny = dy * inv;
-        const double fn = law->kn * (R - r);
-        double ftx = 0.0, fty = 0.0;
-        uint8_t hn = (uint8_t)(h | CDEM_PAIR_TOUCH);
-        if (law->ks > 0.0) {
-            const double tx = -ny, ty = nx;
-            double sv = xs[p] + (dvx * tx + dvy * ty) * dt;
-            double fs = law->ks * sv;
-            double limit = law->friction[c] * fn;
-            if (hn & CDEM_PAIR_COHESIVE)
-                limit += law->cohesion[c];
-            if (fabs(fs) > limit) {
-                fs = fs > 0.0 ? limit : -limit;
-                sv = fs / law->ks;
-                if (law->first_slip)
-                    hn &= (uint8_t)~CDEM_PAIR_COHESIVE;
+    if (!(h & CDEM_PAIR_BONDED)) {
+        if (r2 >= R * R || r2 <= 0.0) {
+            /* separated: xs != 0 only with h != 0 */
+            pfx[p] = 0.0;
+            pfy[p] = 0.0;
+            if (h) {
+                hist[p] = 0;
+                xs[p] = 0.0;
             }
-            xs[p] = sv;
-            ftx = fs * tx;
-            fty = fs * ty;
+            return;
         }
-        pfx[p] = -fn * nx + ftx;
-        pfy[p] = -fn * ny + fty;
-        hist[p] = hn;
+        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
+                              &pfy[p]);
         return;
     }
     cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
@@ -476,8 +451,7 @@ static inline void finish_element(long i, double sx, double sy, const double *re
                                   const uint32_t *restrict flags, double *restrict vxw,
                                   double *restrict vyw, double *restrict fx, double *restrict fy,
                                   double hdt, double c, double g, double ob, int kick,
-                                  const double *restrict x, double ef, double exmid,
-                                  const double *restrict y, const double *restrict aff) {
+                                  const double *restrict x, double ef, double exmid) {
     const uint32_t fl = flags[i];
     if (fl & CDEM_FLAGS_BOUNDARY) {
         fx[i] = sx;
@@ -488,47 +462,14 @@ static inline void finish_element(long i, double sx, double sy, const double *re
     sy -= m * g + ((fl & CDEM_FLAG_SURFACE) ? ob : 0.0);
     if (fl & CDEM_FLAG_BIAXIAL_EDGE)
         sx += x[i] < exmid ? ef : -ef;
-    /* damping acts on v - v_aff (v_aff = 0 exactly unless affine damping is on) */
-    const double rx = aff[0] * (x[i] - aff[2]), ry = aff[1] * (y[i] - aff[3]);
     if (kick) {
-        /* v = (v_half + hdt/m (F + c v_aff)) / (1 + c hdt/m), with 1 / (m + c hdt) from
-         * kick_finish */
+        /* v = (v_half + hdt/m F) / (1 + c hdt/m), with 1 / (m + c hdt) from kick_finish */
         const double inv = kick_finish ? kick_finish[i] : 1.0 / (m + c * hdt);
-        vxw[i] = (m * vxw[i] + hdt * (sx + c * rx)) * inv;
-        vyw[i] = (m * vyw[i] + hdt * (sy + c * ry)) * inv;
+        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
+        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
     }
-    fx[i] = sx - c * (vxw[i] - rx);
-    fy[i] = sy - c * (vyw[i] - ry);
-}
-
-/* Affine damping: the least-squares homogeneous strain-rate field of the free elements'
- * current (mid-step) velocities, v_aff = (ax (x - xc), ay (y - yc)), xc, yc their mean
- * position. Serial sums in element order: reproducible for any thread count. */
-static void fit_affine(cdem_integrator *it, const cdem_state *s) {
-    double n = 0.0, sx = 0.0, sy = 0.0;
-    for (size_t i = 0; i < s->n; i++)
-        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
-            n += 1.0;
-            sx += s->x[i];
-            sy += s->y[i];
-        }
-    it->aff[0] = it->aff[1] = it->aff[2] = it->aff[3] = 0.0;
-    if (n < 2.0)
-        return;
-    const double xc = sx / n, yc = sy / n;
-    double sxx = 0.0, syy = 0.0, svx = 0.0, svy = 0.0;
-    for (size_t i = 0; i < s->n; i++)
-        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY)) {
-            const double dx = s->x[i] - xc, dy = s->y[i] - yc;
-            sxx += dx * dx;
-            syy += dy * dy;
-            svx += s->vx[i] * dx;
-            svy += s->vy[i] * dy;
-        }
-    it->aff[0] = sxx > 0.0 ? svx / sxx : 0.0;
-    it->aff[1] = syy > 0.0 ? svy / syy : 0.0;
-    it->aff[2] = xc;
-    it->aff[3] = yc;
+    fx[i] = sx - c * vxw[i];
+    fy[i] = sy - c * vyw[i];
 }
 
 /* Everything the force pass reads or writes, gathered once per step. */
@@ -536,7 +477,6 @@ typedef struct {
     const cdem_contact_law *law;
     int kick;
     double dt, hdt, c, g, ob, ef, exmid;
-    double aff[4]; /* affine damping field (integrate.h), zeros when off */
     const double *x, *y, *mass, *Rp;
     const double *kick_finish; /* it->kick_finish (integrate.h) */
     const int32_t *pi, *pj, *istart;
@@ -656,8 +596,7 @@ static void chunk_pass(force_pass *fp, int chunk) {
         wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
-                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid, fp->y,
-                       fp->aff);
+                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
     fp->unstable[chunk] = -1;
     if (fp->radius) {
         /* the run loop's guard (integrate.h): here, while the velocities are in cache */
@@ -822,7 +761,8 @@ static int wanted_chunks(const cdem_integrator *it, long n) {
  * list must match the state's element count. Returns 0 when the forces were computed. */
 static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved) {
     cdem_neighbour *nb = &it->nb;
-    const cdem_contact_law lawc = it->law; /* a local copy: provably not aliased by stores */
+    cdem_contact_law lawc; /* the law of this step, a local copy: provably not aliased by stores */
+    cdem_contact_law_phase(&it->law, it->equilibrating, &lawc);
     const long n = (long)s->n;
     force_pass fp = {
         .law = &lawc,
@@ -834,7 +774,6 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .ob = it->overburden_force,
         .ef = it->confining_pressure * it->column_width * it->confining_factor,
         .exmid = it->edge_x_mid,
-        .aff = {it->aff[0], it->aff[1], it->aff[2], it->aff[3]},
         .x = s->x,
         .y = s->y,
         .mass = s->mass,
@@ -933,10 +872,6 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
                              (int)s->id[i], s->mass[i]);
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    if (it->affine_damping)
-        fit_affine(it, s);
-    else
-        it->aff[0] = it->aff[1] = 0.0;
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
@@ -991,17 +926,11 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         it->confining_factor = cdem_bc_confining_ramp(it->step, it->confining_equil);
     if (bc)
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
-    if (it->affine_damping)
-        fit_affine(it, s);
-    else
-        it->aff[0] = it->aff[1] = 0.0; /* plain damping (also after switching it off) */
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
     if (it->nb.n == s->n && forces_and_kick(it, s, 1, 1) == 0)
         return CDEM_OK;
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    if (it->affine_damping)
-        fit_affine(it, s); /* again: the rebuild may have removed escaping elements */
     forces_and_kick(it, s, 1, 0);
     return CDEM_OK;
 }

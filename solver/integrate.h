@@ -124,10 +124,11 @@ typedef struct {
     int32_t *band_lo, *band_hi; /* per-band scratch: leftmost / rightmost element (bandcap) */
     size_t bandcap;             /* capacity of band_lo, band_hi */
 
-    /* affine damping (biaxial): 0 (default) damping -c v; 1: -c (v - v_aff), v_aff the
-     * least-squares homogeneous strain-rate field of the free elements, refitted each step */
-    int affine_damping; /* 0/1, set by the run loop from the mode (cdem_bc_affine_damping) */
-    double aff[4];      /* v_aff = (aff[0] (x - aff[2]), aff[1] (y - aff[3])): 1/s, 1/s, m, m */
+    /* 1 on the steps of the equilibration (the packing phase), 0 afterwards: selects the law
+     * in force (cdem_contact_law_phase: settling friction, cohesion of forming contacts).
+     * Set by the run loop (1 from set-up to the last equilibration step); 0 after init: the
+     * material as given. */
+    int equilibrating;
 } cdem_integrator;
 
 /* Sets up the stepper from the model constants (dt, damping, gravity, kn, ks, max radius)

@@ -346,9 +346,9 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     r->it.unstable_guard = 1; /* check_unstable */
+    r->it.equilibrating = 1;  /* the packing phase's law until the end of equilibration */
     if (opt->par_min > 0)
         r->it.par_min = opt->par_min;
-    cdem_bc_adjust_law(&r->bc, &r->it.law); /* e.g. the biaxial test's smooth platens */
     cdem_integrator_enable_escape(&r->it);
     CDEM_TRY(cdem_integrator_set_overburden(&r->it, p->overburden_pressure, err));
     CDEM_TRY(cdem_integrator_set_confining(&r->it, cdem_bc_lateral_pressure(&r->bc),
@@ -532,9 +532,8 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         /* wall forces are summed only on the steps whose sample reports them, and on every
          * equilibration step of a mode that moves boundaries then (biaxial servo platens) */
         const int eq_moves = step <= equil && cdem_bc_moves_in_equilibration(&r->bc);
-        /* affine damping (biaxial) only while the boundaries impose a strain: equilibration
-         * (and settling) keep plain damping, so the assembly settles */
-        r->it.affine_damping = deforming && cdem_bc_affine_damping(&r->bc);
+        /* the packing phase's law (settling friction) up to the end of equilibration */
+        r->it.equilibrating = step <= equil;
         r->it.boundary_forces = (step % interval == 0) || eq_moves;
         cdem_status st =
             cdem_integrator_step(&r->it, &r->s, (deforming || eq_moves) ? &r->bc : NULL,

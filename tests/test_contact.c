@@ -20,6 +20,9 @@ static cdem_params base_params(cdem_material_model model) {
     memset(&p, 0, sizeof p);
     p.material = model;
     p.first_slip = 1;
+    p.granular_law = CDEM_LAW_COULOMB;
+    p.cohesive_contacts = CDEM_COHESIVE_EQUILIBRATED;
+    p.settling_friction = 1.0;
     p.element =
         (cdem_contact_material){.friction = 0.25, .cohesion = 5.0e6, .breaking_strain = 0.02};
     p.wall = (cdem_contact_material){.friction = 0.5, .cohesion = 1.0e6, .breaking_strain = 0.05};
@@ -27,13 +30,20 @@ static cdem_params base_params(cdem_material_model model) {
     return p;
 }
 
-static cdem_contact_law make_law(cdem_material_model model, int first_slip) {
+static cdem_contact_law make_law_of(cdem_material_model model, int first_slip,
+                                    cdem_granular_law granular) {
     cdem_params p = base_params(model);
     p.first_slip = first_slip;
+    p.granular_law = granular;
     cdem_contact_law law;
     cdem_error err;
     assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
     return law;
+}
+
+/* The Mohr-Coulomb law (granular_law = coulomb), whose hand-computed cases follow. */
+static cdem_contact_law make_law(cdem_material_model model, int first_slip) {
+    return make_law_of(model, first_slip, CDEM_LAW_COULOMB);
 }
 
 static void test_contact_normal_repulsion(void **st) {
@@ -158,6 +168,137 @@ static void test_contact_cohesion_lost_at_separation(void **st) {
     assert_float_equal(f[199], 0.25 * fn, 1e-6 * fn);
 }
 
+/* granular_law = normal-cohesion (C0 in parallel with the normal force): a cohesive contact
+ * sticks up to mu (Fn + C0), slides there on its first slip, then (first slip on) holds
+ * mu Fn; a frictionless class has no shear strength whatever its C0. */
+static void test_contact_normal_cohesion_limit_first_slip(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law_of(CDEM_MATERIAL_GRANULAR, 1, CDEM_LAW_NORMAL_COHESION);
+    const double R = 200.0, delta = 0.5, fn = KN * delta;
+    const double mu = 0.25, c0 = 5.0e6, limit = mu * (fn + c0); /* 1.25e8 + 1.25e6 */
+    double xs = 0.0, f[200];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    const double dxs = 0.011; /* 5.5e6 N per step */
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
+    const int kslip = (int)floor(limit / (KS * dxs)); /* 22 steps stay below */
+    assert_int_equal(kslip, 22);
+    for (int k = 0; k < kslip; k++)
+        assert_float_equal(f[k], KS * dxs * (k + 1), 1e-6 * KS * dxs * (k + 1));
+    assert_float_equal(f[kslip], limit, 1e-9 * limit);
+    assert_float_equal(f[kslip + 1], mu * fn, 1e-9 * fn);
+    assert_false(h & CDEM_PAIR_COHESIVE);
+    assert_float_equal(xs, mu * fn / KS, 1e-12);
+    /* first slip off: it keeps sliding at mu (Fn + C0) until the pair separates */
+    law = make_law_of(CDEM_MATERIAL_GRANULAR, 0, CDEM_LAW_NORMAL_COHESION);
+    xs = 0.0;
+    h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
+    assert_float_equal(f[199], limit, 1e-9 * limit);
+    assert_true(h & CDEM_PAIR_COHESIVE);
+    /* at Fn -> 0 the strength is mu C0 (a 1 um overlap: Fn = 1e3 N) */
+    xs = 0.0;
+    h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_ELEMENT, R, 1e-6, 1.0, 1, &xs, &h, f);
+    assert_float_equal(f[0], mu * (KN * 1e-6 + c0), 1e-6 * mu * c0);
+    /* a frictionless cohesive class (the fault class here: mu 0, C0 0) and a frictionless
+     * class with cohesion have no shear strength */
+    cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
+    p.granular_law = CDEM_LAW_NORMAL_COHESION;
+    p.fault.cohesion = 1e9;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    xs = 0.0;
+    h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_FAULT, R, delta, dxs, 3, &xs, &h, f);
+    assert_float_equal(f[2], 0.0, 0.0);
+}
+
+/* granular_law = spring-cohesion (the manual's Eq. 2 as printed): Fs = Ks Xs + C0 sgn(Xs)
+ * below mu Fn, capped at mu Fn; the stored spring then holds the limit force. */
+static void test_contact_spring_cohesion(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law_of(CDEM_MATERIAL_GRANULAR, 0, CDEM_LAW_SPRING_COHESION);
+    const double R = 200.0, delta = 0.5, fn = KN * delta, mu = 0.25, c0 = 5.0e6;
+    double xs = 0.0, f[40];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    const double dxs = 0.011;
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 40, &xs, &h, f);
+    /* (mu Fn - C0) / (Ks dxs) = 21.8: 21 steps below the cap */
+    for (int k = 0; k < 21; k++)
+        assert_float_equal(f[k], KS * dxs * (k + 1) + c0, 1e-9 * mu * fn);
+    assert_float_equal(f[21], mu * fn, 1e-9 * fn);
+    assert_float_equal(f[39], mu * fn, 1e-9 * fn);
+    assert_float_equal(xs, mu * fn / KS, 1e-12);
+    assert_true(h & CDEM_PAIR_COHESIVE); /* first slip off: kept */
+    /* the cohesive term follows the sense of the tangential displacement */
+    xs = 0.0;
+    h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, -dxs, 1, &xs, &h, f);
+    assert_float_equal(f[0], -KS * dxs - c0, 1e-9 * c0);
+    /* a non-cohesive contact is plain Coulomb */
+    xs = 0.0;
+    h = 0;
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 1, &xs, &h, f);
+    assert_float_equal(f[0], KS * dxs, 1e-9 * c0);
+}
+
+/* The law in force on a step (cdem_contact_law_phase): while equilibrating, friction x
+ * settling_friction and no forming contact is cohesive; afterwards the material, and with
+ * cohesive_contacts = formed a contact that forms (or re-forms after a separation) is
+ * cohesive until its first slip. */
+static void test_contact_phases_settling_friction_and_formed_contacts(void **st) {
+    (void)st;
+    cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
+    p.granular_law = CDEM_LAW_NORMAL_COHESION;
+    p.cohesive_contacts = CDEM_COHESIVE_FORMED;
+    p.settling_friction = 0.4;
+    cdem_contact_law law, now;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    const double R = 200.0, delta = 0.5, fn = KN * delta, c0 = 5.0e6;
+    double xs = 0.0, f[1];
+    uint8_t h = 0;
+    /* equilibrating: a new contact pushed past its strength slides at 0.4 mu Fn */
+    cdem_contact_law_phase(&law, 1, &now);
+    assert_float_equal(now.friction[CDEM_CLASS_WALL], 0.4 * 0.5, 1e-15);
+    assert_false(now.cohesive_new);
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 10.0, 1, &xs, &h, f);
+    assert_float_equal(f[0], 0.4 * 0.25 * fn, 1e-9 * fn);
+    assert_true(h == CDEM_PAIR_TOUCH);
+    /* deforming: the same touching contact stays non-cohesive (it did not form now) */
+    cdem_contact_law_phase(&law, 0, &now);
+    assert_float_equal(now.friction[CDEM_CLASS_ELEMENT], 0.25, 0.0);
+    assert_true(now.cohesive_new);
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 10.0, 1, &xs, &h, f);
+    assert_float_equal(f[0], 0.25 * fn, 1e-9 * fn);
+    /* separated, then touching again: a formed contact, cohesive */
+    double fx, fy;
+    cdem_contact_eval(&now, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    assert_int_equal(h, 0);
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 0.0, 1, &xs, &h, f);
+    assert_true(h & CDEM_PAIR_COHESIVE);
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 10.0, 1, &xs, &h, f);
+    assert_float_equal(f[0], 0.25 * (fn + c0), 1e-9 * fn); /* its first slip */
+    assert_false(h & CDEM_PAIR_COHESIVE);                  /* first slip on: lost */
+    /* equilibrated (the default): forming contacts are never cohesive */
+    p.cohesive_contacts = CDEM_COHESIVE_EQUILIBRATED;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    cdem_contact_law_phase(&law, 0, &now);
+    assert_false(now.cohesive_new);
+    h = 0;
+    xs = 0.0;
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 0.0, 1, &xs, &h, f);
+    assert_int_equal(h, CDEM_PAIR_TOUCH);
+    /* the bonded model never makes a forming contact bonded */
+    p.material = CDEM_MATERIAL_BONDED;
+    p.cohesive_contacts = CDEM_COHESIVE_FORMED;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    cdem_contact_law_phase(&law, 0, &now);
+    h = 0;
+    drive(&now, CDEM_CLASS_ELEMENT, R, delta, 0.0, 1, &xs, &h, f);
+    assert_false(h & CDEM_PAIR_BONDED);
+}
+
 static void test_contact_wall_and_fault_materials(void **st) {
     (void)st;
     cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 0);
@@ -198,6 +339,10 @@ static void test_contact_law_rejects_bad_values(void **st) {
     p = base_params(CDEM_MATERIAL_GRANULAR);
     assert_int_equal(cdem_contact_law_init(&law, &p, 0.0, KS, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "model.kn = 0"));
+    p = base_params(CDEM_MATERIAL_GRANULAR);
+    p.settling_friction = 1.5;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "material.settling_friction = 1.5"));
     p = base_params(CDEM_MATERIAL_BONDED);
     assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
     assert_float_equal(law.max_breaking_strain, 0.05, 1e-15);
@@ -209,6 +354,9 @@ int main(void) {
         cmocka_unit_test(test_contact_bond_attraction_breaking),
         cmocka_unit_test(test_contact_coulomb_limit_first_slip),
         cmocka_unit_test(test_contact_cohesion_lost_at_separation),
+        cmocka_unit_test(test_contact_normal_cohesion_limit_first_slip),
+        cmocka_unit_test(test_contact_spring_cohesion),
+        cmocka_unit_test(test_contact_phases_settling_friction_and_formed_contacts),
         cmocka_unit_test(test_contact_wall_and_fault_materials),
         cmocka_unit_test(test_contact_law_rejects_bad_values),
     };

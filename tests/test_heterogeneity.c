@@ -28,6 +28,8 @@ static cdem_params het_params(cdem_material_model model) {
     memset(&p, 0, sizeof p);
     p.material = model;
     p.first_slip = 1;
+    p.granular_law = CDEM_LAW_COULOMB; /* limits below: mu Fn + C0 of each class */
+    p.settling_friction = 1.0;
     p.density = RHO;
     p.element =
         (cdem_contact_material){.friction = 0.25, .cohesion = 5.0e6, .breaking_strain = 0.02};

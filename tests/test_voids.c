@@ -1,0 +1,131 @@
+/* Tests of voids.[ch] (steepest surface slope, closed-off voids) on synthetic packings whose
+ * answers are known by construction. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "analysis_fixtures.h"
+#include "assert_near.h"
+#include "voids.h"
+
+/* A dense packing 8000 x 3000 m kept where keep_fn(x, y, r) holds, with the base row and two
+ * tall lateral walls (boundary elements: solid, never measured). */
+static void make_block(cdem_state *s, int (*keep_fn)(double, double, double)) {
+    make_packing(s, 4000, 8000.0, 3000.0, 11);
+    unsigned char *keep = malloc(s->n);
+    assert_non_null(keep);
+    for (size_t i = 0; i < s->n; i++)
+        keep[i] = (s->flags[i] & CDEM_FLAGS_BOUNDARY) || keep_fn(s->x[i], s->y[i], s->radius[i]);
+    cdem_state_compact(s, keep, NULL);
+    free(keep);
+    cdem_error err;
+    for (double y = -50.0; y < 4000.0; y += 50.0) {
+        assert_int_equal(
+            cdem_state_append(s, -1, -60.0, y, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
+        assert_int_equal(
+            cdem_state_append(s, -1, 8060.0, y, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err),
+            CDEM_OK);
+    }
+}
+
+static int flat(double x, double y, double r) {
+    (void)x;
+    return y + r <= 2500.0;
+}
+static int cavity(double x, double y, double r) { /* a 400 m hole under 1.3 km of rock */
+    return flat(x, y, r) && hypot(x - 4000.0, y - 1200.0) > 400.0;
+}
+static int cliff(double x, double y, double r) { /* 2 km step at x = 4000 m */
+    return y + r <= (x < 4000.0 ? 2500.0 : 500.0);
+}
+static int slot(double x, double y, double r) { /* a 300 m slot down to 800 m */
+    return flat(x, y, r) && !(fabs(x - 4000.0) < 150.0 && y > 800.0);
+}
+
+static cdem_voids_result measure(int (*keep_fn)(double, double, double)) {
+    cdem_state s = {0};
+    make_block(&s, keep_fn);
+    cdem_voids_result r;
+    cdem_error err;
+    assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_OK);
+    cdem_state_free(&s);
+    return r;
+}
+
+static void test_voids_intact_block(void **state) {
+    (void)state;
+    const cdem_voids_result r = measure(flat);
+    assert_int_equal(r.n_voids, 0);
+    assert_near(r.min_clearance, 125.0, 0.0);
+    assert_near(r.window, 1000.0, 0.0);
+    assert_near(r.column_width, 250.0, 1e-9);
+    assert_true(r.largest_clearance < r.min_clearance); /* pores and pockets of the packing */
+    assert_true(r.steepest_deg < 10.0);                 /* a flat top */
+    assert_near(r.void_min_room, M_PI * 125.0 * 125.0 / 16.0, 1e-6);
+    assert_near(r.cell, 12.5, 1e-9);
+}
+
+static void test_voids_enclosed_cavity(void **state) {
+    (void)state;
+    const cdem_voids_result r = measure(cavity);
+    assert_int_equal(r.n_voids, 1);
+    /* the hole's radius less the elements' overhang into it */
+    assert_true(r.largest_clearance > 300.0 && r.largest_clearance < 460.0);
+    assert_near(r.largest_x, 4000.0, 150.0);
+    assert_near(r.largest_y, 1200.0, 150.0);
+    assert_true(r.void_area > 1e5 && r.void_area < M_PI * 400.0 * 400.0);
+    assert_true(r.steepest_deg < 10.0); /* the surface does not see it */
+}
+
+static void test_voids_cliff(void **state) {
+    (void)state;
+    const cdem_voids_result r = measure(cliff);
+    assert_int_equal(r.n_voids, 0); /* open to the sky */
+    /* 2 km down over 1 km: atan(2) = 63.4 degrees, less a column's rounding */
+    assert_true(r.steepest_deg > 58.0 && r.steepest_deg < 66.0);
+    assert_true(r.steepest_x0 < 4000.0 && r.steepest_x1 > 4000.0);
+}
+
+static void test_voids_open_slot(void **state) {
+    (void)state;
+    /* a 300 m slot open to the sky: the big probe (250 m across) does not get far down it, so
+     * it is a closed-off room for the largest element: a crack between separating blocks */
+    const cdem_voids_result r = measure(slot);
+    assert_true(r.n_voids >= 1);
+}
+
+static void test_voids_bad_input(void **state) {
+    (void)state;
+    cdem_state s = {0};
+    cdem_error err;
+    cdem_voids_result r;
+    assert_int_equal(cdem_state_init(&s, 8, 0, &err), CDEM_OK);
+    assert_int_equal(
+        cdem_state_append(&s, -1, 0.0, 0.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err), CDEM_OK);
+    assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "no free element"));
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, 100.0, 50.0, 1.0, 1, 0, 0, NULL, &err),
+                     CDEM_OK);
+    assert_int_equal(cdem_voids_measure(&s, 0.0, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "window = 0"));
+    assert_int_equal(cdem_voids_measure(&s, NAN, &r, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_OK); /* one element */
+    assert_int_equal(r.n_voids, 0);
+    cdem_state_free(&s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_voids_intact_block), cmocka_unit_test(test_voids_enclosed_cavity),
+        cmocka_unit_test(test_voids_cliff),        cmocka_unit_test(test_voids_open_slot),
+        cmocka_unit_test(test_voids_bad_input),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
