@@ -31,6 +31,9 @@
 static const char *const material_words[] = {"granular", "bonded", NULL};
 static const char *const law_words[] = {"normal-cohesion", "coulomb", "spring-cohesion", NULL};
 static const char *const cohesive_words[] = {"equilibrated", "formed", NULL};
+/* A real parameter whose row has choices accepts its one word instead of a number, stored as
+ * NaN: "take the value of another parameter" (the base takes the lateral walls' values). */
+static const char *const as_wall_words[] = {"wall", NULL};
 static const char *const mode_words[] = {
     "planar-fault", "listric-fault", "irregular-fault", "vertical-faults",
     "detachment",   "repose",        "biaxial",         NULL};
@@ -99,11 +102,17 @@ static const cdem_param_def param_table[] = {
     {"material", "element_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(element.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
      "bonded: element-element bond breaks when r - R >= breaking_strain * R"},
     {"material", "wall_friction", CDEM_PTYPE_DOUBLE, P_OFF(wall.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-wall friction coefficient (base, lateral walls; biaxial platens are smooth)"},
+     "element-wall friction coefficient (lateral walls, biaxial platens; the base too unless base_friction is set)"},
     {"material", "wall_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(wall.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
      "element-wall cohesion force"},
     {"material", "wall_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(wall.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
      "bonded: element-wall breaking strain"},
+    {"material", "base_friction", CDEM_PTYPE_DOUBLE, P_OFF(base.friction), 0, "", "wall", 0, 10, 0, 0, as_wall_words,
+     "element-base friction coefficient (the base row; biaxial: the bottom platen); wall = wall_friction"},
+    {"material", "base_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(base.cohesion), 0, "N", "wall", 0, 1e15, 0, 0, as_wall_words,
+     "element-base cohesion force; wall = wall_cohesion"},
+    {"material", "base_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(base.breaking_strain), 0, "", "wall", 0, 1, 1, 0, as_wall_words,
+     "bonded: element-base breaking strain; wall = wall_breaking_strain"},
     {"material", "fault_friction", CDEM_PTYPE_DOUBLE, P_OFF(fault.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
      "element-fault friction coefficient (set 0 for CH kinematics)"},
     {"material", "fault_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(fault.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
@@ -282,6 +291,14 @@ static void format_double(double v, char *buf, size_t n) {
 /* Describes the allowed range: "between 0.5 and 25 m/s^2", "> 0 and <= 90 degrees",
  * ">= 100 s". */
 static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
+    if (d->type == CDEM_PTYPE_DOUBLE && d->choices) {
+        cdem_param_def plain = *d;
+        plain.choices = NULL;
+        char num[128];
+        describe_range(&plain, num, sizeof num);
+        snprintf(buf, n, "%s, or %s", num, d->choices[0]);
+        return;
+    }
     char lo[32], hi[32];
     format_double(d->min, lo, sizeof lo);
     format_double(d->max, hi, sizeof hi);
@@ -309,6 +326,14 @@ static void format_safe(double v, int up, char *buf, size_t n) {
 
 /* Short "allowed values" text for comments and the markdown table. */
 static void describe_allowed(const cdem_param_def *d, char *buf, size_t n) {
+    if (d->type == CDEM_PTYPE_DOUBLE && d->choices) {
+        cdem_param_def plain = *d;
+        plain.choices = NULL;
+        char num[128];
+        describe_allowed(&plain, num, sizeof num);
+        snprintf(buf, n, "%s, or %s", num, d->choices[0]);
+        return;
+    }
     switch (d->type) {
     case CDEM_PTYPE_BOOL:
         snprintf(buf, n, "on/off");
@@ -370,6 +395,11 @@ static cdem_status assign_value(cdem_params *p, const cdem_param_def *d, const c
         if (value[0] == '\0')
             return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: %s = : missing value; expected %s %s", where,
                              d->key, type_noun(d->type), range);
+        if (d->type == CDEM_PTYPE_DOUBLE && d->choices && strcasecmp(value, d->choices[0]) == 0) {
+            const double inherit = NAN;
+            memcpy(field, &inherit, sizeof inherit);
+            return CDEM_OK;
+        }
         char *end = NULL;
         errno = 0;
         double v = 0.0;
@@ -753,7 +783,10 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
     case CDEM_PTYPE_DOUBLE: {
         double v;
         memcpy(&v, field, sizeof v);
-        format_double(v, buf, n);
+        if (isnan(v) && def->choices)
+            snprintf(buf, n, "%s", def->choices[0]);
+        else
+            format_double(v, buf, n);
         break;
     }
     case CDEM_PTYPE_INT: {
@@ -923,6 +956,8 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
         switch (d->type) {
         case CDEM_PTYPE_DOUBLE:
             memcpy(&v, field, sizeof v);
+            if (isnan(v) && d->choices)
+                continue; /* the row's word */
             break;
         case CDEM_PTYPE_INT:
             memcpy(&iv, field, sizeof iv);

@@ -97,7 +97,8 @@ typedef struct {
     cdem_cohesive_contacts cohesive_contacts; /* which contacts carry C0 */
     double settling_friction;      /* friction multiplier during equilibration (packing), 0-1 */
     cdem_contact_material element; /* element-element contacts */
-    cdem_contact_material wall;    /* element-wall contacts (base, lateral walls, platens) */
+    cdem_contact_material wall;    /* element-wall contacts (lateral walls, platens, the base) */
+    cdem_contact_material base;    /* element-base contacts; NaN = the wall value (word "wall") */
     cdem_contact_material fault;   /* element-fault contacts */
 
     /* [heterogeneity] */
@@ -141,7 +142,7 @@ typedef struct {
 } cdem_params;
 
 typedef enum {
-    CDEM_PTYPE_DOUBLE,
+    CDEM_PTYPE_DOUBLE, /* with choices: also accepts choices[0], stored as NaN */
     CDEM_PTYPE_INT,
     CDEM_PTYPE_LONG,
     CDEM_PTYPE_BOOL,   /* stored as int 0/1; accepts true/false, yes/no, on/off, 1/0 */

@@ -18,19 +18,21 @@
 
 /* Element flags (bit field, stored as uint32 in every increment). */
 enum {
-    CDEM_FLAG_WALL = 1u << 0,          /* fixed or moving wall element (base, lateral wall, platen) */
-    CDEM_FLAG_FAULT = 1u << 1,         /* element of a fault face */
-    CDEM_FLAG_MOVING = 1u << 2,        /* boundary element whose motion is prescribed by the mode */
-    CDEM_FLAG_GROWTH = 1u << 3,        /* deposited during the run (syn-tectonic sedimentation) */
-    CDEM_FLAG_WEAK = 1u << 4,          /* inside the weak and/or light interval */
-    CDEM_FLAG_BIAXIAL_EDGE = 1u << 5,  /* biaxial free-edge element carrying confining pressure */
-    CDEM_FLAG_FOOTWALL = 1u << 6,      /* removed footwall element kept fixed for display only */
-    CDEM_FLAG_MYLAR = 1u << 7,         /* CD "mylar sheet" element dragging the hanging wall */
-    CDEM_FLAG_SURFACE = 1u << 8,       /* top-surface element (overburden acts on it) */
+    CDEM_FLAG_WALL = 1u << 0,   /* fixed or moving wall element (base, lateral wall, platen) */
+    CDEM_FLAG_FAULT = 1u << 1,  /* element of a fault face */
+    CDEM_FLAG_MOVING = 1u << 2, /* boundary element whose motion is prescribed by the mode */
+    CDEM_FLAG_GROWTH = 1u << 3, /* deposited during the run (syn-tectonic sedimentation) */
+    CDEM_FLAG_WEAK = 1u << 4,   /* inside the weak and/or light interval */
+    CDEM_FLAG_BIAXIAL_EDGE = 1u << 5, /* biaxial free-edge element carrying confining pressure */
+    CDEM_FLAG_FOOTWALL = 1u << 6,     /* removed footwall element kept fixed for display only */
+    CDEM_FLAG_MYLAR = 1u << 7,        /* CD "mylar sheet" element dragging the hanging wall */
+    CDEM_FLAG_SURFACE = 1u << 8,      /* top-surface element (overburden acts on it) */
+    CDEM_FLAG_BASE = 1u << 9,         /* wall element of the base row (material.base_*) */
 };
 
 /* Elements that are integrated by Newton's law: neither wall, fault nor footwall display. */
-#define CDEM_FLAGS_BOUNDARY (CDEM_FLAG_WALL | CDEM_FLAG_FAULT | CDEM_FLAG_FOOTWALL | CDEM_FLAG_MYLAR)
+#define CDEM_FLAGS_BOUNDARY                                                                        \
+    (CDEM_FLAG_WALL | CDEM_FLAG_FAULT | CDEM_FLAG_FOOTWALL | CDEM_FLAG_MYLAR)
 
 typedef struct {
     size_t n;        /* number of elements in use */
@@ -38,15 +40,15 @@ typedef struct {
     int has_stress;  /* 1: sxx, syy, sxy are allocated */
     int32_t next_id; /* id for the next added element */
 
-    int32_t *id;     /* stable element id, unique within a run */
-    double *x, *y;   /* centre position, m */
-    double *vx, *vy; /* velocity, m/s */
-    double *fx, *fy; /* total force of the current step, N */
-    double *radius;  /* m */
-    double *mass;    /* kg per metre */
-    int32_t *layer;  /* 1..24 pre-growth layers; 25.. growth layers; 0 = wall/unassigned */
-    uint32_t *flags; /* CDEM_FLAG_* bits */
-    int32_t *born;   /* increment number at which the element was created (0 = initial) */
+    int32_t *id;             /* stable element id, unique within a run */
+    double *x, *y;           /* centre position, m */
+    double *vx, *vy;         /* velocity, m/s */
+    double *fx, *fy;         /* total force of the current step, N */
+    double *radius;          /* m */
+    double *mass;            /* kg per metre */
+    int32_t *layer;          /* 1..24 pre-growth layers; 25.. growth layers; 0 = wall/unassigned */
+    uint32_t *flags;         /* CDEM_FLAG_* bits */
+    int32_t *born;           /* increment number at which the element was created (0 = initial) */
     double *sxx, *syy, *sxy; /* stress, N/m, compression positive; NULL unless has_stress */
 } cdem_state;
 

@@ -492,8 +492,8 @@ static cdem_status append_walls(cdem_state *s, double w, double hw, double rw, d
     double sl = (hw + rw) / (double)nl;
     CDEM_TRY(cdem_state_reserve(s, s->n + (size_t)(nb + 2 * nl), err));
     for (long i = 0; i < nb; i++)
-        CDEM_TRY(cdem_state_append(s, -1, -rw + (double)i * sb, -rw, rw, mw, 0, CDEM_FLAG_WALL, 0,
-                                   NULL, err));
+        CDEM_TRY(cdem_state_append(s, -1, -rw + (double)i * sb, -rw, rw, mw, 0,
+                                   CDEM_FLAG_WALL | CDEM_FLAG_BASE, 0, NULL, err));
     for (int side = 0; side < 2; side++) {
         double xw = side == 0 ? -rw : w + rw;
         for (long i = 1; i <= nl; i++)

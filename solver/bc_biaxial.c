@@ -89,7 +89,7 @@ static cdem_status biaxial_init(void *vctx, const cdem_params *p, const cdem_mod
     const double ext = 0.25 * (w.x_max - w.x_min);
     const long n_side = (long)ceil(ext / r);
     const double mass = p->density * M_PI * r * r;
-    const uint32_t fl = CDEM_FLAG_WALL | CDEM_FLAG_MOVING;
+    const uint32_t fl = CDEM_FLAG_WALL | CDEM_FLAG_MOVING | CDEM_FLAG_BASE;
     for (long k = 1; k <= n_side; k++) { /* bottom platen beyond both base ends */
         CDEM_TRY(cdem_state_append(s, -1, w.x_min - (double)k * r, w.y_base, r, mass, 0, fl, 0,
                                    NULL, err));

@@ -11,6 +11,7 @@
 static const char *const class_names[CDEM_CLASS_TOTAL] = {"element",
                                                           "wall",
                                                           "fault",
+                                                          "base",
                                                           "element (weak)",
                                                           "element (layered)",
                                                           "element (layered, weak)",
@@ -31,7 +32,7 @@ int cdem_contact_class(uint32_t flags_i, uint32_t flags_j) {
     if (f & (CDEM_FLAG_FAULT | CDEM_FLAG_MYLAR))
         return CDEM_CLASS_FAULT;
     if (f & CDEM_FLAG_WALL)
-        return CDEM_CLASS_WALL;
+        return (f & CDEM_FLAG_BASE) ? CDEM_CLASS_BASE : CDEM_CLASS_WALL;
     return CDEM_CLASS_ELEMENT;
 }
 
@@ -52,7 +53,15 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_contact_law_init: NULL argument");
     CDEM_TRY(check_value(NULL, "kn", kn, 1, err));
     CDEM_TRY(check_value(NULL, "ks", ks, 0, err));
-    const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault};
+    /* the base takes the wall's value wherever its own is NaN (parameter word "wall") */
+    cdem_contact_material base = p->base;
+    if (isnan(base.friction))
+        base.friction = p->wall.friction;
+    if (isnan(base.cohesion))
+        base.cohesion = p->wall.cohesion;
+    if (isnan(base.breaking_strain))
+        base.breaking_strain = p->wall.breaking_strain;
+    const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault, &base};
     law->model = p->material;
     law->first_slip = p->first_slip ? 1 : 0;
     if ((int)p->granular_law < 0 || p->granular_law >= CDEM_LAW_COUNT)

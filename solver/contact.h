@@ -37,13 +37,14 @@ enum {
     CDEM_CLASS_ELEMENT = 0, /* element-element: params.element */
     CDEM_CLASS_WALL = 1,    /* element-wall (either flagged CDEM_FLAG_WALL): params.wall */
     CDEM_CLASS_FAULT = 2,   /* element-fault (either flagged CDEM_FLAG_FAULT): params.fault */
-    CDEM_CLASS_COUNT = 3,   /* number of base classes (element, wall, fault) */
+    CDEM_CLASS_BASE = 3,    /* element-base (a wall flagged CDEM_FLAG_BASE): params.base */
+    CDEM_CLASS_COUNT = 4,   /* number of base classes (element, wall, fault, base) */
     /* element-element refinements (heterogeneity), chosen by cdem_contact_refine */
-    CDEM_CLASS_WEAK = 3,         /* either element weak: element values x weak_strength_percent */
-    CDEM_CLASS_LAYERED = 4,      /* either element in layers 5-8/13-16/21-24: layered friction */
-    CDEM_CLASS_LAYERED_WEAK = 5, /* both rules: layered friction x weak_strength_percent */
-    CDEM_CLASS_SLIP = 6,         /* flexural slip: different pre-growth layers, no strength */
-    CDEM_CLASS_TOTAL = 7         /* length of the per-class arrays */
+    CDEM_CLASS_WEAK = 4,         /* either element weak: element values x weak_strength_percent */
+    CDEM_CLASS_LAYERED = 5,      /* either element in layers 5-8/13-16/21-24: layered friction */
+    CDEM_CLASS_LAYERED_WEAK = 6, /* both rules: layered friction x weak_strength_percent */
+    CDEM_CLASS_SLIP = 7,         /* flexural slip: different pre-growth layers, no strength */
+    CDEM_CLASS_TOTAL = 8         /* length of the per-class arrays */
 };
 
 /* Pair history flags (uint8 per pair). */
@@ -79,9 +80,9 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
 /* Name of a class for messages and views ("element", "wall", "fault"). */
 const char *cdem_contact_class_name(int cls);
 
-/* Class of a pair from the two elements' flags (CDEM_FLAG_*): fault beats wall beats
- * element. Returns -1 when the pair never interacts (both boundary elements, or either a
- * display-only footwall element). */
+/* Class of a pair from the two elements' flags (CDEM_FLAG_*): fault beats wall (base for a
+ * wall flagged CDEM_FLAG_BASE) beats element. Returns -1 when the pair never interacts (both
+ * boundary elements, or either a display-only footwall element). */
 int cdem_contact_class(uint32_t flags_i, uint32_t flags_j);
 
 /* Refines a base class (cdem_contact_class) of a pair from its elements' layers and flags.

@@ -27,6 +27,7 @@ static cdem_params base_params(cdem_material_model model) {
         (cdem_contact_material){.friction = 0.25, .cohesion = 5.0e6, .breaking_strain = 0.02};
     p.wall = (cdem_contact_material){.friction = 0.5, .cohesion = 1.0e6, .breaking_strain = 0.05};
     p.fault = (cdem_contact_material){.friction = 0.0, .cohesion = 0.0, .breaking_strain = 0.01};
+    p.base = (cdem_contact_material){.friction = NAN, .cohesion = NAN, .breaking_strain = NAN};
     return p;
 }
 
@@ -323,6 +324,37 @@ static void test_contact_wall_and_fault_materials(void **st) {
     assert_string_equal(cdem_contact_class_name(CDEM_CLASS_FAULT), "fault");
 }
 
+/* The base (wall elements flagged CDEM_FLAG_BASE) has its own class: it takes the wall's
+ * values where its own are NaN (parameter word "wall", the default), else its own. */
+static void test_contact_base_material(void **st) {
+    (void)st;
+    assert_int_equal(cdem_contact_class(0, CDEM_FLAG_WALL | CDEM_FLAG_BASE), CDEM_CLASS_BASE);
+    assert_int_equal(cdem_contact_class(CDEM_FLAG_WALL | CDEM_FLAG_BASE, CDEM_FLAG_WEAK),
+                     CDEM_CLASS_BASE);
+    assert_int_equal(cdem_contact_class(0, CDEM_FLAG_WALL), CDEM_CLASS_WALL);
+    assert_string_equal(cdem_contact_class_name(CDEM_CLASS_BASE), "base");
+    cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
+    cdem_contact_law law;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    assert_float_equal(law.friction[CDEM_CLASS_BASE], 0.5, 0.0); /* the wall's */
+    assert_float_equal(law.cohesion[CDEM_CLASS_BASE], 1.0e6, 0.0);
+    p.base.friction = 0.0; /* a smooth detachment under frictional lateral walls */
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_OK);
+    assert_float_equal(law.friction[CDEM_CLASS_BASE], 0.0, 0.0);
+    assert_float_equal(law.cohesion[CDEM_CLASS_BASE], 1.0e6, 0.0); /* still the wall's */
+    assert_float_equal(law.friction[CDEM_CLASS_WALL], 0.5, 0.0);
+    /* a sheared cohesive element-base contact: no strength with mu = 0 (coulomb: C0 only) */
+    const double R = 200.0, delta = 0.5;
+    double xs = 0.0, f[3];
+    uint8_t h = CDEM_PAIR_COHESIVE;
+    drive(&law, CDEM_CLASS_BASE, R, delta, 10.0, 1, &xs, &h, f);
+    assert_float_equal(f[0], 1.0e6, 1e-6); /* the limit mu Fn + C0 = C0 */
+    p.base.friction = -1.0;
+    assert_int_equal(cdem_contact_law_init(&law, &p, KN, KS, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "material.base_friction"));
+}
+
 static void test_contact_law_rejects_bad_values(void **st) {
     (void)st;
     cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
@@ -358,6 +390,7 @@ int main(void) {
         cmocka_unit_test(test_contact_spring_cohesion),
         cmocka_unit_test(test_contact_phases_settling_friction_and_formed_contacts),
         cmocka_unit_test(test_contact_wall_and_fault_materials),
+        cmocka_unit_test(test_contact_base_material),
         cmocka_unit_test(test_contact_law_rejects_bad_values),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -35,6 +35,7 @@ static cdem_params het_params(cdem_material_model model) {
         (cdem_contact_material){.friction = 0.25, .cohesion = 5.0e6, .breaking_strain = 0.02};
     p.wall = (cdem_contact_material){.friction = 0.5, .cohesion = 1.0e6, .breaking_strain = 0.05};
     p.fault = (cdem_contact_material){.friction = 0.0, .cohesion = 0.0, .breaking_strain = 0.01};
+    p.base = (cdem_contact_material){.friction = NAN, .cohesion = NAN, .breaking_strain = NAN};
     p.weak_thickness_percent = 30.0;
     p.weak_strength_percent = 30.0;
     p.weak_density_percent = 80.0;

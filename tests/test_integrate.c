@@ -56,6 +56,7 @@ static cdem_params hand_params(cdem_material_model model) {
     p.element = (cdem_contact_material){.friction = 0.25, .cohesion = 5e9, .breaking_strain = 1.0};
     p.wall = p.element;
     p.fault = p.element;
+    p.base = p.element;
     return p;
 }
 

@@ -451,6 +451,38 @@ static void test_params_overrides(void **state) {
     assert_true(params_equal(&p, &before));
 }
 
+/* The base's material: a number, or the word "wall" (the default: the lateral walls' value),
+ * which is stored as NaN and written back as "wall". */
+static void test_params_base_material_word(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_error err;
+    cdem_params_defaults(&p);
+    assert_true(isnan(p.base.friction) && isnan(p.base.cohesion) && isnan(p.base.breaking_strain));
+    assert_int_equal(cdem_params_override(&p, "material.base_friction=0", &err), CDEM_OK);
+    assert_true(p.base.friction == 0.0);
+    assert_int_equal(cdem_params_override(&p, "material.base_cohesion=WALL", &err), CDEM_OK);
+    assert_true(isnan(p.base.cohesion));
+    const cdem_param_def *d = cdem_params_find("material", "base_friction");
+    assert_non_null(d);
+    char buf[64];
+    cdem_params_format_value(&p, d, buf, sizeof buf);
+    assert_string_equal(buf, "0");
+    cdem_params_format_value(&p, cdem_params_find("material", "base_cohesion"), buf, sizeof buf);
+    assert_string_equal(buf, "wall");
+    assert_int_equal(cdem_params_override(&p, "material.base_friction=-1", &err), CDEM_ERR_RANGE);
+    assert_string_equal(err.msg, "-s material.base_friction=-1: base_friction = -1: must be "
+                                 "between 0 and 10, or wall");
+    assert_int_equal(cdem_params_override(&p, "material.base_friction=walls", &err),
+                     CDEM_ERR_PARSE);
+    assert_msg_has(&err, "base_friction = walls: not a number");
+    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    /* a NaN in a row without the word is still refused */
+    p.wall.friction = NAN;
+    assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_RANGE);
+    assert_msg_has(&err, "wall_friction = nan");
+}
+
 /* ---------- validation ---------- */
 
 typedef struct {
@@ -773,6 +805,7 @@ int main(void) {
         cmocka_unit_test(test_params_crlf_file),
         cmocka_unit_test(test_params_load_errors),
         cmocka_unit_test(test_params_overrides),
+        cmocka_unit_test(test_params_base_material_word),
         cmocka_unit_test(test_params_validate_each_rule),
         cmocka_unit_test(test_params_validate_allowed_combinations),
         cmocka_unit_test(test_params_validate_reports_all_rules_at_once),

@@ -35,6 +35,7 @@ static cdem_params hand_params(cdem_material_model model) {
     p.element = (cdem_contact_material){.friction = 0.5, .cohesion = 0.0, .breaking_strain = 0.5};
     p.wall = p.element;
     p.fault = p.element;
+    p.base = p.element;
     return p;
 }
 
