@@ -82,6 +82,8 @@ static const cdem_param_def param_table[] = {
      "element density"},
     {"physics", "keep_constants", CDEM_PTYPE_BOOL, P_OFF(keep_constants), 0, "", "off", 0, 1, 0, 0, NULL,
      "keep the 1000 m spring and damping constants whatever the unit scaling"},
+    {"physics", "deformation_damping", CDEM_PTYPE_DOUBLE, P_OFF(deformation_damping), 0, "", "1", 0, 1, 0, 0, NULL,
+     "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)"},
     {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
      "store per-element stress in every increment"},
 

@@ -88,6 +88,7 @@ typedef struct {
     double gravity;       /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
     double density;       /* kg/m^3, 1500-3500 */
     int keep_constants;   /* 0/1: use the 1000 m constants whatever the unit scaling */
+    double deformation_damping; /* multiplier of the damping on deformation steps, 0-1 */
     int calculate_stress; /* 0/1: store per-element stress in every increment */
 
     /* [material] */

@@ -184,7 +184,11 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
                                                       : "scaled with the average radius";
     line(f, "normal stiffness Kn", "%.10g N/m (%s)", m->kn, kn_origin);
     line(f, "shear stiffness Ks", "%.10g N/m", m->ks);
-    line(f, "damping", "%.8g N s/m", m->damping);
+    if (p->deformation_damping == 1.0)
+        line(f, "damping", "%.8g N s/m", m->damping);
+    else
+        line(f, "damping", "%.8g N s/m; x %g on deformation steps (physics.deformation_damping)",
+             m->damping, p->deformation_damping);
     line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
     line(f, "gravity", "%g m/s^2%s", m->gravity,
          p->mode == CDEM_MODE_BIAXIAL ? " (off in the biaxial test)" : "");
@@ -224,12 +228,38 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "model", "%s",
          p->material == CDEM_MATERIAL_GRANULAR ? "granular frictional-cohesive"
                                                : "initially bonded");
-    if (p->material == CDEM_MATERIAL_GRANULAR)
+    if (p->material == CDEM_MATERIAL_GRANULAR) {
+        static const char *const laws[CDEM_LAW_COUNT] = {
+            "normal-cohesion: shear strength mu (Fn + C0)", "coulomb: shear strength mu Fn + C0",
+            "spring-cohesion: Fs = Ks Xs + C0, shear strength mu Fn"};
+        line(f, "contact law", "%s",
+             (int)p->granular_law >= 0 && p->granular_law < CDEM_LAW_COUNT ? laws[p->granular_law]
+                                                                           : "?");
+        line(f, "cohesive contacts", "%s",
+             p->cohesive_contacts == CDEM_COHESIVE_FORMED
+                 ? "those of the end of equilibration and every contact formed later"
+                 : "those of the end of equilibration");
         line(f, "cohesion lost", "%s",
              p->first_slip ? "at the first slip (first slip on)"
                            : "when the pair separates (first slip off)");
+        if (p->settling_friction != 1.0)
+            line(f, "settling friction", "friction x %g during equilibration",
+                 p->settling_friction);
+    }
     contact_line(f, "element-element", p, &p->element);
     contact_line(f, "element-wall", p, &p->wall);
+    cdem_contact_material base = p->base;
+    const int own = !(isnan(base.friction) && isnan(base.cohesion) && isnan(base.breaking_strain));
+    if (isnan(base.friction))
+        base.friction = p->wall.friction;
+    if (isnan(base.cohesion))
+        base.cohesion = p->wall.cohesion;
+    if (isnan(base.breaking_strain))
+        base.breaking_strain = p->wall.breaking_strain;
+    if (own)
+        contact_line(f, "element-base", p, &base);
+    else
+        line(f, "element-base", "as element-wall");
     contact_line(f, "element-fault", p, &p->fault);
 
     heading(f, "Heterogeneity");

@@ -46,6 +46,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
                          "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
                          m->radius[0]);
     it->par_min = PAR_MIN_DEFAULT;
+    it->damping_factor = 1.0;
     it->unstable_index = -1;
     it->boundary_forces = 1;
     it->dt = m->dt;
@@ -190,9 +191,11 @@ static cdem_status reserve_per_element(cdem_integrator *it, size_t n, cdem_error
 static int update_kick(cdem_integrator *it, const cdem_state *s) {
     if (it->kickcap < s->n)
         return 0;
-    if (it->kick_build == it->nb.n_builds && it->kick_n == s->n && it->kick_dt == it->dt)
+    const double c = cdem_integrator_damping(it);
+    if (it->kick_build == it->nb.n_builds && it->kick_n == s->n && it->kick_dt == it->dt &&
+        it->kick_c == c)
         return 1;
-    const double hdt = 0.5 * it->dt, c = it->damping;
+    const double hdt = 0.5 * it->dt;
     const long n = (long)s->n;
     const double *restrict mass = s->mass;
     double *restrict kd = it->kick_drift, *restrict kf = it->kick_finish;
@@ -204,6 +207,7 @@ static int update_kick(cdem_integrator *it, const cdem_state *s) {
     it->kick_build = it->nb.n_builds;
     it->kick_n = s->n;
     it->kick_dt = it->dt;
+    it->kick_c = c;
     return 1;
 }
 
@@ -769,7 +773,7 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .kick = kick,
         .dt = it->dt,
         .hdt = 0.5 * it->dt,
-        .c = it->damping,
+        .c = cdem_integrator_damping(it),
         .g = it->gravity,
         .ob = it->overburden_force,
         .ef = it->confining_pressure * it->column_width * it->confining_factor,

@@ -33,17 +33,20 @@
 #define CDEM_MAX_CHUNKS 64
 
 typedef struct {
-    double dt;            /* s, time step, > 0 */
-    double damping;       /* N s/m, viscous coefficient c, >= 0 */
-    double gravity;       /* m/s^2, applied in -y, >= 0 */
-    cdem_contact_law law; /* contact law and materials */
-    cdem_neighbour nb;    /* pair list with histories and force slots */
-    long step;            /* steps taken so far */
-    int boundary_forces;  /* 0/1, kept for the callers: the force pass now sums the contact
-                             force on boundary elements (state fx, fy) every step, as it
-                             costs nothing extra in the scatter; 1 = default */
-    long par_min;         /* loops over fewer items than this run on one thread (>= 0);
-                             results are bit-identical either way */
+    double dt;             /* s, time step, > 0 */
+    double damping;        /* N s/m, viscous coefficient c of the model, >= 0 */
+    double damping_factor; /* multiplier of c on the current step, >= 0 (1 after init; the
+                              run loop sets physics.deformation_damping on deformation
+                              steps): cdem_integrator_damping */
+    double gravity;        /* m/s^2, applied in -y, >= 0 */
+    cdem_contact_law law;  /* contact law and materials */
+    cdem_neighbour nb;     /* pair list with histories and force slots */
+    long step;             /* steps taken so far */
+    int boundary_forces;   /* 0/1, kept for the callers: the force pass now sums the contact
+                              force on boundary elements (state fx, fy) every step, as it
+                              costs nothing extra in the scatter; 1 = default */
+    long par_min;          /* loops over fewer items than this run on one thread (>= 0);
+                              results are bit-identical either way */
 
     /* force pass decomposition (scratch derived from the pair list, not state: rebuilt
      * whenever the list or the thread count changes; never serialised). Chunk c owns the
@@ -89,6 +92,7 @@ typedef struct {
     long kick_build;
     size_t kick_n;
     double kick_dt;
+    double kick_c; /* the damping the kick factors were derived for */
     /* unstable-motion guard (0 = off; the run loop sets it): after each step,
      * unstable_index is the lowest index whose element moved more than its radius in the
      * step's velocity (|v| dt > r), or -1; found in the force pass's element loop */
@@ -130,6 +134,11 @@ typedef struct {
      * material as given. */
     int equilibrating;
 } cdem_integrator;
+
+/* The viscous coefficient in force on the current step, N s/m: damping x damping_factor. */
+static inline double cdem_integrator_damping(const cdem_integrator *it) {
+    return it->damping * it->damping_factor;
+}
 
 /* Sets up the stepper from the model constants (dt, damping, gravity, kn, ks, max radius)
  * and material parameters. skin = 0.25 x the smallest radius. */

@@ -532,8 +532,10 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         /* wall forces are summed only on the steps whose sample reports them, and on every
          * equilibration step of a mode that moves boundaries then (biaxial servo platens) */
         const int eq_moves = step <= equil && cdem_bc_moves_in_equilibration(&r->bc);
-        /* the packing phase's law (settling friction) up to the end of equilibration */
+        /* the packing phase's law (settling friction) up to the end of equilibration; the
+         * damping of deformation steps (physics.deformation_damping) */
         r->it.equilibrating = step <= equil;
+        r->it.damping_factor = deforming ? p->deformation_damping : 1.0;
         r->it.boundary_forces = (step % interval == 0) || eq_moves;
         cdem_status st =
             cdem_integrator_step(&r->it, &r->s, (deforming || eq_moves) ? &r->bc : NULL,
