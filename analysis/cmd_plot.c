@@ -619,6 +619,9 @@ int cdem_cmd_plot_voids(int argc, char **argv) {
                "%.6g m\n",
                res.largest_clearance, res.largest_clearance / res.min_clearance, res.largest_x,
                res.largest_y);
+        printf("deepest open fissure = %.4g m (below the rims within %.4g m on either side) at x "
+               "= %.6g m, bottom y = %.6g m\n",
+               res.fissure_depth, res.fissure_width, res.fissure_x, res.fissure_y);
     }
     cdem_state_free(&s);
     cdem_h5_reader_close(r);

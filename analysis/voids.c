@@ -169,6 +169,50 @@ static long region(uint8_t *m, const uint8_t *near, uint8_t want_set, uint8_t ma
     return n;
 }
 
+/* Open fissures (voids.h): in every raster column, the depth of its first solid cell below
+ * the lower of the highest free-element cells within 2 rmax on either side. */
+static void fissures(const uint8_t *g, long nx, long ny, double h, double gx0, double gy0,
+                     double rmax, cdem_voids_result *res) {
+    const long k = (long)ceil(2.0 * rmax / h);
+    res->fissure_width = 2.0 * rmax;
+    long *top = malloc((size_t)nx * sizeof *top), *first = malloc((size_t)nx * sizeof *first);
+    if (!top || !first) {
+        free(top);
+        free(first);
+        return; /* the measure stays 0; the others are complete */
+    }
+    for (long i = 0; i < nx; i++) {
+        top[i] = first[i] = -1;
+        for (long j = ny - 1; j >= 0; j--) {
+            const uint8_t c = g[j * nx + i];
+            if (c != CELL_EMPTY && first[i] < 0)
+                first[i] = j;
+            if (c == CELL_FREE) {
+                top[i] = j;
+                break;
+            }
+        }
+    }
+    for (long i = k; i + k < nx; i++) {
+        long left = -1, right = -1;
+        for (long a = i - k; a < i; a++)
+            left = top[a] > left ? top[a] : left;
+        for (long a = i + 1; a <= i + k; a++)
+            right = top[a] > right ? top[a] : right;
+        if (left < 0 || right < 0 || first[i] < 0)
+            continue;
+        const long rim = left < right ? left : right;
+        const double depth = (double)(rim - first[i]) * h;
+        if (depth > res->fissure_depth) {
+            res->fissure_depth = depth;
+            res->fissure_x = gx0 + (i + 0.5) * h;
+            res->fissure_y = gy0 + (first[i] + 0.5) * h;
+        }
+    }
+    free(top);
+    free(first);
+}
+
 cdem_status cdem_voids_measure(const cdem_state *s, double window, cdem_voids_result *res,
                                cdem_error *err) {
     if (!s || !res)
@@ -294,6 +338,7 @@ cdem_status cdem_voids_measure(const cdem_state *s, double window, cdem_voids_re
             res->void_area += room;
         }
     }
+    fissures(g, nx, ny, h, xmin, ymin, rmax, res);
     free(m);
     free(near);
     free(g);

@@ -18,6 +18,12 @@
  *     its cells are nearest to a free element, not to a wall or a fault ramp): room for the
  *     largest element that gravity should have filled (a cavity under a cohesive arch, a
  *     crack between separating blocks). The pores of a packing have far less clearance.
+ *   - open fissures: in every cell column of the raster, the depth of its first solid cell
+ *     (from the sky down) below the rim, the lower of the highest free-element cells within
+ *     2 r_max on either side; the deepest is reported. A crack or slot open to the sky but
+ *     narrower than 4 r_max (a gap between separating blocks) is as deep as it is open; a
+ *     slope or a step gives its drop over 2 r_max, the notches between surface elements
+ *     about an element.
  * Used by `cdem-strain voids` and by the material regression tests (tests/test_material.c).
  * Ownership: the caller owns the state. Thread safety: pure function; scratch memory is
  * allocated per call. Units: m, m^2, degrees. */
@@ -42,6 +48,9 @@ typedef struct {
     double largest_clearance;        /* m, largest clearance inside the rock mass (not outside,
                                         nearest solid a free element, in the free elements' box) */
     double largest_x, largest_y;     /* m, where it is */
+    double fissure_width;            /* m, the rim search on either side, 2 r_max */
+    double fissure_depth;            /* m, the deepest open fissure (0: none) */
+    double fissure_x, fissure_y;     /* m, its column and bottom */
 } cdem_voids_result;
 
 /* Measures state s with slope window `window` (m, > 0). Fails with CDEM_ERR_INVALID when s

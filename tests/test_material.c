@@ -6,9 +6,9 @@
  *     on a 10 x 2.5 km assembly at default radii, 400 s of equilibration and 600 s (about
  *     420 m) of slip: no void (analysis/voids.h) and no surface steeper than 40 degrees over
  *     1 km (a graben's flanks); coulomb: a cavity or a chasm.
- *   - collapse: the repose test (right wall removed) on the same assembly, 1600 s after the
- *     wall goes: a slope of 20-40 degrees is fitted (analysis/repose.h) and nothing is
- *     steeper than 60 degrees over 1 km; coulomb: a standing cliff. */
+ *   - collapse: the repose test (right wall removed) on the default 10 x 5 km assembly,
+ *     2000 s after the wall goes: a slope of 20-40 degrees is fitted (analysis/repose.h) and
+ *     nothing is steeper than 60 degrees over 1 km; coulomb: a standing cliff. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -95,7 +95,9 @@ static void test_material_extension_opens_no_void(void **st) {
 static void test_material_collapse_leaves_no_cliff(void **st) {
     (void)st;
     cdem_params p = small_params(CDEM_MODE_REPOSE);
-    p.runtime = 2000.0;
+    p.height = 5.0; /* a 2.5 km block of the dense default material stands steeper */
+    p.runtime = 2400.0;
+    p.display_interval = 200.0;
     cdem_state s = {0};
     cdem_voids_result v;
     cdem_repose_result rep;

@@ -1,5 +1,5 @@
-/* Tests of voids.[ch] (steepest surface slope, closed-off voids) on synthetic packings whose
- * answers are known by construction. */
+/* Tests of voids.[ch] (steepest surface slope, closed-off voids, open fissures) on synthetic
+ * packings whose answers are known by construction. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -69,6 +69,7 @@ static void test_voids_intact_block(void **state) {
     assert_true(r.largest_clearance < r.min_clearance); /* pores and pockets of the packing */
     assert_true(r.steepest_deg < 10.0);                 /* a flat top */
     assert_near(r.void_min_room, M_PI * 125.0 * 125.0 / 16.0, 1e-6);
+    assert_true(r.fissure_depth < 500.0); /* notches where top elements are missing */
     assert_near(r.cell, 12.5, 1e-9);
 }
 
@@ -99,6 +100,10 @@ static void test_voids_open_slot(void **state) {
      * it is a closed-off room for the largest element: a crack between separating blocks */
     const cdem_voids_result r = measure(slot);
     assert_true(r.n_voids >= 1);
+    /* and an open fissure from the top (2500 m) to the slot's floor (800 m) */
+    assert_true(r.fissure_depth > 1400.0 && r.fissure_depth < 1800.0);
+    assert_near(r.fissure_x, 4000.0, 200.0);
+    assert_near(r.fissure_width, 250.0, 0.0);
 }
 
 static void test_voids_bad_input(void **state) {
