@@ -134,9 +134,10 @@ static inline void cdem_contact_law_phase(const cdem_contact_law *law, int equil
  * for the granular material, the tangential spring limited by the pair's law. The one
  * kernel of the granular laws: the integrator, the tests and everything else call it (or
  * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
-static inline void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2, double dx,
-                                         double dy, double R, double dvx, double dvy, double dt,
-                                         double *xs, uint8_t *hist, double *fx, double *fy) {
+static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2,
+                                              double dx, double dy, double R, double dvx,
+                                              double dvy, double dt, double *xs, uint8_t *hist,
+                                              double *fx, double *fy) {
     uint8_t h = *hist;
     const double r = sqrt(r2);
     const double inv = 1.0 / r;

@@ -411,12 +411,6 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
     return CDEM_OK;
 }
 
-#if defined(__GNUC__)
-#define CDEM_INLINE inline __attribute__((always_inline))
-#else
-#define CDEM_INLINE inline
-#endif
-
 /* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
  * the common case of a list pair that does not touch is settled here, everything else by
  * the one contact kernel (contact.h). (A branch-free variant of the granular law,

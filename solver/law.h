@@ -13,6 +13,14 @@
 #ifndef CDEM_LAW_H
 #define CDEM_LAW_H
 
+/* The per-pair kernel and the laws are inlined into the force loop whatever the compiler's
+ * inlining budget says (a call per touching pair cost about 4 % of a step). */
+#if defined(__GNUC__)
+#define CDEM_INLINE inline __attribute__((always_inline))
+#else
+#define CDEM_INLINE inline
+#endif
+
 typedef struct {
     double force;  /* N, tangential force on the contact */
     double spring; /* N, elastic shear force kept for the next step (Ks Xs) */

@@ -13,7 +13,7 @@
 
 #include <math.h>
 
-static inline cdem_shear cdem_law_coulomb(double spring, double fn, double mu, double c0) {
+static CDEM_INLINE cdem_shear cdem_law_coulomb(double spring, double fn, double mu, double c0) {
     double limit = mu * fn;
     if (c0 > 0.0)
         limit += c0;

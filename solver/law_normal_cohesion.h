@@ -16,7 +16,8 @@
 
 #include <math.h>
 
-static inline cdem_shear cdem_law_normal_cohesion(double spring, double fn, double mu, double c0) {
+static CDEM_INLINE cdem_shear cdem_law_normal_cohesion(double spring, double fn, double mu,
+                                                       double c0) {
     const double limit = mu * (fn + c0);
     cdem_shear s = {spring, spring, 0};
     if (fabs(spring) > limit) {

@@ -14,7 +14,8 @@
 
 #include <math.h>
 
-static inline cdem_shear cdem_law_spring_cohesion(double spring, double fn, double mu, double c0) {
+static CDEM_INLINE cdem_shear cdem_law_spring_cohesion(double spring, double fn, double mu,
+                                                       double c0) {
     const double limit = mu * fn;
     double f = spring;
     if (c0 > 0.0 && spring != 0.0)

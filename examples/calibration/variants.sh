@@ -19,8 +19,10 @@ mkdir -p "$OUT"
 # name | overrides (material, biaxial-only)
 variants() {
     for law in normal-cohesion coulomb spring-cohesion; do
+        sfs="1 0"
+        [ "$law" = normal-cohesion ] && sfs="1 0.5 0.25 0"
         for coh in equilibrated formed; do
-            for sf in 1 0.5 0; do
+            for sf in $sfs; do
                 echo "$law/$coh/sf$sf|-s material.granular_law=$law -s material.cohesive_contacts=$coh -s material.settling_friction=$sf|"
             done
         done
