@@ -196,6 +196,12 @@ static void test_contact_normal_cohesion_limit_first_slip(void **st) {
     drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
     assert_float_equal(f[199], limit, 1e-9 * limit);
     assert_true(h & CDEM_PAIR_COHESIVE);
+    /* ... and loses its cohesion when the pair separates: a new contact holds mu Fn */
+    double fx, fy;
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    assert_true(h == 0 && xs == 0.0 && fx == 0.0 && fy == 0.0);
+    drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
+    assert_float_equal(f[199], mu * fn, 1e-9 * fn);
     /* at Fn -> 0 the strength is mu C0 (a 1 um overlap: Fn = 1e3 N) */
     xs = 0.0;
     h = CDEM_PAIR_COHESIVE;
