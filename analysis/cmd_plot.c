@@ -106,8 +106,16 @@ typedef struct {
     double range[4];              /* xmin, xmax, ymin, ymax of --xrange, --yrange */
 } plot_args;
 
+static const cdem_cli_help *help_of(const char *cmd) {
+    return !strcmp(cmd, "mohr")     ? &cdem_cmd_mohr_help
+           : !strcmp(cmd, "repose") ? &cdem_cmd_repose_help
+                                    : &cdem_cmd_plot_series_help;
+}
+
+/* synopsis is the first usage form of the command's help (help_of) */
 static int usage(const char *cmd, const char *what, const char *synopsis) {
-    fprintf(stderr, "cdem-strain %s: %s\nusage: cdem-strain %s %s\n", cmd, what, cmd, synopsis);
+    (void)synopsis;
+    cdem_cli_usage_print(stderr, help_of(cmd), what);
     return 2;
 }
 
@@ -154,7 +162,7 @@ static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("usage: cdem-strain %s %s\n", cmd, synopsis);
+            cdem_cli_help_print(stdout, help_of(cmd));
             return -1;
         }
         size_t f;
@@ -240,6 +248,32 @@ static cdem_status read_series(const char *path, cdem_series_sample **smp, size_
 static const char series_synopsis[] =
     "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT.png|.pdf|.svg "
     "[--xrange MIN,MAX] [--yrange MIN,MAX] [--width N] [--height N]";
+static const char *const series_forms[] = {series_synopsis, NULL};
+/* the picture size options shared by the plots */
+#define WIDTH_OPTION                                                                               \
+    { "--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000" }
+#define HEIGHT_OPTION                                                                              \
+    { "--height", "N", "as --width" }
+static const cdem_cli_option series_options[] = {
+    {"--y", "COLUMN",
+     "the /series column to plot: time, step, kinetic_energy, contacts, bonds, n_elements, "
+     "net_displacement, boundary_force_x, boundary_force_y, base_force_x, base_force_y, "
+     "axial_strain, differential_stress, sea_level"},
+    {"--x", "time|step|net_displacement", "the x axis (default time)"},
+    {"-o, --output", "OUT.png|.pdf|.svg", "the picture"},
+    {"--xrange", "MIN,MAX", "fixed x range"},
+    {"--yrange", "MIN,MAX", "fixed y range"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_plot_series_help = {
+    .program = "cdem-strain plot-series",
+    .forms = series_forms,
+    .about = "Line plot of a time-series column of one or more runs (one curve per run), e.g. "
+             "kinetic_energy to check that equilibration has settled. Columns and units: "
+             "docs/format.md, \"/series\".",
+    .options = series_options,
+};
 
 int cdem_cmd_plot_series(int argc, char **argv) {
     plot_args a = {.cmd = "plot-series"};
@@ -307,6 +341,24 @@ int cdem_cmd_plot_series(int argc, char **argv) {
 static const char mohr_synopsis[] =
     "RUN1.h5 RUN2.h5 ... | --data FILE (columns: sigma3 q, N/m)  [-o OUT.png|.pdf|.svg] "
     "[--width N] [--height N]";
+
+static const char *const mohr_forms[] = {mohr_synopsis, NULL};
+static const cdem_cli_option mohr_options[] = {
+    {"--data", "FILE", "fit peaks measured elsewhere: a text file of columns sigma3 q (N/m)"},
+    {"-o, --output", "OUT.png|.pdf|.svg",
+     "stress-strain curves and Mohr circles with the fitted envelope"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_mohr_help = {
+    .program = "cdem-strain mohr",
+    .forms = mohr_forms,
+    .about = "Mohr-Coulomb fit of biaxial tests: takes the peak differential stress of each "
+             "run (sigma3 = its confining pressure) and prints the cohesion and friction "
+             "angle with their standard errors (none with exactly two tests). Formulas: "
+             "docs/rendering.md.",
+    .options = mohr_options,
+};
 
 #define MOHR_CIRCLE_POINTS 181
 
@@ -482,6 +534,20 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
 /* ---------------------------------------------------------------- repose */
 static const char repose_synopsis[] =
     "RUN.h5 [--increment K|last|equil|first] [-o OUT.png|.pdf|.svg] [--width N] [--height N]";
+static const char *const repose_forms[] = {repose_synopsis, NULL};
+static const cdem_cli_option repose_options[] = {
+    {"--increment", "K|last|equil|first", "the increment (default last)"},
+    {"-o, --output", "OUT.png|.pdf|.svg", "the free surface with the fitted flanks"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_repose_help = {
+    .program = "cdem-strain repose",
+    .forms = repose_forms,
+    .about = "Angle of repose: the slope of the free surface of a repose-collapse run, fitted "
+             "on each flank (docs/analysis.md).",
+    .options = repose_options,
+};
 
 static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int number,
                                  const cdem_repose_result *res, cdem_error *err) {

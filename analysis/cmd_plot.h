@@ -10,6 +10,7 @@
 #define CDEM_CMD_PLOT_H
 
 #include "cdem_error.h"
+#include "cli_help.h"
 #include "h5format.h"
 
 #include <stddef.h>
@@ -20,6 +21,11 @@
  * differential_stress, sea_level). *label (may be NULL) gets an axis label with unit. */
 cdem_status cdem_cmd_plot_column(const cdem_series_sample *samples, size_t n, const char *name,
                                  double *out, const char **label, cdem_error *err);
+
+/* Usage, description and options of each (--help, man page, completion). */
+extern const cdem_cli_help cdem_cmd_plot_series_help;
+extern const cdem_cli_help cdem_cmd_mohr_help;
+extern const cdem_cli_help cdem_cmd_repose_help;
 
 int cdem_cmd_plot_series(int argc, char **argv);
 int cdem_cmd_plot_mohr(int argc, char **argv);

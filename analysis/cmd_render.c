@@ -41,24 +41,68 @@ static int fail(const cdem_error *err) {
     return 1;
 }
 
+/* The help of render (cli_help.h): --help, the usage errors, the man page and the bash
+ * completion come from it; tests/test_help.c checks that parse_args accepts every option. */
+static const char *const render_forms[] = {
+    "RUN.h5 [--increment K|last|first|equil|all] [--color QUANTITY] [--vectors incr|total] "
+    "[--axes incr-strain|total-strain|stress] [--shear-axes] [--above-tenth-max] [--no-fill] "
+    "[--no-colours] [--no-scale-bar] [--no-colour-bar] [--no-label] [--width N] [--height N] "
+    "[--zoom XMIN,XMAX,YMIN,YMAX] [--highlight FIRST-LAST] [--color-walls #RRGGBB] "
+    "[--color-layers #RRGGBB,#RRGGBB] -o OUT.png|.pdf|.svg",
+    "RUN.h5 --increment all [OPTIONS] -o DIR [--prefix P] [--format png|pdf|svg]",
+    "RUN.h5 [OPTIONS] --gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]",
+    "RUN.h5 --follow [--interval SECONDS] [OPTIONS] [-o OUT.png]", NULL};
+
+static const cdem_cli_option render_options[] = {
+    {"--increment", "K|last|first|equil|all",
+     "which increment (default last); all writes DIR/<prefix><number>.<format> for every "
+     "increment"},
+    {"--color, --colour", "QUANTITY",
+     "colour by a quantity ('cdem-strain quantities'; default: layer colours)"},
+    {"--above-tenth-max", NULL, "colour only elements whose value exceeds 0.1 x the maximum"},
+    {"--vectors", "incr|total", "displacement vectors (incremental 5x exaggerated, total 1x)"},
+    {"--axes", "incr-strain|total-strain|stress",
+     "principal axes (S1 and the perpendicular S3) on a grid"},
+    {"--shear-axes", NULL, "with --axes: the maximum-shear directions instead"},
+    {"--no-fill", NULL, "outlines only (the manual's \"toggle elements\")"},
+    {"--no-colours, --no-colors", NULL, "no colours by value"},
+    {"--no-scale-bar", NULL, "no scale bar"},
+    {"--no-colour-bar, --no-color-bar", NULL, "no colour bar"},
+    {"--no-label", NULL, "no increment label"},
+    {"--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000 (default 1200)"},
+    {"--height", "N", "as --width (default: from the aspect ratio)"},
+    {"--zoom", "XMIN,XMAX,YMIN,YMAX", "view box in metres (default: all elements)"},
+    {"--highlight", "FIRST-LAST", "highlight the layers FIRST to LAST"},
+    {"--color-walls, --colour-walls", "#RRGGBB", "wall colour (default brown)"},
+    {"--color-layers, --colour-layers", "#RRGGBB,#RRGGBB",
+     "the two pre-growth band colours (default yellow, red)"},
+    {"-o, --output", "OUT",
+     "picture (.png, .pdf, .svg), or a directory with --increment all (created when "
+     "missing)"},
+    {"--prefix", "P", "file-name prefix with --increment all (default cdem)"},
+    {"--format", "png|pdf|svg", "picture format with --increment all (default png)"},
+    {"--gif", "OUT.gif", "animated GIF of every increment"},
+    {"--backward", NULL, "GIF frames from the last increment to the first"},
+    {"--odd", NULL, "GIF of every other increment (a smaller file)"},
+    {"--gif-scale", "S", "GIF size as a fraction of --width, 0.05 to 1 (default 1)"},
+    {"--delay", "CS", "GIF frame delay in hundredths of a second (default 10)"},
+    {"--follow", NULL,
+     "re-render the newest increment of a run that cdem-run is still writing whenever a new "
+     "one arrives, until the run stops (-o defaults to live.png)"},
+    {"--interval", "SECONDS", "with --follow: seconds between checks (default 2)"},
+    {NULL, NULL, NULL}};
+
+const cdem_cli_help cdem_cmd_render_help = {
+    .program = "cdem-strain render",
+    .forms = render_forms,
+    .about = "Pictures of increments (PNG, PDF, SVG), albums and animated GIFs. Every picture "
+             "of a series uses one view box, so frames line up. docs/rendering.md has the "
+             "details.",
+    .options = render_options,
+};
+
 static int usage(const char *what) {
-    fprintf(
-        stderr,
-        "cdem-strain render: %s\n"
-        "usage: cdem-strain render RUN.h5 [--increment K|last|first|equil|all]\n"
-        "         [--color QUANTITY] [--vectors incr|total] [--axes "
-        "incr-strain|total-strain|stress]\n"
-        "         [--shear-axes] [--above-tenth-max] [--no-fill] [--no-colours] [--no-scale-bar]\n"
-        "         [--no-colour-bar] [--no-label] [--width N] [--height N] [--zoom "
-        "XMIN,XMAX,YMIN,YMAX]\n"
-        "         [--highlight FIRST-LAST] [--color-walls #RRGGBB] [--color-layers "
-        "#RRGGBB,#RRGGBB]\n"
-        "         [-o OUT.png|.pdf|.svg | -o DIR with --increment all [--prefix P] [--format "
-        "png|pdf|svg]]\n"
-        "         [--gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]]\n"
-        "         [--follow [--interval SECONDS]]  re-render the newest increment of a run\n"
-        "         that is still being written (default -o live.png) until it stops\n",
-        what);
+    cdem_cli_usage_print(stderr, &cdem_cmd_render_help, what);
     return 2;
 }
 
@@ -106,7 +150,7 @@ static int parse_args(int argc, char **argv, render_args *a) {
         i++;                                                                                       \
     } while (0)
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            usage("help");
+            cdem_cli_help_print(stdout, &cdem_cmd_render_help);
             return 3; /* help shown: exit 0 after the caller sees 3 */
         } else if (!strcmp(arg, "--increment") || !strcmp(arg, "--increments")) {
             NEED_VALUE();

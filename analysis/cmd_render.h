@@ -6,6 +6,11 @@
 #ifndef CDEM_CMD_RENDER_H
 #define CDEM_CMD_RENDER_H
 
+#include "cli_help.h"
+
+/* Its usage, description and options (--help, man page, completion). */
+extern const cdem_cli_help cdem_cmd_render_help;
+
 /* argv[0] is "render"; returns the process exit code (0 ok, 1 error, 2 usage). */
 int cdem_cmd_render(int argc, char **argv);
 

@@ -122,10 +122,16 @@ static void test_man_lists_every_option_and_command(void **state) {
     char *run_page = slurp("man/cdem-run.1"), *strain_page = slurp("man/cdem-strain.1");
     assert_non_null(run_page);
     assert_non_null(strain_page);
-    const char *options[] = {
-        "\\-o OUT.h5",         "\\-s section.key=value", "\\-\\-summary",
-        "\\-\\-dry\\-run",     "\\-\\-print\\-defaults", "\\-\\-params\\-markdown",
-        "\\-\\-max\\-steps N", "\\-\\-version"};
+    const char *options[] = {"\\-o OUT.h5",
+                             "\\-s section.key=value",
+                             "\\-\\-summary",
+                             "\\-\\-dry\\-run",
+                             "\\-\\-print\\-defaults",
+                             "\\-\\-params\\-markdown",
+                             "\\-\\-max\\-steps N",
+                             "\\-\\-version",
+                             "\\-\\-par\\-min N",
+                             "\\-V"};
     for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
         if (!strstr(run_page, options[i]))
             fail_msg("man/cdem-run.1 lacks option %s", options[i]);
@@ -140,12 +146,19 @@ static void test_man_lists_every_option_and_command(void **state) {
                               "render",
                               "plot\\-series",
                               "mohr",
-                              "repose"};
+                              "repose",
+                              "wedge",
+                              "plot\\-csv",
+                              "help"};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         char row[128];
         snprintf(row, sizeof row, ".TP\n\\fB%s\\fR\n", commands[i]);
         if (!strstr(strain_page, row))
             fail_msg("man/cdem-strain.1 lacks command %s", commands[i]);
+        /* and a subsection with the command's own usage and options */
+        snprintf(row, sizeof row, ".SS %s\n.nf\ncdem\\-strain %s", commands[i], commands[i]);
+        if (!strstr(strain_page, row))
+            fail_msg("man/cdem-strain.1 lacks the usage of command %s", commands[i]);
     }
     /* the render options come from `cdem-strain render --help` */
     assert_non_null(strstr(strain_page, "\\-\\-above\\-tenth\\-max"));
