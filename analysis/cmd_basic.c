@@ -168,19 +168,33 @@ static int cmd_compute(const options *o) {
         if (!f)
             st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", of.tmp, strerror(errno));
     }
-    if (st == CDEM_OK && !h)
-        st = cdem_qexport_csv_header(f, all, &err);
+    /* "all" skips increments without stress; with none at all that is an error, found before
+     * anything is written (on stdout a header followed by an error is a broken CSV) */
+    size_t with_stress = 0;
+    for (size_t k = first; k <= last; k++)
+        with_stress += cdem_analysis_info(a, k)->has_stress != 0;
+    if (st == CDEM_OK && q->needs_stress && all && with_stress == 0)
+        st = CDEM_FAIL(&err, CDEM_ERR_NOTFOUND,
+                       "quantity '%s' needs stress, but no increment of %s stores any (run with "
+                       "physics.calculate_stress = on)",
+                       q->name, o->file);
+    int header_done = h != NULL; /* the CSV header goes out with the first computed rows */
     for (size_t k = first; k <= last && st == CDEM_OK; k++) {
         const cdem_increment_info *in = cdem_analysis_info(a, k);
         if (q->needs_stress && !in->has_stress && all)
-            continue; /* "all" skips increments without stress */
+            continue;
         const cdem_state *s;
         double *v;
         st = cdem_analysis_values(a, k, q, &s, &v, &err);
         if (st != CDEM_OK)
             break;
-        st = h ? cdem_qexport_h5_write(h, in->number, s, v, &err)
-               : cdem_qexport_csv_rows(f, all, in->number, s, v, &err);
+        if (!header_done) {
+            st = cdem_qexport_csv_header(f, all, &err);
+            header_done = 1;
+        }
+        if (st == CDEM_OK)
+            st = h ? cdem_qexport_h5_write(h, in->number, s, v, &err)
+                   : cdem_qexport_csv_rows(f, all, in->number, s, v, &err);
         free(v);
     }
     if (h) {
@@ -296,12 +310,6 @@ static int cmd_export_sspx(const options *o) {
         return usage_error(o, "export-sspx needs --increments A-B (e.g. 56-282, equil-last)");
     if (!o->dir)
         return usage_error(o, "export-sspx needs an output directory");
-    struct stat sb;
-    if (stat(o->dir, &sb) != 0 || !S_ISDIR(sb.st_mode)) {
-        cdem_error err;
-        CDEM_FAIL(&err, CDEM_ERR_IO, "output directory %s does not exist", o->dir);
-        return fail_with(&err);
-    }
     cdem_analysis *a;
     int rc = open_run(o, &a);
     if (rc)
@@ -312,6 +320,8 @@ static int cmd_export_sspx(const options *o) {
     if (!prefix[0])
         prefix = "cdem";
     cdem_status st = cdem_sspx_parse_range(a, o->increments, &first, &last, &err);
+    if (st == CDEM_OK) /* after the run file and range are known good: no stray folder */
+        st = cdem_outfile_make_dirs(o->dir, &err);
     if (st == CDEM_OK)
         st = cdem_sspx_export(a, first, last, o->dir, prefix, &written, &err);
     if (st == CDEM_OK)

@@ -5,6 +5,7 @@
 
 #include "analysis.h"
 #include "gif.h"
+#include "outfile.h"
 #include "render.h"
 
 #include <errno.h>
@@ -56,7 +57,7 @@ static const char *const render_forms[] = {
 static const cdem_cli_option render_options[] = {
     {"--increment", "K|last|first|equil|all",
      "which increment (default last); all writes DIR/<prefix><number>.<format> for every "
-     "increment"},
+     "increment, numbers zero-padded to one width (cdem000.png .. cdem282.png)"},
     {"--color, --colour", "QUANTITY",
      "colour by a quantity ('cdem-strain quantities'; default: layer colours)"},
     {"--above-tenth-max", NULL, "colour only elements whose value exceeds 0.1 x the maximum"},
@@ -475,21 +476,22 @@ static int run_render(const render_args *a) {
     if (!a->output)
         goto done;
     if (!strcmp(a->increment, "all")) {
-        if (mkdir(a->output, 0777) != 0 && errno != EEXIST) {
-            CDEM_FAIL(&err, CDEM_ERR_IO, "%s: cannot create the output directory: %s", a->output,
-                      strerror(errno));
+        if (cdem_outfile_make_dirs(a->output, &err) != CDEM_OK) {
             rc = fail(&err);
             goto done;
         }
+        /* numbers zero-padded to the width of the largest, so the files sort in increment
+         * order (fr000.png .. fr282.png; movie tools take them in name order) */
+        const int width = snprintf(NULL, 0, "%d", (int)cdem_analysis_info(an, n - 1)->number);
         for (size_t i = 0; i < n && rc == 0; i++) {
             char path[4096];
-            snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+            snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                      (int)cdem_analysis_info(an, i)->number, a->format);
             if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK) {
                 rc = fail(&err);
                 /* no partial series that looks complete: remove this run's pictures */
                 for (size_t j = 0; j < i; j++) {
-                    snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+                    snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                              (int)cdem_analysis_info(an, j)->number, a->format);
                     remove(path);
                 }

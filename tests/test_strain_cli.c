@@ -167,6 +167,17 @@ static void test_strain_cli_exports_and_import(void **state) {
     }
     snprintf(path, sizeof path, "%s/mod1.txt", g_tmp);
     assert_int_not_equal(access(path, R_OK), 0);
+    /* a folder that does not exist yet (two levels) is created (issue 18) */
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-4 %s/new/sspx", g_exe, g_run,
+             g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    snprintf(path, sizeof path, "%s/new/sspx/cdem4.txt", g_tmp);
+    assert_int_equal(access(path, R_OK), 0);
+    /* but not for a bad range: nothing is created then */
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-99 %s/never", g_exe, g_run, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    snprintf(path, sizeof path, "%s/never", g_tmp);
+    assert_int_not_equal(access(path, F_OK), 0);
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(cmd, sizeof cmd,
              "%s import-cdem2d %s/cdem2d_basic -o %s/imp.h5 && %s compute "
@@ -244,6 +255,20 @@ static void test_strain_cli_errors(void **state) {
     snprintf(cmd, sizeof cmd, "%s compute %s --increment last --quantity sxx", g_exe, g_run);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "needs stress"));
+    /* nothing on stdout before such an error: no CSV header alone (issue 18) */
+    const char *incs[] = {"last", "all"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd, "(%s compute %s --increment %s --quantity sxx 2>/dev/null)",
+                 g_exe, g_run, incs[k]);
+        assert_int_equal(run(cmd, out, sizeof out), 1);
+        if (out[0])
+            fail_msg("compute --increment %s --quantity sxx printed '%s' before failing", incs[k],
+                     out);
+        snprintf(cmd, sizeof cmd, "%s compute %s --increment %s --quantity sxx", g_exe, g_run,
+                 incs[k]);
+        assert_int_equal(run(cmd, out, sizeof out), 1);
+        assert_non_null(strstr(out, "physics.calculate_stress = on"));
+    }
     snprintf(cmd, sizeof cmd, "%s compute %s --quantity uplift", g_exe, g_run);
     assert_int_equal(run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "--increment"));
