@@ -116,10 +116,17 @@ static int cmd_info(const options *o) {
            (int)cdem_analysis_info(a, cdem_analysis_equil_index(a))->number);
     printf("%9s %12s %12s %-13s %14s %9s\n", "increment", "step", "time_s", "phase", "net_displ_m",
            "elements");
+    /* an imported cdem2D folder has no step, time or displacement: "-" rather than zeros */
+    const int imported = !strncmp(cdem_h5_reader_source(r), "cdem2d-import:", 14);
     for (size_t k = 0; k < cdem_analysis_count(a); k++) {
         const cdem_increment_info *in = cdem_analysis_info(a, k);
-        printf("%9d %12lld %12.3f %-13s %14.3f %9lld\n", (int)in->number, (long long)in->step,
-               in->time, phase_name(in->phase), in->net_displacement, (long long)in->n_elements);
+        if (imported)
+            printf("%9d %12s %12s %-13s %14s %9lld\n", (int)in->number, "-", "-",
+                   phase_name(in->phase), "-", (long long)in->n_elements);
+        else
+            printf("%9d %12lld %12.3f %-13s %14.3f %9lld\n", (int)in->number, (long long)in->step,
+                   in->time, phase_name(in->phase), in->net_displacement,
+                   (long long)in->n_elements);
     }
     cdem_analysis_close(a);
     return EXIT_OK;

@@ -246,7 +246,7 @@ static cdem_status read_series(const char *path, cdem_series_sample **smp, size_
 
 /* ---------------------------------------------------------------- plot-series */
 static const char series_synopsis[] =
-    "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT.png|.pdf|.svg "
+    "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x COLUMN] -o OUT.png|.pdf|.svg "
     "[--xrange MIN,MAX] [--yrange MIN,MAX] [--width N] [--height N]";
 static const char *const series_forms[] = {series_synopsis, NULL};
 /* the picture size options shared by the plots */
@@ -259,7 +259,9 @@ static const cdem_cli_option series_options[] = {
      "the /series column to plot: time, step, kinetic_energy, contacts, bonds, n_elements, "
      "net_displacement, boundary_force_x, boundary_force_y, base_force_x, base_force_y, "
      "axial_strain, differential_stress, sea_level"},
-    {"--x", "time|step|net_displacement", "the x axis (default time)"},
+    {"--x", "COLUMN",
+     "the x axis, any column as for --y (default time; e.g. net_displacement, or "
+     "axial_strain for a biaxial stress-strain curve)"},
     {"-o, --output", "OUT.png|.pdf|.svg", "the picture"},
     {"--xrange", "MIN,MAX", "fixed x range"},
     {"--yrange", "MIN,MAX", "fixed y range"},
@@ -286,14 +288,14 @@ int cdem_cmd_plot_series(int argc, char **argv) {
         return usage(a.cmd, "missing --y COLUMN", series_synopsis);
     if (!a.out)
         return usage(a.cmd, "missing -o OUT.png|.pdf|.svg", series_synopsis);
+    /* any column can be the x axis (axial_strain for a biaxial stress-strain curve) */
     const char *xname = a.x ? a.x : "time";
-    if (strcmp(xname, "time") && strcmp(xname, "step") && strcmp(xname, "net_displacement"))
-        return usage(a.cmd, "--x must be time, step or net_displacement", series_synopsis);
     cdem_error err;
     const char *ylabel = NULL, *xlabel = NULL;
+    if (cdem_cmd_plot_column(NULL, 0, xname, NULL, &xlabel, &err) != CDEM_OK)
+        return usage(a.cmd, err.msg, series_synopsis);
     if (cdem_cmd_plot_column(NULL, 0, a.y, NULL, &ylabel, &err) != CDEM_OK)
         return fail(a.cmd, &err);
-    cdem_cmd_plot_column(NULL, 0, xname, NULL, &xlabel, &err);
     cdem_plot_series ser[MAX_FILES];
     double *buf[MAX_FILES] = {0};
     memset(ser, 0, sizeof ser);

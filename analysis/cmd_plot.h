@@ -1,5 +1,5 @@
 /* cmd_plot: the calibration and evolution plot subcommands of cdem-strain:
- *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT
+ *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x COLUMN] -o OUT
  *   mohr RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT]   (Mohr-Coulomb fit, see mohr.h)
  *   repose RUN.h5 [--increment K] [-o OUT]             (angle of repose, see repose.h)
  * Each returns the process exit code (0 ok, 1 error, 2 usage) and prints its own messages

@@ -311,10 +311,15 @@ static void scene_free(scene_data *d) {
     memset(d, 0, sizeof *d);
 }
 
-static void make_label(const cdem_analysis *an, size_t index, char *buf, size_t n) {
+void cdem_render_increment_label(const cdem_analysis *an, size_t index, char *buf, size_t n) {
     const cdem_increment_info *info = cdem_analysis_info(an, index);
     const cdem_params *p = cdem_analysis_params(an);
-    if (p->mode == CDEM_MODE_BIAXIAL)
+    const cdem_h5_reader *r = cdem_analysis_reader(an);
+    if (r && !strncmp(cdem_h5_reader_source(r), "cdem2d-import:", 14))
+        /* a cdem2D folder gives positions per increment, no displacement or time: a label
+         * "Net displacement 0.0 m" on every increment would be false */
+        snprintf(buf, n, "Increment %d", (int)info->number);
+    else if (p->mode == CDEM_MODE_BIAXIAL)
         snprintf(buf, n, "Increment %d   Axial strain %.4f", (int)info->number, info->axial_strain);
     else if (p->mode == CDEM_MODE_REPOSE)
         snprintf(buf, n, "Increment %d   Time %.0f s", (int)info->number, info->time);
@@ -368,7 +373,7 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
         d->sc.n_axes = d->axes.n;
         d->sc.axis_perpendicular = 1;
     }
-    make_label(an, index, d->label, sizeof d->label);
+    cdem_render_increment_label(an, index, d->label, sizeof d->label);
     d->sc.label = d->label;
     return CDEM_OK;
 }

@@ -187,6 +187,17 @@ static void test_strain_cli_exports_and_import(void **state) {
     /* element 0 starts at (100, 100) and moves 5 + 0.02 y = 7 m per increment; the end of
      * equilibration is increment 1, so at increment 3 it sits at x = 121 with u = 14 m */
     assert_non_null(strstr(out, "\n0,121.000000,100.000000,14\n"));
+    /* info of an imported run: no step, time or displacement invented (issue 18) */
+    snprintf(cmd, sizeof cmd, "%s info %s/imp.h5", g_exe, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    int number, elements;
+    char step[16], time[16], phase[32], net[16];
+    const char *row = strstr(out, "\n        3 ");
+    assert_non_null(row);
+    assert_int_equal(
+        sscanf(row, "%d %15s %15s %31s %15s %d", &number, step, time, phase, net, &elements), 6);
+    assert_string_equal(net, "-");
+    assert_string_equal(step, "-");
 }
 
 static void test_strain_cli_export_biaxial(void **state) {
