@@ -11,8 +11,10 @@
 #include "qexport.h"
 #include "quantity.h"
 #include "sspx.h"
+#include "xdmf.h"
 
 #include <errno.h>
+#include <hdf5.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -36,6 +38,7 @@ typedef struct {
     const char *out;        /* -o OUT */
     const char *prefix;     /* --prefix P */
     const char *element;    /* --element ID */
+    int xdmf2;              /* --xdmf2 */
 } options;
 
 static void print_error(const cdem_error *err) {
@@ -200,7 +203,7 @@ static int cmd_compute(const options *o) {
             header_done = 1;
         }
         if (st == CDEM_OK)
-            st = h ? cdem_qexport_h5_write(h, in->number, s, v, &err)
+            st = h ? cdem_qexport_h5_write(h, in->number, in->time, s, v, &err)
                    : cdem_qexport_csv_rows(f, all, in->number, s, v, &err);
         free(v);
     }
@@ -216,6 +219,8 @@ static int cmd_compute(const options *o) {
         st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", of.tmp);
     if (of.active)
         st = cdem_outfile_end(&of, st, &err);
+    if (st == CDEM_OK && strcmp(format, "h5") == 0) /* its sidecar, once the file has its name */
+        st = cdem_qexport_write_xdmf(o->out, NULL, CDEM_XDMF3, NULL, &err);
     cdem_analysis_close(a);
     return st == CDEM_OK ? EXIT_OK : fail_with(&err);
 }
@@ -385,6 +390,46 @@ static int cmd_quantities(const options *o) {
     return EXIT_OK;
 }
 
+/* ---------------------------------------------------------------- xdmf */
+/* 1 when path is a compute --format h5 file (root attribute "quantity"), 0 otherwise. */
+static int is_quantity_file(const char *path) {
+    int yes = 0;
+    H5E_BEGIN_TRY {
+        hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+        if (f >= 0) {
+            yes = H5Aexists(f, "quantity") > 0;
+            H5Fclose(f);
+        }
+    }
+    H5E_END_TRY;
+    return yes;
+}
+
+static int cmd_xdmf(const options *o) {
+    if (!o->file)
+        return usage_error(o, "xdmf needs the HDF5 file (RUN.h5, or a compute --format h5 file)");
+    cdem_error err;
+    char *own = o->out ? NULL : cdem_xdmf_path_for(o->file);
+    const char *out = o->out ? o->out : own;
+    const int want = o->xdmf2 ? CDEM_XDMF2 : CDEM_XDMF3;
+    int written = 0;
+    cdem_status st = !out ? CDEM_FAIL(&err, CDEM_ERR_NOMEM, "out of memory")
+                     : is_quantity_file(o->file)
+                         ? cdem_qexport_write_xdmf(o->file, out, want, &written, &err)
+                         : cdem_h5_write_xdmf(o->file, out, want, &written, &err);
+    if (st == CDEM_OK) {
+        printf("%s\n", out);
+        if (written != want)
+            fprintf(stderr,
+                    "cdem-strain xdmf: note: %s has no xy view (written by an older version) "
+                    "or a name with ':' or '|': wrote an XDMF 2 sidecar; ParaView opens it with "
+                    "its legacy \"XDMF Reader\"\n",
+                    o->file);
+    }
+    free(own);
+    return st == CDEM_OK ? EXIT_OK : fail_with(&err);
+}
+
 /* ---------------------------------------------------------------- help tables */
 static const char *const info_forms[] = {"RUN.h5", NULL};
 static const cdem_cli_option info_options[] = {{NULL, NULL, NULL}};
@@ -483,6 +528,23 @@ const cdem_cli_help cdem_cmd_import_cdem2d_help = {
     .options = import_options,
 };
 
+static const char *const xdmf_forms[] = {"FILE.h5 [-o OUT.xmf] [--xdmf2]", NULL};
+static const cdem_cli_option xdmf_options[] = {
+    {"-o, --output", "OUT.xmf",
+     "the sidecar (default: next to FILE.h5, run.h5 -> run.xmf); it names FILE.h5 by its name "
+     "when both are in one folder, else by its absolute path"},
+    {"--xdmf2", NULL, "XDMF 2 instead of 3, for VisIt and ParaView's legacy \"XDMF Reader\""},
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_xdmf_help = {
+    .program = "cdem-strain xdmf",
+    .forms = xdmf_forms,
+    .about = "Writes the XDMF sidecar that lets ParaView (and VisIt, with --xdmf2) open a run "
+             "file or a compute --format h5 file: after renaming or moving the file, or for "
+             "the other flavour. cdem-run and compute write one themselves (docs/format.md, "
+             "\"XDMF sidecar\"). Prints the sidecar's name.",
+    .options = xdmf_options,
+};
+
 static const char *const quantities_forms[] = {"", NULL};
 static const cdem_cli_option quantities_options[] = {{NULL, NULL, NULL}};
 const cdem_cli_help cdem_cmd_quantities_help = {
@@ -504,6 +566,11 @@ static const struct {
     {"--output", offsetof(options, out)},          {"--prefix", offsetof(options, prefix)},
     {"--element", offsetof(options, element)}};
 
+static const struct {
+    const char *name;
+    size_t offset;
+} switch_fields[] = {{"--xdmf2", offsetof(options, xdmf2)}};
+
 /* Fills o from argv[first..]: only the options of h's table; positional arguments are the
  * file, then the directory. Returns EXIT_OK or EXIT_USAGE (message printed). */
 static int parse_options(int argc, char **argv, int first, const char *cmd, const cdem_cli_help *h,
@@ -514,6 +581,16 @@ static int parse_options(int argc, char **argv, int first, const char *cmd, cons
     for (int i = first; i < argc; i++) {
         const char *arg = argv[i], *val;
         const cdem_cli_option *opt = cdem_cli_find_option(h, arg, &val);
+        if (opt && !opt->arg) { /* a switch */
+            size_t f = 0;
+            while (f < sizeof switch_fields / sizeof switch_fields[0] &&
+                   !cdem_cli_option_is(opt, switch_fields[f].name))
+                f++;
+            if (f == sizeof switch_fields / sizeof switch_fields[0])
+                return usage_error(o, "internal: a switch of the help table has no field");
+            *(int *)((char *)o + switch_fields[f].offset) = 1;
+            continue;
+        }
         if (opt) {
             if (!val && i + 1 < argc)
                 val = argv[++i];
@@ -581,6 +658,9 @@ int cdem_cmd_export_biaxial(int argc, char **argv) {
 }
 int cdem_cmd_import_cdem2d(int argc, char **argv) {
     return run_command(argc, argv, &cdem_cmd_import_cdem2d_help, cmd_import_cdem2d);
+}
+int cdem_cmd_xdmf(int argc, char **argv) {
+    return run_command(argc, argv, &cdem_cmd_xdmf_help, cmd_xdmf);
 }
 int cdem_cmd_quantities(int argc, char **argv) {
     return run_command(argc, argv, &cdem_cmd_quantities_help, cmd_quantities);

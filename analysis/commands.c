@@ -46,6 +46,8 @@ static const cdem_command table[] = {
      "biaxial test series: time step, axial strain, differential stress"},
     {"import-cdem2d", cdem_cmd_import_cdem2d, &cdem_cmd_import_cdem2d_help,
      "convert a cdem2D simulation folder into a cdem file"},
+    {"xdmf", cdem_cmd_xdmf, &cdem_cmd_xdmf_help,
+     "(re)write the XDMF sidecar of a run or compute file for ParaView"},
     {"quantities", cdem_cmd_quantities, &cdem_cmd_quantities_help,
      "list every quantity name with unit and colour scale"},
     {"help", cmd_help, &help_help, "the general help, or the help of one command"},

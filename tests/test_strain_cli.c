@@ -131,7 +131,49 @@ static void test_strain_cli_compute_csv(void **state) {
     H5Gget_info(g, &gi);
     assert_int_equal(gi.nlinks, NINC);
     H5Gclose(g);
+    /* every group has the n x 2 view of x and y for the XDMF 3 sidecar */
+    hid_t xy = H5Dopen2(f, "increments/000006/xy", H5P_DEFAULT);
+    assert_true(xy >= 0);
+    H5Dclose(xy);
     H5Fclose(f);
+    /* ... and the file its own sidecar (issue 18), which names it and resolves */
+    char xmf[1300], text[65536];
+    snprintf(xmf, sizeof xmf, "%s/q.xmf", g_tmp);
+    snprintf(cmd, sizeof cmd, "xmllint --noout --xinclude %s && cat %s", xmf, xmf);
+    assert_int_equal(run(cmd, text, sizeof text), 0);
+    assert_non_null(strstr(text, ">q.h5:/increments/000006/xy|0 0:1 1:"));
+    assert_non_null(strstr(text, "<Attribute Name=\"cum-max-shear\""));
+    assert_non_null(strstr(text, "<Grid Name=\"increment_000006\""));
+}
+
+/* cdem-strain xdmf: a renamed run file gets a sidecar naming it (issue 18: renaming the pair
+ * broke the old one); --xdmf2 writes the legacy flavour; files that are neither a run nor a
+ * compute file are refused. ParaView itself reads these in make validate. */
+static void test_strain_cli_xdmf(void **state) {
+    (void)state;
+    char cmd[8192], out[65536];
+    snprintf(cmd, sizeof cmd, "cp %s %s/renamed.h5 && %s xdmf %s/renamed.h5", g_run, g_tmp, g_exe,
+             g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    char want[1300];
+    snprintf(want, sizeof want, "%s/renamed.xmf\n", g_tmp);
+    assert_string_equal(out, want);
+    snprintf(cmd, sizeof cmd,
+             "xmllint --noout --xinclude %s/renamed.xmf && grep -c "
+             "'>renamed.h5:/increments/xy|' %s/renamed.xmf",
+             g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(atoi(out), NINC);
+    snprintf(cmd, sizeof cmd,
+             "%s xdmf %s/renamed.h5 --xdmf2 -o %s/legacy.xdmf2 && grep -c "
+             "'GeometryType=\"X_Y\"' %s/legacy.xdmf2",
+             g_exe, g_tmp, g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_non_null(strstr(out, "legacy.xdmf2\n"));
+    assert_int_equal(atoi(strchr(out, '\n') + 1), NINC);
+    snprintf(cmd, sizeof cmd, "echo text > %s/not.h5 && %s xdmf %s/not.h5", g_tmp, g_exe, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "not.h5"));
 }
 
 static void test_strain_cli_element_limits_info(void **state) {
@@ -306,6 +348,7 @@ int main(void) {
         cmocka_unit_test(test_strain_cli_exports_and_import),
         cmocka_unit_test(test_strain_cli_export_biaxial),
         cmocka_unit_test(test_strain_cli_errors),
+        cmocka_unit_test(test_strain_cli_xdmf),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
