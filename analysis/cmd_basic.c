@@ -115,7 +115,10 @@ static int cmd_info(const options *o) {
     const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
     printf("\nstop reason: %s%s%s\n", reason[0] ? reason : "(none recorded)", detail[0] ? ": " : "",
            detail);
-    printf("increments: %zu (end of equilibration: increment %d)\n", cdem_analysis_count(a),
+    /* the counts of the summary and the progress line (docs/format.md, "Counting") */
+    const size_t n_inc = cdem_analysis_count(a);
+    printf("increments: %zu, numbered %d..%d (end of equilibration: increment %d)\n", n_inc,
+           (int)cdem_analysis_info(a, 0)->number, (int)cdem_analysis_info(a, n_inc - 1)->number,
            (int)cdem_analysis_info(a, cdem_analysis_equil_index(a))->number);
     printf("%9s %12s %12s %-13s %14s %9s\n", "increment", "step", "time_s", "phase", "net_displ_m",
            "elements");

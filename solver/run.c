@@ -271,9 +271,19 @@ static cdem_status write_sample(run_ctx *r, cdem_error *err) {
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;
 }
 
+/* The element count of increment 0 (docs/format.md, "Counting"): free elements and the
+ * rest (walls, fault ramps, mylar, footwall display), after the mode has added its own. */
+static void count_kinds(const cdem_state *s, long *n_free, long *n_boundary) {
+    *n_free = *n_boundary = 0;
+    for (size_t i = 0; i < s->n; i++)
+        ++*((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? n_boundary : n_free);
+}
+
 static cdem_status make_summary(run_ctx *r, cdem_error *err) {
     char *text = NULL;
-    CDEM_TRY(cdem_summary_text(r->p, &r->m, r->info.n_internal, r->info.n_wall, 0, &text, err));
+    long n_free, n_boundary;
+    count_kinds(&r->s, &n_free, &n_boundary);
+    CDEM_TRY(cdem_summary_text(r->p, &r->m, n_free, n_boundary, 0, &text, err));
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
@@ -873,5 +883,29 @@ cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_count_elements: NULL parameters");
     cdem_model m;
     CDEM_TRY(cdem_model_derive(p, &m, err));
-    return cdem_assembly_count(p, &m, n_internal, n_wall, err);
+    /* the assembly as the run builds it, with the mode's elements (fault ramps, ...) */
+    cdem_state st = {0};
+    cdem_assembly_info info;
+    cdem_bc bc;
+    memset(&bc, 0, sizeof bc);
+    cdem_status s = cdem_state_init(&st, 1024, 0, err);
+    if (s == CDEM_OK)
+        s = cdem_assembly_build(p, &m, &st, &info, err);
+    int bc_made = 0;
+    if (s == CDEM_OK) {
+        s = cdem_bc_init(&bc, p, &m, &st, err);
+        bc_made = s == CDEM_OK;
+    }
+    long n_free = 0, n_boundary = 0;
+    if (s == CDEM_OK)
+        count_kinds(&st, &n_free, &n_boundary);
+    if (bc_made)
+        cdem_bc_free(&bc);
+    cdem_state_free(&st);
+    CDEM_TRY(s);
+    if (n_internal)
+        *n_internal = n_free;
+    if (n_wall)
+        *n_wall = n_boundary;
+    return CDEM_OK;
 }
