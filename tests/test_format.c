@@ -1115,6 +1115,11 @@ static void test_format_size_of_default_run(void **state) {
     assert_int_equal(s.n, 2271);
     assert_true(s.x[2000] != (double)(float)s.x[2000]);
     cdem_state_free(&s);
+    cdem_series_sample *smp = NULL; /* docs/format.md quotes these counts */
+    size_t ns = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);
+    assert_int_equal(ns, 1132);
+    free(smp);
     cdem_h5_reader_close(r);
     remove_pair(path);
     long stressed = write_synthetic_run(path, 1);

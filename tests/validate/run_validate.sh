@@ -21,6 +21,9 @@
 #     (tests/validate/check_paraview.py); skipped, saying so, when ParaView is not installed.
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
 #     analyses and pictures; a few minutes on 2 cores).
+# 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
+#     (tests/docs/run_doc_blocks.py --all; make test runs the quick ones);
+# 11. docs/measured.md equals a fresh measurement of the default model (make measured).
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -124,6 +127,10 @@ fi
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
 check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
+
+check doc-blocks /usr/bin/python3 tests/docs/run_doc_blocks.py --all "$BUILD"
+check docs-measured sh -c "/usr/bin/python3 scripts/measure_docs.py '$BUILD' > '$TMP/measured.md' &&
+    diff -u docs/measured.md '$TMP/measured.md'"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
