@@ -6,6 +6,7 @@
 
 #include "analysis.h"
 #include "biaxial.h"
+#include "cmd_plot.h"
 #include "cdem2d.h"
 #include "outfile.h"
 #include "qexport.h"
@@ -39,6 +40,7 @@ typedef struct {
     const char *prefix;     /* --prefix P */
     const char *element;    /* --element ID */
     int xdmf2;              /* --xdmf2 */
+    int json;               /* --json */
 } options;
 
 static void print_error(const cdem_error *err) {
@@ -99,7 +101,103 @@ static int info_without_increments(const char *path) {
     return EXIT_OK;
 }
 
+/* s as a JSON string (quotes, escapes; control characters as \u00XX). */
+static void json_string(FILE *f, const char *s) {
+    fputc('"', f);
+    for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            fprintf(f, "\\%c", *c);
+        else if (*c == '\n')
+            fputs("\\n", f);
+        else if (*c == '\t')
+            fputs("\\t", f);
+        else if (*c < 0x20)
+            fprintf(f, "\\u%04x", *c);
+        else
+            fputc(*c, f);
+    }
+    fputc('"', f);
+}
+
+/* A number, or null for NaN and infinities (JSON has neither). */
+static void json_number(FILE *f, double v) {
+    if (isfinite(v))
+        fprintf(f, "%.17g", v);
+    else
+        fputs("null", f);
+}
+
+/* info --json: the same facts as the text, for scripts (docs/analysis.md). */
+static int info_json(const options *o) {
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (!o->file)
+        return usage_error(o, "missing the run file (RUN.h5)");
+    if (cdem_h5_reader_open(o->file, &r, &err) != CDEM_OK)
+        return fail_with(&err);
+    const size_t n = cdem_h5_reader_increment_count(r);
+    size_t equil = 0;
+    const int has_equil = n > 0 && cdem_h5_reader_find_increment(r, "equil", &equil, &err) == CDEM_OK;
+    FILE *f = stdout;
+    fputs("{\n  \"file\": ", f);
+    json_string(f, o->file);
+    fprintf(f, ",\n  \"format_version\": %d,\n  \"program_version\": ",
+            cdem_h5_reader_format_version(r));
+    json_string(f, cdem_h5_reader_program_version(r));
+    fputs(",\n  \"source\": ", f);
+    json_string(f, cdem_h5_reader_source(r));
+    fputs(",\n  \"created\": ", f);
+    json_string(f, cdem_h5_reader_created(r));
+    fprintf(f, ",\n  \"seed\": %ld,\n  \"unclosed\": %s,\n  \"stop_reason\": ",
+            cdem_h5_reader_seed(r), cdem_h5_reader_unclosed(r) ? "true" : "false");
+    json_string(f, cdem_h5_reader_stop_reason(r));
+    fputs(",\n  \"stop_detail\": ", f);
+    json_string(f, cdem_h5_reader_stop_detail(r));
+    fputs(",\n  \"summary\": ", f);
+    json_string(f, cdem_h5_reader_summary(r));
+    fprintf(f, ",\n  \"increment_count\": %zu", n);
+    cdem_status st = CDEM_OK;
+    cdem_increment_info first = {0}, last = {0}, eq = {0};
+    if (n > 0) {
+        st = cdem_h5_reader_increment_info(r, 0, &first, &err);
+        if (st == CDEM_OK)
+            st = cdem_h5_reader_increment_info(r, n - 1, &last, &err);
+        if (st == CDEM_OK && has_equil)
+            st = cdem_h5_reader_increment_info(r, equil, &eq, &err);
+    }
+    if (n > 0)
+        fprintf(f, ",\n  \"first_increment\": %d,\n  \"last_increment\": %d", (int)first.number,
+                (int)last.number);
+    if (has_equil)
+        fprintf(f, ",\n  \"end_of_equilibration\": %d", (int)eq.number);
+    fputs(",\n  \"increments\": [", f);
+    for (size_t k = 0; k < n && st == CDEM_OK; k++) {
+        cdem_increment_info in;
+        st = cdem_h5_reader_increment_info(r, k, &in, &err);
+        if (st != CDEM_OK)
+            break;
+        fprintf(f, "%s\n    {\"number\": %d, \"step\": %lld, \"time\": ", k ? "," : "",
+                (int)in.number, (long long)in.step);
+        json_number(f, in.time);
+        fprintf(f, ", \"phase\": \"%s\", \"net_displacement\": ", phase_name(in.phase));
+        json_number(f, in.net_displacement);
+        fputs(", \"axial_strain\": ", f);
+        json_number(f, in.axial_strain);
+        fputs(", \"differential_stress\": ", f);
+        json_number(f, in.differential_stress);
+        fputs(", \"sea_level\": ", f);
+        json_number(f, in.sea_level);
+        fprintf(f, ", \"elements\": %lld, \"has_stress\": %s}", (long long)in.n_elements,
+                in.has_stress ? "true" : "false");
+    }
+    fputs(n ? "\n  ]\n}\n" : "]\n}\n", f);
+    cdem_h5_reader_close(r);
+    return st == CDEM_OK ? EXIT_OK : fail_with(&err);
+}
+
 static int cmd_info(const options *o) {
+    if (o->json)
+        return info_json(o);
     int none = o->file ? info_without_increments(o->file) : -1;
     if (none >= 0)
         return none;
@@ -393,6 +491,63 @@ static int cmd_quantities(const options *o) {
     return EXIT_OK;
 }
 
+/* ---------------------------------------------------------------- series */
+/* The /series columns in file order (docs/format.md). */
+static const char *const series_names[] = {
+    "step",         "time",           "kinetic_energy",   "contacts",         "bonds",
+    "n_elements",   "net_displacement", "boundary_force_x", "boundary_force_y", "base_force_x",
+    "base_force_y", "axial_strain",   "differential_stress", "sea_level"};
+#define N_SERIES_NAMES (sizeof series_names / sizeof series_names[0])
+
+static int cmd_series(const options *o) {
+    if (!o->file)
+        return usage_error(o, "missing the run file (RUN.h5)");
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(o->file, &r, &err) != CDEM_OK)
+        return fail_with(&err);
+    cdem_series_sample *smp = NULL;
+    size_t n = 0;
+    double *cols = NULL;
+    cdem_status st = cdem_h5_reader_read_series(r, &smp, &n, &err);
+    cdem_h5_reader_close(r);
+    if (st == CDEM_OK && !(cols = malloc((n ? n : 1) * N_SERIES_NAMES * sizeof *cols)))
+        st = CDEM_FAIL(&err, CDEM_ERR_NOMEM, "out of memory for %zu samples", n);
+    for (size_t c = 0; c < N_SERIES_NAMES && st == CDEM_OK; c++)
+        st = cdem_cmd_plot_column(smp, n, series_names[c], cols + c * n, NULL, &err);
+    FILE *f = stdout;
+    cdem_outfile of = {.active = 0}; /* -o OUT: written to OUT.tmp, renamed on success */
+    if (st == CDEM_OK && o->out) {
+        st = cdem_outfile_begin(&of, o->out, &err);
+        if (st == CDEM_OK && !(f = fopen(of.tmp, "w")))
+            st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", of.tmp, strerror(errno));
+    }
+    if (st == CDEM_OK) {
+        for (size_t c = 0; c < N_SERIES_NAMES; c++)
+            fprintf(f, "%s%s", c ? "," : "", series_names[c]);
+        fputc('\n', f);
+        for (size_t k = 0; k < n; k++)
+            for (size_t c = 0; c < N_SERIES_NAMES; c++) {
+                const double v = cols[c * n + k];
+                if (isfinite(v))
+                    fprintf(f, "%s%.17g", c ? "," : "", v);
+                else
+                    fprintf(f, "%snan", c ? "," : "");
+                if (c + 1 == N_SERIES_NAMES)
+                    fputc('\n', f);
+            }
+        if (ferror(f))
+            st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", o->out ? of.tmp : "stdout");
+    }
+    if (f && f != stdout && fclose(f) != 0 && st == CDEM_OK)
+        st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", of.tmp);
+    if (of.active)
+        st = cdem_outfile_end(&of, st, &err);
+    free(cols);
+    free(smp);
+    return st == CDEM_OK ? EXIT_OK : fail_with(&err);
+}
+
 /* ---------------------------------------------------------------- xdmf */
 /* 1 when path is a compute --format h5 file (root attribute "quantity"), 0 otherwise. */
 static int is_quantity_file(const char *path) {
@@ -434,8 +589,12 @@ static int cmd_xdmf(const options *o) {
 }
 
 /* ---------------------------------------------------------------- help tables */
-static const char *const info_forms[] = {"RUN.h5", NULL};
-static const cdem_cli_option info_options[] = {{NULL, NULL, NULL}};
+static const char *const info_forms[] = {"RUN.h5 [--json]", NULL};
+static const cdem_cli_option info_options[] = {
+    {"--json", NULL,
+     "the same as one JSON object: file facts, stop reason, summary, counts and one "
+     "object per increment (NaN as null)"},
+    {NULL, NULL, NULL}};
 const cdem_cli_help cdem_cmd_info_help = {
     .program = "cdem-strain info",
     .forms = info_forms,
@@ -531,6 +690,20 @@ const cdem_cli_help cdem_cmd_import_cdem2d_help = {
     .options = import_options,
 };
 
+static const char *const series_forms[] = {"RUN.h5 [-o OUT.csv]", NULL};
+static const cdem_cli_option series_options[] = {
+    {"-o, --output", "OUT.csv", "output file (default: standard output)"}, {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_series_help = {
+    .program = "cdem-strain series",
+    .forms = series_forms,
+    .about = "The run's whole time series (/series) as CSV: a header of the column names (step, "
+             "time, kinetic_energy, contacts, bonds, n_elements, net_displacement, "
+             "boundary_force_x, boundary_force_y, base_force_x, base_force_y, axial_strain, "
+             "differential_stress, sea_level; units in docs/format.md), then one line per "
+             "sample, full precision, nan for sea_level without sedimentation.",
+    .options = series_options,
+};
+
 static const char *const xdmf_forms[] = {"FILE.h5 [-o OUT.xmf] [--xdmf2]", NULL};
 static const cdem_cli_option xdmf_options[] = {
     {"-o, --output", "OUT.xmf",
@@ -572,7 +745,7 @@ static const struct {
 static const struct {
     const char *name;
     size_t offset;
-} switch_fields[] = {{"--xdmf2", offsetof(options, xdmf2)}};
+} switch_fields[] = {{"--xdmf2", offsetof(options, xdmf2)}, {"--json", offsetof(options, json)}};
 
 /* Fills o from argv[first..]: only the options of h's table; positional arguments are the
  * file, then the directory. Returns EXIT_OK or EXIT_USAGE (message printed). */
@@ -661,6 +834,9 @@ int cdem_cmd_export_biaxial(int argc, char **argv) {
 }
 int cdem_cmd_import_cdem2d(int argc, char **argv) {
     return run_command(argc, argv, &cdem_cmd_import_cdem2d_help, cmd_import_cdem2d);
+}
+int cdem_cmd_series(int argc, char **argv) {
+    return run_command(argc, argv, &cdem_cmd_series_help, cmd_series);
 }
 int cdem_cmd_xdmf(int argc, char **argv) {
     return run_command(argc, argv, &cdem_cmd_xdmf_help, cmd_xdmf);

@@ -8,6 +8,7 @@
  *   import-cdem2d DIR -o OUT.h5  a cdem2D folder into a cdem file
  *   quantities                   the quantity names
  *   xdmf FILE.h5                 (re)writes the XDMF sidecar of a run or compute file
+ *   series RUN.h5                the time series as CSV
  * Each has a help description (cli_help.h), which is also the table its parser accepts.
  * Ownership: nothing outlives a call. Thread safety: one call at a time per process. */
 #ifndef CDEM_CMD_BASIC_H
@@ -24,6 +25,7 @@ int cdem_cmd_export_biaxial(int argc, char **argv);
 int cdem_cmd_import_cdem2d(int argc, char **argv);
 int cdem_cmd_quantities(int argc, char **argv);
 int cdem_cmd_xdmf(int argc, char **argv);
+int cdem_cmd_series(int argc, char **argv);
 
 /* "cdem-strain RUN.h5 --increment K --quantity NAME": compute with argv[0] the run file. */
 int cdem_cmd_compute_file_first(int argc, char **argv);
@@ -37,5 +39,6 @@ extern const cdem_cli_help cdem_cmd_export_biaxial_help;
 extern const cdem_cli_help cdem_cmd_import_cdem2d_help;
 extern const cdem_cli_help cdem_cmd_quantities_help;
 extern const cdem_cli_help cdem_cmd_xdmf_help;
+extern const cdem_cli_help cdem_cmd_series_help;
 
 #endif

@@ -32,6 +32,7 @@ static const cdem_command table[] = {
      "colour-bar limits of a quantity at an increment"},
     {"render", cdem_cmd_render, &cdem_cmd_render_help,
      "pictures of increments (PNG, PDF, SVG), albums and animated GIFs"},
+    {"series", cdem_cmd_series, &cdem_cmd_series_help, "the time series as CSV"},
     {"plot-series", cdem_cmd_plot_series, &cdem_cmd_plot_series_help,
      "line plot of time-series columns"},
     {"mohr", cdem_cmd_plot_mohr, &cdem_cmd_mohr_help, "Mohr-Coulomb fit of biaxial tests"},

@@ -39,7 +39,7 @@ static void on_signal(int sig) {
  * man page and the bash completion are generated from it, and tests/test_help.c checks that
  * every option in it appears in the synopsis and is accepted by parse_args. */
 static const char *const run_forms[] = {
-    "[MODEL.ini] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
+    "[MODEL.ini|-] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
     "[--print-defaults] [--params-markdown] [--max-steps N] [--par-min N] "
     "[--ignore-free-space]",
     "--resume RUN.h5 [-q] [--max-steps N] [--par-min N]", "-V|--version | -h|--help", NULL};
@@ -75,7 +75,8 @@ static const cdem_cli_help run_help = {
     .forms = run_forms,
     .about = "Simulates a 2-D discrete element model and writes every display increment to an "
              "HDF5 file. Without MODEL.ini the built-in default model is used (the paper's "
-             "Figure 7A: 10 x 5 km, planar normal fault dipping 30 degrees).",
+             "Figure 7A: 10 x 5 km, planar normal fault dipping 30 degrees); '-' reads the "
+             "parameter file from standard input (default output stdin.h5).",
     .options = run_options,
     .notes = "Ctrl-C (SIGINT) or SIGTERM stops the run cleanly after the current step; the "
              "file stays valid and 'cdem-run --resume RUN.h5' continues it. Parameters, "
@@ -181,10 +182,13 @@ static int parse_args(int argc, char **argv, cli_args *a) {
     return EXIT_OK;
 }
 
-/* "dir/fault.ini" -> "fault.h5" (in the current directory). */
+/* "dir/fault.ini" -> "fault.h5" (in the current directory); "-" (standard input) ->
+ * "stdin.h5". */
 static char *default_output(const char *model_path) {
     if (!model_path)
         return strdup("cdem-default.h5");
+    if (!strcmp(model_path, "-"))
+        return strdup("stdin.h5");
     const char *base = strrchr(model_path, '/');
     base = base ? base + 1 : model_path;
     const char *dot = strrchr(base, '.');
@@ -216,6 +220,38 @@ static char *stored_params_text(const cdem_params *p, const cli_args *a, char *f
     cdem_params_write(p, f);
     fclose(f);
     return buf;
+}
+
+/* The whole of standard input (a parameter file), malloc'd into *text. */
+static cdem_status read_stdin(char **text, cdem_error *err) {
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        size_t got = fread(buf + len, 1, cap - 1 - len, stdin);
+        len += got;
+        if (got == 0)
+            break;
+        if (len + 1 == cap) {
+            char *nb = cap < ((size_t)64 << 20) ? realloc(buf, cap * 2) : NULL;
+            if (!nb) {
+                free(buf);
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "standard input: more than 64 MiB or out of memory; not a "
+                                 "parameter file");
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    if (!buf)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading standard input");
+    if (ferror(stdin)) {
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "error reading the parameters from standard input");
+    }
+    buf[len] = '\0';
+    *text = buf;
+    return CDEM_OK;
 }
 
 static void install_handlers(void) {
@@ -304,8 +340,14 @@ int main(int argc, char **argv) {
     char *summary = NULL;
     rc = EXIT_ERROR;
 
-    if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK)
+    if (a.model_path && !strcmp(a.model_path, "-")) {
+        /* "-": the parameter file on standard input (generated or piped parameters) */
+        if (read_stdin(&file_text, &err) != CDEM_OK ||
+            cdem_params_parse_text(&p, file_text, "standard input", &err) != CDEM_OK)
+            goto fail;
+    } else if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK) {
         goto fail;
+    }
     for (int i = 0; i < a.n_overrides; i++)
         if (cdem_params_override(&p, a.overrides[i], &err) != CDEM_OK)
             goto fail;
@@ -316,7 +358,8 @@ int main(int argc, char **argv) {
     }
     if (cdem_params_validate(&p, &err) != CDEM_OK) {
         fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
-                a.model_path ? a.model_path : "", a.model_path ? ": " : "");
+                !a.model_path ? "" : strcmp(a.model_path, "-") ? a.model_path : "standard input",
+                a.model_path ? ": " : "");
         goto fail;
     }
     cdem_model m;

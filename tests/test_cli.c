@@ -192,7 +192,7 @@ static void test_cli_usage_errors_and_info(void **state) {
     assert_int_equal(run(c, "-o"), 2);
     assert_int_equal(run(c, "--help"), 0);
     char *out = slurp(c, "out.txt");
-    assert_has(out, "usage: cdem-run [MODEL.ini]");
+    assert_has(out, "usage: cdem-run [MODEL.ini|-]");
     free(out);
     assert_int_equal(run(c, "--version"), 0);
     out = slurp(c, "out.txt");
@@ -201,6 +201,24 @@ static void test_cli_usage_errors_and_info(void **state) {
     assert_int_equal(run(c, "/nonexistent/x.ini"), 1);
     err = slurp(c, "err.txt");
     assert_has(err, "cdem-run: /nonexistent/x.ini: cannot open parameter file");
+    free(err);
+}
+
+/* "cdem-run -": the parameter file on standard input (issue 18 item 8); errors name it. */
+static void test_cli_parameters_from_stdin(void **state) {
+    cli_ctx *c = *state;
+    write_file(c, "piped.ini", "[boundary]\nfault_dip = 45\n");
+    char args[2400];
+    snprintf(args, sizeof args, "- --print-defaults < '%s/piped.ini'", c->tmp);
+    assert_int_equal(run(c, args), 0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "fault_dip = 45");
+    free(out);
+    write_file(c, "bad.ini", "[physics]\ngravity = 40\n");
+    snprintf(args, sizeof args, "- --summary < '%s/bad.ini'", c->tmp);
+    assert_int_equal(run(c, args), 1);
+    char *err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: standard input:2: gravity = 40");
     free(err);
 }
 
@@ -284,6 +302,7 @@ int main(void) {
         cmocka_unit_test_setup_teardown(test_cli_summary_and_dry_run, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_usage_errors_and_info, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_params_markdown, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_parameters_from_stdin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -294,6 +294,46 @@ static void test_strain_cli_export_biaxial(void **state) {
     assert_int_equal(rows, 12);
 }
 
+/* series (CSV of /series) and info --json (issue 18 item 8): checked against the file by
+ * Debian's python (h5py, json). */
+static void test_strain_cli_series_and_json(void **state) {
+    (void)state;
+    char cmd[8192], out[65536];
+    snprintf(cmd, sizeof cmd, "%s/biax.h5", g_tmp); /* written by the export-biaxial test */
+    if (access(cmd, R_OK) != 0)
+        skip();
+    snprintf(cmd, sizeof cmd,
+             "%s series %s/biax.h5 -o %s/series.csv && /usr/bin/python3 -c '"
+             "import csv, h5py, math, sys\n"
+             "rows = list(csv.DictReader(open(sys.argv[1])))\n"
+             "f = h5py.File(sys.argv[2], \"r\")\n"
+             "cols = list(f[\"series\"])\n"
+             "assert sorted(rows[0]) == sorted(cols), (sorted(rows[0]), cols)\n"
+             "assert len(rows) == len(f[\"series/step\"])\n"
+             "for c in cols:\n"
+             "    for r, v in zip(rows, f[\"series/\" + c][:]):\n"
+             "        assert (math.isnan(v) and r[c] == \"nan\") or float(r[c]) == v, (c, r[c], v)\n"
+             "print(len(rows))' %s/series.csv %s/biax.h5",
+             g_exe, g_tmp, g_tmp, g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(atoi(out), 12);
+    snprintf(cmd, sizeof cmd,
+             "%s info %s --json | /usr/bin/python3 -c '"
+             "import json, sys\n"
+             "d = json.load(sys.stdin)\n"
+             "assert d[\"increment_count\"] == len(d[\"increments\"]) == %d\n"
+             "assert d[\"first_increment\"] == 0 and d[\"last_increment\"] == %d\n"
+             "assert d[\"end_of_equilibration\"] == 2 and d[\"stop_reason\"] == \"completed\"\n"
+             "assert d[\"summary\"] == \"CLI test summary\"\n"
+             "i = d[\"increments\"][4]\n"
+             "assert i[\"phase\"] == \"deformation\" and i[\"net_displacement\"] == 10.0\n"
+             "assert i[\"sea_level\"] is None and i[\"has_stress\"] is False\n"
+             "print(\"ok\")'",
+             g_exe, g_run, NINC, NINC - 1);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_string_equal(out, "ok\n");
+}
+
 static void test_strain_cli_errors(void **state) {
     (void)state;
     char cmd[8192], out[8192];
@@ -347,6 +387,7 @@ int main(void) {
         cmocka_unit_test(test_strain_cli_element_limits_info),
         cmocka_unit_test(test_strain_cli_exports_and_import),
         cmocka_unit_test(test_strain_cli_export_biaxial),
+        cmocka_unit_test(test_strain_cli_series_and_json),
         cmocka_unit_test(test_strain_cli_errors),
         cmocka_unit_test(test_strain_cli_xdmf),
     };
