@@ -137,7 +137,8 @@ static int info_json(const options *o) {
         return fail_with(&err);
     const size_t n = cdem_h5_reader_increment_count(r);
     size_t equil = 0;
-    const int has_equil = n > 0 && cdem_h5_reader_find_increment(r, "equil", &equil, &err) == CDEM_OK;
+    const int has_equil =
+        n > 0 && cdem_h5_reader_find_increment(r, "equil", &equil, &err) == CDEM_OK;
     FILE *f = stdout;
     fputs("{\n  \"file\": ", f);
     json_string(f, o->file);
@@ -148,8 +149,9 @@ static int info_json(const options *o) {
     json_string(f, cdem_h5_reader_source(r));
     fputs(",\n  \"created\": ", f);
     json_string(f, cdem_h5_reader_created(r));
-    fprintf(f, ",\n  \"seed\": %ld,\n  \"unclosed\": %s,\n  \"stop_reason\": ",
-            cdem_h5_reader_seed(r), cdem_h5_reader_unclosed(r) ? "true" : "false");
+    fprintf(f,
+            ",\n  \"seed\": %ld,\n  \"unclosed\": %s,\n  \"stop_reason\": ", cdem_h5_reader_seed(r),
+            cdem_h5_reader_unclosed(r) ? "true" : "false");
     json_string(f, cdem_h5_reader_stop_reason(r));
     fputs(",\n  \"stop_detail\": ", f);
     json_string(f, cdem_h5_reader_stop_detail(r));
@@ -493,10 +495,12 @@ static int cmd_quantities(const options *o) {
 
 /* ---------------------------------------------------------------- series */
 /* The /series columns in file order (docs/format.md). */
+/* clang-format off */
 static const char *const series_names[] = {
-    "step",         "time",           "kinetic_energy",   "contacts",         "bonds",
-    "n_elements",   "net_displacement", "boundary_force_x", "boundary_force_y", "base_force_x",
-    "base_force_y", "axial_strain",   "differential_stress", "sea_level"};
+    "step", "time", "kinetic_energy", "contacts", "bonds", "n_elements", "net_displacement",
+    "boundary_force_x", "boundary_force_y", "base_force_x", "base_force_y", "axial_strain",
+    "differential_stress", "sea_level"};
+/* clang-format on */
 #define N_SERIES_NAMES (sizeof series_names / sizeof series_names[0])
 
 static int cmd_series(const options *o) {

@@ -358,7 +358,9 @@ int main(int argc, char **argv) {
     }
     if (cdem_params_validate(&p, &err) != CDEM_OK) {
         fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
-                !a.model_path ? "" : strcmp(a.model_path, "-") ? a.model_path : "standard input",
+                !a.model_path               ? ""
+                : strcmp(a.model_path, "-") ? a.model_path
+                                            : "standard input",
                 a.model_path ? ": " : "");
         goto fail;
     }

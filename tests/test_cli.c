@@ -256,9 +256,8 @@ static void test_cli_counts_agree(void **state) {
                             "  wall and fault elements: %ld", &boundary),
                      1);
     assert_int_equal(elements, free_el + boundary);
-    assert_int_equal(sscanf(strstr(out, "  increments:"), "  increments: %d, numbered 0..%d", &k,
-                            &last),
-                     2);
+    assert_int_equal(
+        sscanf(strstr(out, "  increments:"), "  increments: %d, numbered 0..%d", &k, &last), 2);
     assert_int_equal(k, last + 1);
     assert_int_equal(sscanf(strstr(out, "  end of equilibration:"),
                             "  end of equilibration: increment %d", &equil),
@@ -277,8 +276,8 @@ static void test_cli_counts_agree(void **state) {
              (int)(strrchr(c->bin, '/') - c->bin + 1), c->bin, c->tmp, c->tmp);
     assert_int_equal(system(cmd), 0);
     char *info = slurp(c, "info.txt");
-    snprintf(want, sizeof want, "increments: %d, numbered 0..%d (end of equilibration: increment %d)",
-             k, last, equil);
+    snprintf(want, sizeof want,
+             "increments: %d, numbered 0..%d (end of equilibration: increment %d)", k, last, equil);
     assert_has(info, want);
     long n0 = -1;
     const char *row = strstr(info, "\n        0 ");

@@ -46,8 +46,10 @@ static void test_install_and_uninstall(void **state) {
         assert_int_equal(sb.st_mode & 0777, i < 2 ? 0755 : 0644);
     }
     /* the installed programs run, and the man page is the committed one */
-    snprintf(cmd, sizeof cmd, "'%s/opt/cdem/bin/cdem-strain' -V >/dev/null && "
-             "cmp -s man/cdem-strain.1 '%s/opt/cdem/share/man/man1/cdem-strain.1'", dest, dest);
+    snprintf(cmd, sizeof cmd,
+             "'%s/opt/cdem/bin/cdem-strain' -V >/dev/null && "
+             "cmp -s man/cdem-strain.1 '%s/opt/cdem/share/man/man1/cdem-strain.1'",
+             dest, dest);
     assert_int_equal(sh(cmd), 0);
     snprintf(cmd, sizeof cmd,
              "env -u MAKEFLAGS -u MAKELEVEL make -s uninstall BUILD='%s' DESTDIR='%s' "

@@ -204,7 +204,7 @@ static void test_man_completion_fresh_and_working(void **state) {
     } cases[] = {
         {"cdem-strain ren", "render"},
         {"cdem-strain render run.h5 --col", "--color --colour --color-walls --colour-walls "
-                                             "--color-layers --colour-layers"},
+                                            "--color-layers --colour-layers"},
         {"cdem-strain render run.h5 --color total-max-s", "total-max-shear"},
         {"cdem-strain render run.h5 --vectors ''", "incr total"},
         {"cdem-strain compute run.h5 --format ''", "csv h5"},

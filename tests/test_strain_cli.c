@@ -302,19 +302,20 @@ static void test_strain_cli_series_and_json(void **state) {
     snprintf(cmd, sizeof cmd, "%s/biax.h5", g_tmp); /* written by the export-biaxial test */
     if (access(cmd, R_OK) != 0)
         skip();
-    snprintf(cmd, sizeof cmd,
-             "%s series %s/biax.h5 -o %s/series.csv && /usr/bin/python3 -c '"
-             "import csv, h5py, math, sys\n"
-             "rows = list(csv.DictReader(open(sys.argv[1])))\n"
-             "f = h5py.File(sys.argv[2], \"r\")\n"
-             "cols = list(f[\"series\"])\n"
-             "assert sorted(rows[0]) == sorted(cols), (sorted(rows[0]), cols)\n"
-             "assert len(rows) == len(f[\"series/step\"])\n"
-             "for c in cols:\n"
-             "    for r, v in zip(rows, f[\"series/\" + c][:]):\n"
-             "        assert (math.isnan(v) and r[c] == \"nan\") or float(r[c]) == v, (c, r[c], v)\n"
-             "print(len(rows))' %s/series.csv %s/biax.h5",
-             g_exe, g_tmp, g_tmp, g_tmp, g_tmp);
+    snprintf(
+        cmd, sizeof cmd,
+        "%s series %s/biax.h5 -o %s/series.csv && /usr/bin/python3 -c '"
+        "import csv, h5py, math, sys\n"
+        "rows = list(csv.DictReader(open(sys.argv[1])))\n"
+        "f = h5py.File(sys.argv[2], \"r\")\n"
+        "cols = list(f[\"series\"])\n"
+        "assert sorted(rows[0]) == sorted(cols), (sorted(rows[0]), cols)\n"
+        "assert len(rows) == len(f[\"series/step\"])\n"
+        "for c in cols:\n"
+        "    for r, v in zip(rows, f[\"series/\" + c][:]):\n"
+        "        assert (math.isnan(v) and r[c] == \"nan\") or float(r[c]) == v, (c, r[c], v)\n"
+        "print(len(rows))' %s/series.csv %s/biax.h5",
+        g_exe, g_tmp, g_tmp, g_tmp, g_tmp);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_int_equal(atoi(out), 12);
     snprintf(cmd, sizeof cmd,
