@@ -1,23 +1,15 @@
-/* cli_help: one description per program and subcommand (usage forms, prose, option table),
- * printed by -h/--help in one layout, so that every command reads the same way and the man
- * pages (scripts/help2roff.py), the bash completion (scripts/completion.py) and the option
- * parsers of cdem-strain's simple commands all come from the same table.
- *
- * Layout of the printed help (help2roff.py and tests/test_help.c rely on it):
- *   usage: PROGRAM FORM...          (one line per form, later forms indented under "usage:")
- *          continuation             (long forms wrap at 80 columns, never inside [...])
- *   <blank>
- *   paragraphs of description       (wrapped at 80 columns)
- *   <blank>
- *   Options:                        (or any heading ending in ':'; rows indented by two)
- *     -o, --output FILE    text     (text in column 23, or on the next line when the
- *                          more     option is longer)
- *   <blank>
- *   paragraphs of notes
- *   <blank>
- *   Exit status: ...
- * Ownership: the descriptions are static const data; nothing is allocated.
- * Thread safety: pure functions of their arguments. */
+/* cli_help: one description per program and subcommand (usage forms, prose, option table)
+ * printed by -h/--help in one layout, so every command reads the same way and the man pages
+ * (scripts/help2roff.py), the bash completion (scripts/help2completion.py) and the parsers of
+ * cdem-strain's simple commands come from the same table. Printed layout, 80 columns:
+ *   usage: PROGRAM FORM             later forms under it; long forms wrap, never inside [...]
+ *   <blank> description paragraphs  (a paragraph starting with a space is printed as is)
+ *   <blank> Heading:                "Commands:" (rows) and "Options:"; rows indented by two,
+ *     -o, --output FILE  text       text from column 23, or on the next line
+ *   <blank> notes paragraphs
+ *   <blank> Exit status: ...
+ * help2roff.py and tests/test_help.c rely on this layout.
+ * Ownership: descriptions are static const data. Thread safety: pure functions. */
 #ifndef CDEM_CLI_HELP_H
 #define CDEM_CLI_HELP_H
 

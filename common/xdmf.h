@@ -1,23 +1,15 @@
-/* xdmf: the XDMF sidecars that let ParaView and VisIt read cdem HDF5 files (a run file's
- * run.xmf, a `compute --format h5` file's .xmf), in two flavours:
- *
- * - XDMF 3 (the default; ParaView's Xdmf3 readers, which it picks for .xmf): every data item
- *   is an HDF5 reference whose hyperslab is in the text ("file.h5:/path|start:stride:count:
- *   dataspace"), with NumberType and Precision of the dataset. VTK's Xdmf3 reader learns an
- *   array's type from that reference before it reads anything; a HyperSlab or Function data
- *   item (XDMF 2's way, and what X_Y geometry becomes) has no type until read, which that
- *   reader skips ("Skipping unrecognized array type [None]") and then crashes on (ParaView
- *   5.11). So the geometry is XY from one n x 2 dataset: /increments/xy, a virtual dataset
- *   (HDF5 VDS: no storage) mapping the columns to x and y (cdem_xdmf_create_xy_view). The
- *   Polyvertex topology (one vertex cell per element) is a HyperSlab of one inline list
- *   0..N-1 shared by every grid through XInclude: topology is read before its type is asked.
- * - XDMF 2 (--xdmf2; ParaView's legacy "XDMF Reader", VisIt): HyperSlab data items over the
- *   ragged datasets, X_Y geometry from x and y, no topology data.
- *
- * Heavy data references are written relative to the sidecar's folder (or absolute when the
- * HDF5 file lives elsewhere), XML-escaped. Library code: never prints. docs/format.md, "XDMF
- * sidecar", is the authority on the layout.
- * Ownership: the caller owns everything passed in. Thread safety: none needed (no state). */
+/* xdmf: the XDMF sidecars that let ParaView and VisIt read cdem HDF5 files (run.xmf, the
+ * .xmf of a compute --format h5 file). XDMF 3 (default; ParaView's Xdmf3 readers): every data
+ * item is an HDF5 reference with its hyperslab in the text ("f.h5:/ds|start:stride:count:
+ * dataspace") and the dataset's NumberType/Precision, because VTK's Xdmf3 reader types an
+ * array before reading it and HyperSlab/Function items (XDMF 2's way, and X_Y geometry) have
+ * no type then: ParaView 5.11 skipped them and crashed. The geometry is XY from an n x 2 HDF5
+ * virtual dataset over x and y (cdem_xdmf_create_xy_view, no storage); the Polyvertex
+ * topology is a HyperSlab of one shared inline list 0..N-1 (XInclude; topology is read before
+ * its type is asked). XDMF 2 (--xdmf2; VisIt, ParaView's legacy reader): HyperSlabs of the
+ * ragged datasets, X_Y geometry. References are relative to the sidecar's folder, else
+ * absolute. docs/format.md, "XDMF sidecar", is the authority. Library code: never prints.
+ * Ownership: the caller owns everything passed in. Thread safety: no state. */
 #ifndef CDEM_XDMF_H
 #define CDEM_XDMF_H
 
