@@ -9,6 +9,10 @@
 #   make demo       the main job: simulate the default model, analyse, render a picture
 #   make fuzz       build the libFuzzer harnesses (tests/fuzz/, clang) and run each for
 #                   FUZZ_SECONDS (default 600); FUZZ_HARNESSES picks a subset
+#   make install    programs, man pages and bash completion into $(DESTDIR)$(PREFIX)
+#                   (PREFIX default /usr/local); make uninstall removes them
+#   make man, make completion, make measured   regenerate man/, completion/cdem-c.bash
+#                   and docs/measured.md (tests fail when the committed ones are stale)
 
 BUILD   ?= build
 CC      ?= gcc
@@ -115,3 +119,33 @@ clean:
 .PHONY: man
 man: all
 	/usr/bin/python3 scripts/help2roff.py $(BUILD) man
+
+# docs/measured.md: the default model's counts and file sizes quoted by the docs, measured
+# afresh (two default runs); make validate fails when the committed page is stale.
+.PHONY: measured
+measured: all
+	/usr/bin/python3 scripts/measure_docs.py $(BUILD) > docs/measured.md.tmp
+	mv docs/measured.md.tmp docs/measured.md
+
+# Bash completion from the programs' --help (tests/test_man.c fails when it is stale).
+.PHONY: completion
+completion: all
+	/usr/bin/python3 scripts/help2completion.py $(BUILD) completion/cdem-c.bash
+
+# make install / uninstall: the programs, their man pages and the bash completion under
+# $(DESTDIR)$(PREFIX) (tests/test_install.c installs into a scratch DESTDIR and back out).
+PREFIX      ?= /usr/local
+BINDIR      := $(PREFIX)/bin
+MANDIR      := $(PREFIX)/share/man/man1
+BASHCOMPDIR := $(PREFIX)/share/bash-completion/completions
+.PHONY: install uninstall
+install: all
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(MANDIR) $(DESTDIR)$(BASHCOMPDIR)
+	install -m 755 $(BUILD)/cdem-run $(BUILD)/cdem-strain $(DESTDIR)$(BINDIR)/
+	install -m 644 man/cdem-run.1 man/cdem-strain.1 $(DESTDIR)$(MANDIR)/
+	install -m 644 completion/cdem-c.bash $(DESTDIR)$(BASHCOMPDIR)/cdem-run
+	install -m 644 completion/cdem-c.bash $(DESTDIR)$(BASHCOMPDIR)/cdem-strain
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/cdem-run $(DESTDIR)$(BINDIR)/cdem-strain
+	rm -f $(DESTDIR)$(MANDIR)/cdem-run.1 $(DESTDIR)$(MANDIR)/cdem-strain.1
+	rm -f $(DESTDIR)$(BASHCOMPDIR)/cdem-run $(DESTDIR)$(BASHCOMPDIR)/cdem-strain

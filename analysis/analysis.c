@@ -448,7 +448,7 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         if (!cur->has_stress) {
             st = CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
                            "quantity '%s' needs stress, but increment %d stores none (run with "
-                           "physics.calculate_stress = true)",
+                           "physics.calculate_stress = on)",
                            q->name, (int)a->infos[index].number);
             break;
         }

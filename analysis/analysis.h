@@ -32,6 +32,7 @@ typedef struct cdem_analysis cdem_analysis;
 typedef struct {
     size_t (*count)(void *ctx); /* increments available */
     cdem_status (*info)(void *ctx, size_t index, cdem_increment_info *info, cdem_error *err);
+    /* s is empty on entry (zeroed); load fills it */
     cdem_status (*load)(void *ctx, size_t index, cdem_state *s, cdem_error *err);
     void (*close)(void *ctx);             /* releases ctx at cdem_analysis_close; may be NULL */
     cdem_h5_reader *(*reader)(void *ctx); /* the file reader, or NULL (may be NULL) */

@@ -220,7 +220,7 @@ cdem_status cdem_axes_stress(const cdem_state *cur, double spacing, cdem_axes *o
         memset(out, 0, sizeof *out);
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "stress axes: this increment stores no stress (run with "
-                         "physics.calculate_stress = true)");
+                         "physics.calculate_stress = on)");
     }
     return axes_run(NULL, cur, spacing, 1, out, err);
 }

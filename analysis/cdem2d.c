@@ -421,7 +421,7 @@ cdem_status cdem_cdem2d_import(const char *dir, cdem_cdem2d_sink sink, void *use
         st = sink(user, &info, &cur, err);
         if (st != CDEM_OK)
             break;
-        st = cdem_state_copy(&prev, &cur, err);
+        st = cdem_state_assign(&prev, &cur, err); /* prev is reused */
         have_prev = 1;
     }
     free(nums);

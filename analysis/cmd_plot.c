@@ -108,8 +108,17 @@ typedef struct {
     double range[4];              /* xmin, xmax, ymin, ymax of --xrange, --yrange */
 } plot_args;
 
+static const cdem_cli_help *help_of(const char *cmd) {
+    return !strcmp(cmd, "mohr")     ? &cdem_cmd_mohr_help
+           : !strcmp(cmd, "repose") ? &cdem_cmd_repose_help
+           : !strcmp(cmd, "voids")  ? &cdem_cmd_voids_help
+                                    : &cdem_cmd_plot_series_help;
+}
+
+/* synopsis is the first usage form of the command's help (help_of) */
 static int usage(const char *cmd, const char *what, const char *synopsis) {
-    fprintf(stderr, "cdem-strain %s: %s\nusage: cdem-strain %s %s\n", cmd, what, cmd, synopsis);
+    (void)synopsis;
+    cdem_cli_usage_print(stderr, help_of(cmd), what);
     return 2;
 }
 
@@ -156,7 +165,7 @@ static int parse_args(int argc, char **argv, plot_args *a, const char *synopsis)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            printf("usage: cdem-strain %s %s\n", cmd, synopsis);
+            cdem_cli_help_print(stdout, help_of(cmd));
             return -1;
         }
         size_t f;
@@ -250,8 +259,36 @@ static cdem_status read_series(const char *path, cdem_series_sample **smp, size_
 
 /* ---------------------------------------------------------------- plot-series */
 static const char series_synopsis[] =
-    "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT.png|.pdf|.svg "
+    "RUN.h5 [RUN2.h5 ...] --y COLUMN [--x COLUMN] -o OUT.png|.pdf|.svg "
     "[--xrange MIN,MAX] [--yrange MIN,MAX] [--width N] [--height N]";
+static const char *const series_forms[] = {series_synopsis, NULL};
+/* the picture size options shared by the plots */
+#define WIDTH_OPTION                                                                               \
+    { "--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000" }
+#define HEIGHT_OPTION                                                                              \
+    { "--height", "N", "as --width" }
+static const cdem_cli_option series_options[] = {
+    {"--y", "COLUMN",
+     "the /series column to plot: time, step, kinetic_energy, contacts, bonds, n_elements, "
+     "net_displacement, boundary_force_x, boundary_force_y, base_force_x, base_force_y, "
+     "axial_strain, differential_stress, sea_level"},
+    {"--x", "COLUMN",
+     "the x axis, any column as for --y (default time; e.g. net_displacement, or "
+     "axial_strain for a biaxial stress-strain curve)"},
+    {"-o, --output", "OUT.png|.pdf|.svg", "the picture"},
+    {"--xrange", "MIN,MAX", "fixed x range"},
+    {"--yrange", "MIN,MAX", "fixed y range"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_plot_series_help = {
+    .program = "cdem-strain plot-series",
+    .forms = series_forms,
+    .about = "Line plot of a time-series column of one or more runs (one curve per run), e.g. "
+             "kinetic_energy to check that equilibration has settled. Columns and units: "
+             "docs/format.md, \"/series\".",
+    .options = series_options,
+};
 
 int cdem_cmd_plot_series(int argc, char **argv) {
     plot_args a = {.cmd = "plot-series"};
@@ -264,14 +301,14 @@ int cdem_cmd_plot_series(int argc, char **argv) {
         return usage(a.cmd, "missing --y COLUMN", series_synopsis);
     if (!a.out)
         return usage(a.cmd, "missing -o OUT.png|.pdf|.svg", series_synopsis);
+    /* any column can be the x axis (axial_strain for a biaxial stress-strain curve) */
     const char *xname = a.x ? a.x : "time";
-    if (strcmp(xname, "time") && strcmp(xname, "step") && strcmp(xname, "net_displacement"))
-        return usage(a.cmd, "--x must be time, step or net_displacement", series_synopsis);
     cdem_error err;
     const char *ylabel = NULL, *xlabel = NULL;
+    if (cdem_cmd_plot_column(NULL, 0, xname, NULL, &xlabel, &err) != CDEM_OK)
+        return usage(a.cmd, err.msg, series_synopsis);
     if (cdem_cmd_plot_column(NULL, 0, a.y, NULL, &ylabel, &err) != CDEM_OK)
         return fail(a.cmd, &err);
-    cdem_cmd_plot_column(NULL, 0, xname, NULL, &xlabel, &err);
     cdem_plot_series ser[MAX_FILES];
     double *buf[MAX_FILES] = {0};
     memset(ser, 0, sizeof ser);
@@ -319,6 +356,24 @@ int cdem_cmd_plot_series(int argc, char **argv) {
 static const char mohr_synopsis[] =
     "RUN1.h5 RUN2.h5 ... | --data FILE (columns: sigma3 q, N/m)  [-o OUT.png|.pdf|.svg] "
     "[--width N] [--height N]";
+
+static const char *const mohr_forms[] = {mohr_synopsis, NULL};
+static const cdem_cli_option mohr_options[] = {
+    {"--data", "FILE", "fit peaks measured elsewhere: a text file of columns sigma3 q (N/m)"},
+    {"-o, --output", "OUT.png|.pdf|.svg",
+     "stress-strain curves and Mohr circles with the fitted envelope"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_mohr_help = {
+    .program = "cdem-strain mohr",
+    .forms = mohr_forms,
+    .about = "Mohr-Coulomb fit of biaxial tests: takes the peak differential stress of each "
+             "run (sigma3 = its confining pressure) and prints the cohesion and friction "
+             "angle with their standard errors (none with exactly two tests). Formulas: "
+             "docs/rendering.md.",
+    .options = mohr_options,
+};
 
 #define MOHR_CIRCLE_POINTS 181
 
@@ -494,6 +549,20 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
 /* ---------------------------------------------------------------- repose */
 static const char repose_synopsis[] =
     "RUN.h5 [--increment K|last|equil|first] [-o OUT.png|.pdf|.svg] [--width N] [--height N]";
+static const char *const repose_forms[] = {repose_synopsis, NULL};
+static const cdem_cli_option repose_options[] = {
+    {"--increment", "K|last|equil|first", "the increment (default last)"},
+    {"-o, --output", "OUT.png|.pdf|.svg", "the free surface with the fitted flanks"},
+    WIDTH_OPTION,
+    HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_repose_help = {
+    .program = "cdem-strain repose",
+    .forms = repose_forms,
+    .about = "Angle of repose: the slope of the free surface of a repose-collapse run, fitted "
+             "on each flank (docs/analysis.md).",
+    .options = repose_options,
+};
 
 static cdem_status repose_figure(const plot_args *a, const cdem_state *s, int number,
                                  const cdem_repose_result *res, cdem_error *err) {
@@ -584,6 +653,20 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
 
 /* ---------------------------------------------------------------- voids */
 static const char voids_synopsis[] = "RUN.h5 [--increment K|last|equil|first] [--window M]";
+static const char *const voids_forms[] = {voids_synopsis, NULL};
+static const cdem_cli_option voids_options[] = {
+    {"--increment", "K|last|equil|first", "the increment (default last)"},
+    {"--window", "M", "horizontal span of the steepest-slope measure in m (default 1000)"},
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_voids_help = {
+    .program = "cdem-strain voids",
+    .forms = voids_forms,
+    .about = "Open space a rock mass should not hold, in one increment: the steepest surface "
+             "slope over a horizontal window (cliffs, chasm walls), voids (closed-off room for "
+             "the largest element: cavities under arches, gaps behind rigid blocks) and the "
+             "deepest open fissure (analysis/voids.h, docs/analysis.md).",
+    .options = voids_options,
+};
 
 int cdem_cmd_plot_voids(int argc, char **argv) {
     plot_args a = {.cmd = "voids"};

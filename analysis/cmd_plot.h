@@ -1,5 +1,5 @@
 /* cmd_plot: the calibration and evolution plot subcommands of cdem-strain:
- *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x time|step|net_displacement] -o OUT
+ *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x COLUMN] -o OUT
  *   mohr RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT]   (Mohr-Coulomb fit, see mohr.h)
  *   repose RUN.h5 [--increment K] [-o OUT]             (angle of repose, see repose.h)
  *   voids RUN.h5 [--increment K] [--window M]          (open space and cliffs, see voids.h)
@@ -11,6 +11,7 @@
 #define CDEM_CMD_PLOT_H
 
 #include "cdem_error.h"
+#include "cli_help.h"
 #include "h5format.h"
 
 #include <stddef.h>
@@ -21,6 +22,12 @@
  * differential_stress, sea_level). *label (may be NULL) gets an axis label with unit. */
 cdem_status cdem_cmd_plot_column(const cdem_series_sample *samples, size_t n, const char *name,
                                  double *out, const char **label, cdem_error *err);
+
+/* Usage, description and options of each (--help, man page, completion). */
+extern const cdem_cli_help cdem_cmd_plot_series_help;
+extern const cdem_cli_help cdem_cmd_mohr_help;
+extern const cdem_cli_help cdem_cmd_repose_help;
+extern const cdem_cli_help cdem_cmd_voids_help;
 
 int cdem_cmd_plot_series(int argc, char **argv);
 int cdem_cmd_plot_mohr(int argc, char **argv);

@@ -5,6 +5,7 @@
 
 #include "analysis.h"
 #include "gif.h"
+#include "outfile.h"
 #include "render.h"
 
 #include <errno.h>
@@ -41,24 +42,68 @@ static int fail(const cdem_error *err) {
     return 1;
 }
 
+/* The help of render (cli_help.h): --help, the usage errors, the man page and the bash
+ * completion come from it; tests/test_help.c checks that parse_args accepts every option. */
+static const char *const render_forms[] = {
+    "RUN.h5 [--increment K|last|first|equil|all] [--color QUANTITY] [--vectors incr|total] "
+    "[--axes incr-strain|total-strain|stress] [--shear-axes] [--above-tenth-max] [--no-fill] "
+    "[--no-colours] [--no-scale-bar] [--no-colour-bar] [--no-label] [--width N] [--height N] "
+    "[--zoom XMIN,XMAX,YMIN,YMAX] [--highlight FIRST-LAST] [--color-walls #RRGGBB] "
+    "[--color-layers #RRGGBB,#RRGGBB] -o OUT.png|.pdf|.svg",
+    "RUN.h5 --increment all [OPTIONS] -o DIR [--prefix P] [--format png|pdf|svg]",
+    "RUN.h5 [OPTIONS] --gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]",
+    "RUN.h5 --follow [--interval SECONDS] [OPTIONS] [-o OUT.png]", NULL};
+
+static const cdem_cli_option render_options[] = {
+    {"--increment", "K|last|first|equil|all",
+     "which increment (default last); all writes DIR/<prefix><number>.<format> for every "
+     "increment, numbers zero-padded to one width (cdem000.png .. cdem282.png)"},
+    {"--color, --colour", "QUANTITY",
+     "colour by a quantity ('cdem-strain quantities'; default: layer colours)"},
+    {"--above-tenth-max", NULL, "colour only elements whose value exceeds 0.1 x the maximum"},
+    {"--vectors", "incr|total", "displacement vectors (incremental 5x exaggerated, total 1x)"},
+    {"--axes", "incr-strain|total-strain|stress",
+     "principal axes (S1 and the perpendicular S3) on a grid"},
+    {"--shear-axes", NULL, "with --axes: the maximum-shear directions instead"},
+    {"--no-fill", NULL, "outlines only (the manual's \"toggle elements\")"},
+    {"--no-colours, --no-colors", NULL, "no colours by value"},
+    {"--no-scale-bar", NULL, "no scale bar"},
+    {"--no-colour-bar, --no-color-bar", NULL, "no colour bar"},
+    {"--no-label", NULL, "no increment label"},
+    {"--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000 (default 1200)"},
+    {"--height", "N", "as --width (default: from the aspect ratio)"},
+    {"--zoom", "XMIN,XMAX,YMIN,YMAX", "view box in metres (default: all elements)"},
+    {"--highlight", "FIRST-LAST", "highlight the layers FIRST to LAST"},
+    {"--color-walls, --colour-walls", "#RRGGBB", "wall colour (default brown)"},
+    {"--color-layers, --colour-layers", "#RRGGBB,#RRGGBB",
+     "the two pre-growth band colours (default yellow, red)"},
+    {"-o, --output", "OUT",
+     "picture (.png, .pdf, .svg), or a directory with --increment all (created when "
+     "missing)"},
+    {"--prefix", "P", "file-name prefix with --increment all (default cdem)"},
+    {"--format", "png|pdf|svg", "picture format with --increment all (default png)"},
+    {"--gif", "OUT.gif", "animated GIF of every increment"},
+    {"--backward", NULL, "GIF frames from the last increment to the first"},
+    {"--odd", NULL, "GIF of every other increment (a smaller file)"},
+    {"--gif-scale", "S", "GIF size as a fraction of --width, 0.05 to 1 (default 1)"},
+    {"--delay", "CS", "GIF frame delay in hundredths of a second (default 10)"},
+    {"--follow", NULL,
+     "re-render the newest increment of a run that cdem-run is still writing whenever a new "
+     "one arrives, until the run stops (-o defaults to live.png)"},
+    {"--interval", "SECONDS", "with --follow: seconds between checks (default 2)"},
+    {NULL, NULL, NULL}};
+
+const cdem_cli_help cdem_cmd_render_help = {
+    .program = "cdem-strain render",
+    .forms = render_forms,
+    .about = "Pictures of increments (PNG, PDF, SVG), albums and animated GIFs. Every picture "
+             "of a series uses one view box, so frames line up. docs/rendering.md has the "
+             "details.",
+    .options = render_options,
+};
+
 static int usage(const char *what) {
-    fprintf(
-        stderr,
-        "cdem-strain render: %s\n"
-        "usage: cdem-strain render RUN.h5 [--increment K|last|first|equil|all]\n"
-        "         [--color QUANTITY] [--vectors incr|total] [--axes "
-        "incr-strain|total-strain|stress]\n"
-        "         [--shear-axes] [--above-tenth-max] [--no-fill] [--no-colours] [--no-scale-bar]\n"
-        "         [--no-colour-bar] [--no-label] [--width N] [--height N] [--zoom "
-        "XMIN,XMAX,YMIN,YMAX]\n"
-        "         [--highlight FIRST-LAST] [--color-walls #RRGGBB] [--color-layers "
-        "#RRGGBB,#RRGGBB]\n"
-        "         [-o OUT.png|.pdf|.svg | -o DIR with --increment all [--prefix P] [--format "
-        "png|pdf|svg]]\n"
-        "         [--gif OUT.gif [--backward] [--odd] [--gif-scale S] [--delay CS]]\n"
-        "         [--follow [--interval SECONDS]]  re-render the newest increment of a run\n"
-        "         that is still being written (default -o live.png) until it stops\n",
-        what);
+    cdem_cli_usage_print(stderr, &cdem_cmd_render_help, what);
     return 2;
 }
 
@@ -106,7 +151,7 @@ static int parse_args(int argc, char **argv, render_args *a) {
         i++;                                                                                       \
     } while (0)
         if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            usage("help");
+            cdem_cli_help_print(stdout, &cdem_cmd_render_help);
             return 3; /* help shown: exit 0 after the caller sees 3 */
         } else if (!strcmp(arg, "--increment") || !strcmp(arg, "--increments")) {
             NEED_VALUE();
@@ -266,10 +311,15 @@ static void scene_free(scene_data *d) {
     memset(d, 0, sizeof *d);
 }
 
-static void make_label(const cdem_analysis *an, size_t index, char *buf, size_t n) {
+void cdem_render_increment_label(const cdem_analysis *an, size_t index, char *buf, size_t n) {
     const cdem_increment_info *info = cdem_analysis_info(an, index);
     const cdem_params *p = cdem_analysis_params(an);
-    if (p->mode == CDEM_MODE_BIAXIAL)
+    const cdem_h5_reader *r = cdem_analysis_reader(an);
+    if (r && !strncmp(cdem_h5_reader_source(r), "cdem2d-import:", 14))
+        /* a cdem2D folder gives positions per increment, no displacement or time: a label
+         * "Net displacement 0.0 m" on every increment would be false */
+        snprintf(buf, n, "Increment %d", (int)info->number);
+    else if (p->mode == CDEM_MODE_BIAXIAL)
         snprintf(buf, n, "Increment %d   Axial strain %.4f", (int)info->number, info->axial_strain);
     else if (p->mode == CDEM_MODE_REPOSE)
         snprintf(buf, n, "Increment %d   Time %.0f s", (int)info->number, info->time);
@@ -323,7 +373,7 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
         d->sc.n_axes = d->axes.n;
         d->sc.axis_perpendicular = 1;
     }
-    make_label(an, index, d->label, sizeof d->label);
+    cdem_render_increment_label(an, index, d->label, sizeof d->label);
     d->sc.label = d->label;
     return CDEM_OK;
 }
@@ -431,21 +481,22 @@ static int run_render(const render_args *a) {
     if (!a->output)
         goto done;
     if (!strcmp(a->increment, "all")) {
-        if (mkdir(a->output, 0777) != 0 && errno != EEXIST) {
-            CDEM_FAIL(&err, CDEM_ERR_IO, "%s: cannot create the output directory: %s", a->output,
-                      strerror(errno));
+        if (cdem_outfile_make_dirs(a->output, &err) != CDEM_OK) {
             rc = fail(&err);
             goto done;
         }
+        /* numbers zero-padded to the width of the largest, so the files sort in increment
+         * order (fr000.png .. fr282.png; movie tools take them in name order) */
+        const int width = snprintf(NULL, 0, "%d", (int)cdem_analysis_info(an, n - 1)->number);
         for (size_t i = 0; i < n && rc == 0; i++) {
             char path[4096];
-            snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+            snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                      (int)cdem_analysis_info(an, i)->number, a->format);
             if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK) {
                 rc = fail(&err);
                 /* no partial series that looks complete: remove this run's pictures */
                 for (size_t j = 0; j < i; j++) {
-                    snprintf(path, sizeof path, "%s/%s%d.%s", a->output, a->prefix,
+                    snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                              (int)cdem_analysis_info(an, j)->number, a->format);
                     remove(path);
                 }

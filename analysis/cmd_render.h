@@ -6,6 +6,20 @@
 #ifndef CDEM_CMD_RENDER_H
 #define CDEM_CMD_RENDER_H
 
+#include "cli_help.h"
+
+/* Its usage, description and options (--help, man page, completion). */
+extern const cdem_cli_help cdem_cmd_render_help;
+
+#include "analysis.h"
+
+#include <stddef.h>
+
+/* The label drawn above a picture of increment `index`: "Increment K   Net displacement X m"
+ * (time for repose runs, axial strain for biaxial tests; the increment number alone for an
+ * imported cdem2D run, whose folder gives no displacement). */
+void cdem_render_increment_label(const cdem_analysis *an, size_t index, char *buf, size_t n);
+
 /* argv[0] is "render"; returns the process exit code (0 ok, 1 error, 2 usage). */
 int cdem_cmd_render(int argc, char **argv);
 

@@ -18,8 +18,11 @@
 #define MAX_CSV_FILES 32
 #define MAX_Y_COLUMNS 16
 
+/* synopsis is the first usage form of the command's help */
 static int usage(const char *cmd, const char *what, const char *synopsis) {
-    fprintf(stderr, "cdem-strain %s: %s\nusage: cdem-strain %s %s\n", cmd, what, cmd, synopsis);
+    (void)synopsis;
+    cdem_cli_usage_print(
+        stderr, !strcmp(cmd, "wedge") ? &cdem_cmd_wedge_help : &cdem_cmd_plot_csv_help, what);
     return 2;
 }
 
@@ -49,6 +52,22 @@ static const char *opt_value(int argc, char **argv, int *i, const char *flag, in
 
 /* ---------------------------------------------------------------- wedge */
 static const char wedge_synopsis[] = "RUN.h5 [-o OUT.csv] [--increment K|last|all] [--threshold M]";
+static const char *const wedge_forms[] = {wedge_synopsis, NULL};
+static const cdem_cli_option wedge_options[] = {
+    {"-o, --output", "OUT.csv", "output file (default: standard output)"},
+    {"--increment", "K|last|equil|all",
+     "one increment, or all (default) from the end of "
+     "equilibration on"},
+    {"--threshold", "M", "deformed-zone threshold in m (default: the mean element diameter)"},
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_wedge_help = {
+    .program = "cdem-strain wedge",
+    .forms = wedge_forms,
+    .about = "Accretionary-wedge measurements per increment from the end of equilibration, as "
+             "CSV: shortening, height, length, taper, area change and the wall forces "
+             "(columns and definitions in docs/analysis.md, \"Wedge\").",
+    .options = wedge_options,
+};
 
 int cdem_cmd_wedge(int argc, char **argv) {
     const char *cmd = "wedge", *file = NULL, *out = NULL, *inc = "all", *thr = NULL;
@@ -56,13 +75,7 @@ int cdem_cmd_wedge(int argc, char **argv) {
         int missing = 0;
         const char *v;
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            printf("usage: cdem-strain wedge %s\n\nAccretionary-wedge measurements per "
-                   "increment from the end of equilibration (CSV; columns and definitions in "
-                   "docs/analysis.md, \"Wedge\").\n  -o OUT.csv       output file (default: "
-                   "stdout)\n  --increment K    one increment (number, last, equil) or all "
-                   "(default)\n  --threshold M    deformed-zone threshold in m (default: the "
-                   "mean element diameter)\n",
-                   wedge_synopsis);
+            cdem_cli_help_print(stdout, &cdem_cmd_wedge_help);
             return 0;
         }
         if ((v = opt_value(argc, argv, &i, "-o", &missing)) ||
@@ -153,6 +166,24 @@ int cdem_cmd_wedge(int argc, char **argv) {
 static const char plot_csv_synopsis[] =
     "A.csv [B.csv ...] --x COLUMN --y COLUMN[,COLUMN...] -o OUT.png|.pdf|.svg [--labels "
     "L1,L2,...] [--columns N] [--legend K] [--width N] [--height N]";
+static const char *const plot_csv_forms[] = {plot_csv_synopsis, NULL};
+static const cdem_cli_option plot_csv_options[] = {
+    {"--x", "COLUMN", "the x column (by its header name)"},
+    {"--y", "COLUMN[,COLUMN...]", "one panel per column (at most 16)"},
+    {"-o, --output", "OUT.png|.pdf|.svg", "the picture"},
+    {"--labels", "L1,L2,...", "one legend label per CSV file (default: the file names)"},
+    {"--columns", "N", "panels across (default 3)"},
+    {"--legend", "K", "the panel that holds the legend, 1 to 16 (default 1; 0 = none)"},
+    {"--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000"},
+    {"--height", "N", "as --width"},
+    {NULL, NULL, NULL}};
+const cdem_cli_help cdem_cmd_plot_csv_help = {
+    .program = "cdem-strain plot-csv",
+    .forms = plot_csv_forms,
+    .about = "Curves of CSV columns (e.g. of several wedge tables), one curve per file and one "
+             "panel per --y column in a grid.",
+    .options = plot_csv_options,
+};
 
 /* Axis labels of the wedge table's columns; other columns are labelled by their name. */
 static const struct {
@@ -321,10 +352,7 @@ int cdem_cmd_plot_csv(int argc, char **argv) {
         int missing = 0;
         const char *v;
         if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-            printf("usage: cdem-strain plot-csv %s\n\nOne panel per --y column (a grid of "
-                   "--columns panels across, default 3), one curve per CSV file (legend on "
-                   "panel --legend K, default 1, 0 = none: --labels or the file names).\n",
-                   plot_csv_synopsis);
+            cdem_cli_help_print(stdout, &cdem_cmd_plot_csv_help);
             return 0;
         }
         if ((v = opt_value(argc, argv, &i, "--x", &missing)))

@@ -12,6 +12,7 @@
 #define CDEM_CMD_WEDGE_H
 
 #include "cdem_error.h"
+#include "cli_help.h"
 
 #include <stddef.h>
 
@@ -23,6 +24,10 @@ cdem_status cdem_cmd_plot_csv_figure(const char *const *files, const char *const
                                      size_t n_files, const char *xcol, const char *const *ycols,
                                      size_t n_y, int ncols, int legend, int width, int height,
                                      const char *out, cdem_error *err);
+
+/* Usage, description and options of each (--help, man page, completion). */
+extern const cdem_cli_help cdem_cmd_wedge_help;
+extern const cdem_cli_help cdem_cmd_plot_csv_help;
 
 int cdem_cmd_wedge(int argc, char **argv);
 int cdem_cmd_plot_csv(int argc, char **argv);

@@ -17,6 +17,7 @@
  *  - HDF5's error printing is off; its error stack becomes part of cdem_error messages.
  *  - append_series is called from the time-step loop: it never allocates (fixed buffer). */
 #include "h5format.h"
+#include "xdmf.h"
 
 #include <hdf5.h>
 
@@ -335,23 +336,6 @@ done:;
 
 /* ------------------------------------------------------------------ paths */
 
-/* "dir/run.h5" -> "dir/run.xmf" (".h5"/".hdf5"/".hdf" replaced, otherwise appended). */
-static char *xmf_path_for(const char *h5path) {
-    size_t n = strlen(h5path);
-    const char *slash = strrchr(h5path, '/');
-    const char *dot = strrchr(h5path, '.');
-    size_t stem = n;
-    if (dot && (!slash || dot > slash) &&
-        (!strcmp(dot, ".h5") || !strcmp(dot, ".hdf5") || !strcmp(dot, ".hdf")))
-        stem = (size_t)(dot - h5path);
-    char *p = malloc(stem + 5);
-    if (!p)
-        return NULL;
-    memcpy(p, h5path, stem);
-    memcpy(p + stem, ".xmf", 5);
-    return p;
-}
-
 /* ------------------------------------------------------------------ writer */
 
 /* One row of /increments/index (memory layout; the file type is packed little-endian). */
@@ -477,7 +461,6 @@ struct cdem_h5_writer {
     hid_t ckpt_mtype;               /* memory type of ckpt_row */
     char *path;                     /* the .h5 path as given */
     char *xmf_path;                 /* sidecar path */
-    char *xmf_tmp;                  /* sidecar temp path (renamed over xmf_path) */
     const char *h5_name;            /* basename of path, referenced from the sidecar */
     cdem_series_sample *buf;        /* SERIES_BUFFER buffered samples */
     size_t nbuf;                    /* samples in buf */
@@ -497,6 +480,7 @@ struct cdem_h5_writer {
     xmf_entry *entries;             /* one per written increment, in write order */
     size_t n_entries, cap_entries;  /* used / allocated entries */
     size_t xmf_written;             /* entries in the sidecar on disk */
+    int has_xy;                     /* 1: /increments/xy exists (XDMF 3 sidecar) */
 };
 
 static cdem_status flush_file(cdem_h5_writer *w, cdem_error *err) {
@@ -620,94 +604,53 @@ static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
     return CDEM_OK;
 }
 
-static void xml_escaped(FILE *f, const char *s) {
-    for (; *s; s++) {
-        switch (*s) {
-        case '&':
-            fputs("&amp;", f);
-            break;
-        case '<':
-            fputs("&lt;", f);
-            break;
-        case '>':
-            fputs("&gt;", f);
-            break;
-        case '"':
-            fputs("&quot;", f);
-            break;
-        default:
-            fputc(*s, f);
-        }
+/* ------------------------------------------------------------------ XDMF sidecar */
+/* The attributes of a grid, in sidecar order (indices into element_fields). */
+static const size_t xmf_attributes[] = {3, 4, 0, 5, 6, 7, 8, 9};
+
+/* One increment of a version-2 file as an XDMF grid (xdmf.h): rows offset .. of the ragged
+ * datasets, whose extents were data_ext and stress_ext when the sidecar was written. */
+static void xmf_grid(cdem_xdmf_grid *g, const xmf_entry *e, hsize_t data_ext, hsize_t stress_ext) {
+    g->number = e->number;
+    g->time = e->time;
+    g->n = e->n;
+    const cdem_xdmf_data pos = {NULL, e->offset, (long long)data_ext, "Float", 8};
+    g->x = g->y = g->xy = pos;
+    g->x.dataset = "/increments/x";
+    g->y.dataset = "/increments/y";
+    g->xy.dataset = "/increments/xy";
+    for (size_t a = 0; a < sizeof xmf_attributes / sizeof xmf_attributes[0]; a++) {
+        const element_field *fd = &element_fields[xmf_attributes[a]];
+        if (fd->optional && !e->has_stress)
+            continue;
+        static const char *const paths[N_ELEMENT_FIELDS] = {
+            "/increments/id",    "/increments/x",     "/increments/y",    "/increments/radius",
+            "/increments/layer", "/increments/flags", "/increments/born", "/increments/sxx",
+            "/increments/syy",   "/increments/sxy"};
+        g->attribute_names[g->n_attributes] = fd->name;
+        g->attributes[g->n_attributes++] =
+            (cdem_xdmf_data){paths[xmf_attributes[a]], fd->optional ? e->stress_offset : e->offset,
+                             (long long)(fd->optional ? stress_ext : data_ext), fd->xdmf,
+                             fd->type == EL_F64 ? 8 : 4};
     }
 }
 
-/* A hyperslab DataItem: rows [offset, offset + n) of /increments/<field>. */
-static void xmf_data_item(FILE *f, const cdem_h5_writer *w, const xmf_entry *e, size_t k) {
-    const element_field *fd = &element_fields[k];
-    int64_t off = fd->optional ? e->stress_offset : e->offset;
-    hsize_t total = fd->optional ? w->stress_ext : w->data_ext;
-    fprintf(f,
-            "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%lld\" Type=\"HyperSlab\">\n"
-            "          <DataItem Dimensions=\"3 1\" Format=\"XML\">%lld 1 %lld</DataItem>\n"
-            "          <DataItem Dimensions=\"%llu\" NumberType=\"%s\" Precision=\"%d\" "
-            "Format=\"HDF\">",
-            (long long)e->n, (long long)off, (long long)e->n, (unsigned long long)total, fd->xdmf,
-            fd->type == EL_F64 ? 8 : 4);
-    xml_escaped(f, w->h5_name);
-    fprintf(f, ":/increments/%s</DataItem>\n        </DataItem>\n", fd->name);
+/* XDMF 3 needs /increments/xy, and a file name the HDF5 reference syntax can hold. */
+static cdem_xdmf_flavour xmf_flavour(int has_xy, const char *h5_ref, int wanted) {
+    return wanted == CDEM_XDMF3 && has_xy && !strpbrk(h5_ref, ":|") ? CDEM_XDMF3 : CDEM_XDMF2;
 }
 
-/* Rewrites the sidecar from the list of increments: temp file, then rename. */
+static int writer_xmf_grid(void *ctx, size_t k, cdem_xdmf_grid *g) {
+    const cdem_h5_writer *w = ctx;
+    xmf_grid(g, &w->entries[k], w->data_ext, w->stress_ext);
+    return 0;
+}
+
+/* Rewrites the sidecar from the list of increments (temp file, then rename). */
 static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
-    FILE *f = fopen(w->xmf_tmp, "w");
-    if (!f)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot create the XDMF sidecar: %s", w->xmf_tmp,
-                         strerror(errno));
-    fputs("<?xml version=\"1.0\" ?>\n"
-          "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-          "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
-          "  <Domain>\n"
-          "    <Grid Name=\"increments\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
-          f);
-    static const size_t attrs[] = {3, 4, 0, 5, 6, 7, 8, 9};
-    for (size_t i = 0; i < w->n_entries; i++) {
-        const xmf_entry *e = &w->entries[i];
-        if (e->n == 0)
-            continue; /* an empty grid has no geometry; viewers reject it */
-        fprintf(f, "    <Grid Name=\"increment_%06d\" GridType=\"Uniform\">\n", (int)e->number);
-        fprintf(f, "      <Time Value=\"%.17g\"/>\n", e->time);
-        fprintf(f,
-                "      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%lld\" "
-                "NodesPerElement=\"1\"/>\n",
-                (long long)e->n);
-        fputs("      <Geometry GeometryType=\"X_Y\">\n", f);
-        xmf_data_item(f, w, e, 1);
-        xmf_data_item(f, w, e, 2);
-        fputs("      </Geometry>\n", f);
-        for (size_t a = 0; a < sizeof attrs / sizeof attrs[0]; a++) {
-            size_t k = attrs[a];
-            if (element_fields[k].optional && !e->has_stress)
-                continue;
-            fprintf(f, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n",
-                    element_fields[k].name);
-            xmf_data_item(f, w, e, k);
-            fputs("      </Attribute>\n", f);
-        }
-        fputs("    </Grid>\n", f);
-    }
-    fputs("    </Grid>\n  </Domain>\n</Xdmf>\n", f);
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad) {
-        remove(w->xmf_tmp);
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot write the XDMF sidecar (disk full?)",
-                         w->xmf_tmp);
-    }
-    if (rename(w->xmf_tmp, w->xmf_path) != 0) {
-        int e = errno;
-        remove(w->xmf_tmp);
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", w->xmf_path,
-                         w->xmf_tmp, strerror(e));
-    }
+    const cdem_xdmf_doc doc = {w->h5_name, xmf_flavour(w->has_xy, w->h5_name, CDEM_XDMF3),
+                               w->n_entries, writer_xmf_grid, w};
+    CDEM_TRY(cdem_xdmf_write_file(w->xmf_path, &doc, err));
     w->xmf_written = w->n_entries;
     return CDEM_OK;
 }
@@ -854,6 +797,14 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /increments/%s", w->path,
                         fd->name);
     }
+    if (st == CDEM_OK) { /* for the XDMF 3 sidecar; no storage (xdmf.h) */
+        hid_t xy = cdem_xdmf_create_xy_view(gi, "/increments/x", "/increments/y", "xy", 1);
+        if (xy < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the view /increments/xy", w->path);
+        else
+            H5Dclose(xy);
+        w->has_xy = xy >= 0;
+    }
     hid_t ft = -1;
     if (st == CDEM_OK) {
         ft = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 1);
@@ -919,7 +870,6 @@ static void writer_release(cdem_h5_writer *w) {
         H5Fclose(w->file);
     free(w->path);
     free(w->xmf_path);
-    free(w->xmf_tmp);
     free(w->buf);
     free(w->column);
     free(w->entries);
@@ -993,18 +943,16 @@ static cdem_status writer_alloc(const char *path, cdem_h5_writer **out, cdem_err
         w->data[k] = -1;
     w->last_number = -1;
     w->path = dup_str(path);
-    w->xmf_path = xmf_path_for(path);
-    w->xmf_tmp = w->xmf_path ? malloc(strlen(w->xmf_path) + 5) : NULL;
+    w->xmf_path = cdem_xdmf_path_for(path);
     w->buf = malloc(SERIES_BUFFER * sizeof *w->buf);
     w->column = malloc(SERIES_BUFFER * 8);
     w->index_mtype = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
     w->ckpt_mtype = make_compound(ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 0);
-    if (!w->path || !w->xmf_path || !w->xmf_tmp || !w->buf || !w->column || w->index_mtype < 0 ||
+    if (!w->path || !w->xmf_path || !w->buf || !w->column || w->index_mtype < 0 ||
         w->ckpt_mtype < 0) {
         writer_release(w);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
     }
-    snprintf(w->xmf_tmp, strlen(w->xmf_path) + 5, "%s.tmp", w->xmf_path);
     const char *slash = strrchr(w->path, '/');
     w->h5_name = slash ? slash + 1 : w->path;
     *out = w;
@@ -2097,6 +2045,59 @@ int cdem_h5_reader_format_version(const cdem_h5_reader *r) {
     return r ? r->version : 0;
 }
 
+/* The sidecar of a closed or running file, rebuilt from its index (cdem-strain xdmf). */
+typedef struct {
+    const cdem_h5_reader *r;
+    hsize_t data_ext, stress_ext;
+} reader_xmf_ctx;
+
+static int reader_xmf_grid(void *ctx, size_t k, cdem_xdmf_grid *g) {
+    const reader_xmf_ctx *c = ctx;
+    const incr_entry *e = &c->r->incr[k];
+    const xmf_entry x = {e->info.number,     e->info.time, e->info.n_elements,
+                         e->info.has_stress, e->offset,    e->stress_offset};
+    xmf_grid(g, &x, c->data_ext, c->stress_ext);
+    return 0;
+}
+
+cdem_status cdem_h5_write_xdmf(const char *h5_path, const char *xmf_path, int flavour, int *written,
+                               cdem_error *err) {
+    if (written)
+        *written = 0;
+    if (!h5_path || (flavour != CDEM_XDMF3 && flavour != CDEM_XDMF2))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_write_xdmf: a file and flavour 2 or 3");
+    cdem_h5_reader *r = NULL;
+    CDEM_TRY(cdem_h5_reader_open(h5_path, &r, err));
+    char *own = xmf_path ? NULL : cdem_xdmf_path_for(h5_path);
+    const char *out = xmf_path ? xmf_path : own;
+    char ref[4096];
+    cdem_status st = out ? CDEM_OK : CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+    if (st == CDEM_OK && r->version != CDEM_FORMAT_VERSION)
+        st = CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
+                       "%s: cdem format version %d has one group per increment; sidecars are "
+                       "written for version %d files only",
+                       h5_path, r->version, CDEM_FORMAT_VERSION);
+    if (st == CDEM_OK)
+        st = cdem_xdmf_reference(h5_path, out, ref, sizeof ref, err);
+    if (st == CDEM_OK) {
+        reader_xmf_ctx c = {r, extent_of(r->data[1]), extent_of(r->data[7])};
+        for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+            hsize_t e = extent_of(r->data[k]);
+            hsize_t *m = element_fields[k].optional ? &c.stress_ext : &c.data_ext;
+            *m = e < *m ? e : *m;
+        }
+        const int has_xy = H5Lexists(r->file, "/increments/xy", H5P_DEFAULT) > 0;
+        const cdem_xdmf_doc doc = {ref, xmf_flavour(has_xy, ref, flavour), r->n_incr,
+                                   reader_xmf_grid, &c};
+        st = cdem_xdmf_write_file(out, &doc, err);
+        if (st == CDEM_OK && written)
+            *written = (int)doc.flavour;
+    }
+    free(own);
+    cdem_h5_reader_close(r);
+    return st;
+}
+
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress) {
     /* Measured on the default run (docs/format.md): 16.1 bytes per element and increment
      * without stress, 40.5 with; plus 64 KiB of metadata and 0.5 KB per increment. */
@@ -2397,6 +2398,7 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         (w->ckpt_data[0] = H5Dopen2(w->file, "checkpoint/slot0", H5P_DEFAULT)) < 0 ||
         (w->ckpt_data[1] = H5Dopen2(w->file, "checkpoint/slot1", H5P_DEFAULT)) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: a version-2 dataset is missing", w->path);
+    w->has_xy = H5Lexists(w->file, "/increments/xy", H5P_DEFAULT) > 0; /* older files lack it */
 
     /* Increments to keep: the valid prefix of the index up to keep_inc. */
     hsize_t rows = extent_of(w->index), data_ext = extent_of(w->data[0]),

@@ -160,6 +160,15 @@ cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *
 /* The file format version of the open file (1 or CDEM_FORMAT_VERSION). */
 int cdem_h5_reader_format_version(const cdem_h5_reader *r);
 
+/* Added with the XDMF 3 sidecar: writes the sidecar of the run file h5_path to xmf_path
+ * (NULL: next to it, run.h5 -> run.xmf), referring to the file by name when both are in one
+ * folder, else by its absolute path. flavour 3 (ParaView's default Xdmf3 readers) or 2
+ * (legacy XDMF readers, VisIt); docs/format.md, "XDMF sidecar". A file without the view
+ * /increments/xy (written before it existed), or whose name holds ':' or '|', gets flavour
+ * 2; *written (may be NULL) is the flavour written. Version-1 files are refused. */
+cdem_status cdem_h5_write_xdmf(const char *h5_path, const char *xmf_path, int flavour, int *written,
+                               cdem_error *err);
+
 /* Estimated size in bytes of a run file with n_elements elements in each of n_increments
  * increments (stress stored when with_stress), from the measured compression of the
  * default run (docs/format.md, "Size"); for the free-space check before a run. */

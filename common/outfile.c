@@ -49,6 +49,33 @@ cdem_status cdem_outfile_begin(cdem_outfile *o, const char *path, cdem_error *er
     return CDEM_OK;
 }
 
+cdem_status cdem_outfile_make_dirs(const char *dir, cdem_error *err) {
+    char buf[CDEM_OUTFILE_PATH_MAX];
+    if (!dir || !dir[0])
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "output folder name is empty");
+    if (strlen(dir) >= sizeof buf)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "output folder %.60s... is too long", dir);
+    snprintf(buf, sizeof buf, "%s", dir);
+    /* each prefix ending before a '/', then the whole path */
+    for (char *p = buf + 1;; p++) {
+        if (*p != '/' && *p != '\0')
+            continue;
+        const char c = *p;
+        *p = '\0';
+        struct stat sb;
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+            return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create the folder %s: %s", buf,
+                             strerror(errno));
+        if (stat(buf, &sb) != 0 || !S_ISDIR(sb.st_mode))
+            return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create the folder %s: %s is not a folder",
+                             dir, buf);
+        *p = c;
+        if (c == '\0')
+            break;
+    }
+    return CDEM_OK;
+}
+
 void cdem_outfile_discard(cdem_outfile *o) {
     if (!o || !o->active)
         return;

@@ -29,6 +29,11 @@ cdem_status cdem_outfile_begin(cdem_outfile *o, const char *path, cdem_error *er
  * o->tmp and returns st unchanged (err keeps the writer's message). */
 cdem_status cdem_outfile_end(cdem_outfile *o, cdem_status st, cdem_error *err);
 
+/* Creates the folder dir and any missing parents (mkdir -p), for outputs that are a folder
+ * of files (SSPX export, picture albums). An existing folder is fine; an existing file of
+ * that name, or a parent that cannot be created, fails with CDEM_ERR_IO naming it. */
+cdem_status cdem_outfile_make_dirs(const char *dir, cdem_error *err);
+
 /* Removes o->tmp if the write is still active; o may be NULL. */
 void cdem_outfile_discard(cdem_outfile *o);
 

@@ -148,8 +148,12 @@ void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_in
 cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *err) {
     if (dst == src)
         return CDEM_OK;
-    cdem_state_free(dst);
-    CDEM_TRY(cdem_state_init(dst, src->n, src->has_stress, err));
+    /* dst is not read: cdem_state_init overwrites it whole */
+    cdem_status st = cdem_state_init(dst, src->n, src->has_stress, err);
+    if (st != CDEM_OK) {
+        cdem_state_free(dst); /* arrays the failed init did allocate */
+        return st;
+    }
 #define COPY_ONE(name, type) memcpy(dst->name, src->name, src->n * sizeof(type));
     STATE_ARRAYS(COPY_ONE)
     if (src->has_stress) {
@@ -159,6 +163,13 @@ cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *
     dst->n = src->n;
     dst->next_id = src->next_id;
     return CDEM_OK;
+}
+
+cdem_status cdem_state_assign(cdem_state *dst, const cdem_state *src, cdem_error *err) {
+    if (dst == src)
+        return CDEM_OK;
+    cdem_state_free(dst);
+    return cdem_state_copy(dst, src, err);
 }
 
 cdem_status cdem_id_map_build(cdem_id_map *map, const cdem_state *s, cdem_error *err) {

@@ -75,8 +75,16 @@ cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, dou
  * SIZE_MAX. */
 void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_index_out);
 
-/* Copies src into dst (dst is (re)initialised). */
+/* Copies src into dst. dst is an output, like cdem_state_init's: its previous contents are
+ * neither read nor freed, so it may be an uninitialised variable. (A destination that was
+ * freed on entry crashed on garbage pointers; a misused destination now only leaks, which
+ * LeakSanitizer reports under make asan.) To copy into a state that owns arrays, use
+ * cdem_state_assign. Copying a state onto itself does nothing. On failure dst is empty. */
 cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *err);
+
+/* Replaces the contents of dst, which must be initialised or zeroed ({0}), by a copy of src:
+ * dst's arrays are released first. For reusing one destination in a loop. */
+cdem_status cdem_state_assign(cdem_state *dst, const cdem_state *src, cdem_error *err);
 
 /* Map from element id to index, for matching elements across increments. */
 typedef struct {

@@ -140,6 +140,7 @@ static void write_mode(FILE *f, const cdem_params *p, const cdem_model *m) {
 cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
                               long n_wall_elements, int elements_estimated, char **text,
                               cdem_error *err) {
+    /* n_elements: free elements; n_wall_elements: wall, fault and other boundary elements */
     if (text)
         *text = NULL;
     if (!p || !m || !text)
@@ -152,12 +153,17 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
 
     fprintf(f, "cdem-c model summary\n");
 
+    /* One count everywhere (docs/format.md, "Counting"): the elements stored in increment 0,
+     * after the boundary mode has added its fault elements; the progress line and
+     * cdem-strain info count the same. */
     heading(f, "Elements");
-    line(f, "internal elements", "%ld%s", n_elements,
+    line(f, "elements", "%ld in increment 0%s", n_elements + n_wall_elements,
          elements_estimated ? " (estimated from the packing density; the exact count is known "
                               "once the assembly is generated)"
-                            : "");
-    line(f, "wall elements", "%ld%s", n_wall_elements, elements_estimated ? " (estimated)" : "");
+                            : " (escaping, eroded and deposited elements change it later)");
+    line(f, "free elements", "%ld%s", n_elements, elements_estimated ? " (estimated)" : "");
+    line(f, "wall and fault elements", "%ld%s", n_wall_elements,
+         elements_estimated ? " (estimated)" : "");
 
     heading(f, "Model dimensions");
     line(f, "assembly", "%g x %g units = %.6g x %.6g m", p->width, p->height, m->width_m,
@@ -219,8 +225,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     else
         line(f, "display interval", "%g m = %.6g time steps", p->display_interval,
              m->display_steps);
-    line(f, "equilibration", "%d increments", m->n_increments_equil);
-    line(f, "total", "%d increments", m->n_increments_total);
+    /* increments are numbered 0..N and the file holds N + 1 of them (0 = before equilibration) */
+    line(f, "increments", "%d, numbered 0..%d", m->n_increments_total + 1, m->n_increments_total);
+    line(f, "end of equilibration", "increment %d", m->n_increments_equil);
 
     write_mode(f, p, m);
 

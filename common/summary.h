@@ -9,10 +9,12 @@
 #include "model.h"
 #include "params.h"
 
-/* n_elements: the element count of the generated assembly (internal elements), or an
- * estimate when elements_estimated is 1 (the text then says so). */
-cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
-                              long n_wall_elements, int elements_estimated, char **text,
+/* n_free and n_boundary: the free (integrated) elements and the wall, fault and other
+ * boundary elements of increment 0, i.e. of the assembly after the boundary mode has added
+ * its elements (cdem_run_count_elements); their sum is "the element count" everywhere
+ * (docs/format.md, "Counting"). Estimates when elements_estimated is 1 (the text says so). */
+cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_free,
+                              long n_boundary, int elements_estimated, char **text,
                               cdem_error *err);
 
 #endif

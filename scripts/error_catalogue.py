@@ -29,7 +29,8 @@ GROUPS = [  # (title, source files, what to do)
      "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
      "`keep_constants = off` at small unit scaling or use the default constants; "
      "\"settling > displacement\" gives the display_interval and equilibration that work."),
-    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c"],
+    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c", "common/xdmf.c",
+                           "common/outfile.c"],
      "The file is not a cdem file, is truncated (a run killed while writing: re-run it), of "
      "another format version (re-run with this cdem-run), or the increment/dataset asked for "
      "does not exist (`cdem-strain info RUN.h5` lists the increments). A file left open by a "
@@ -38,7 +39,8 @@ GROUPS = [  # (title, source files, what to do)
      "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
      "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "
      "(modelforces_N.txt); docs/formats-text.md."),
-    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/analysis.c", "analysis/strain.c",
+    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/cmd_basic.c",
+      "analysis/analysis.c", "analysis/strain.c",
       "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "analysis/cellgrid.c",
       "analysis/biaxial.c", "analysis/repose.c", "analysis/mohr.c", "analysis/qexport.c", "analysis/sspx.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "

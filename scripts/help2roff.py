@@ -6,10 +6,11 @@ committed page differs from what it generates.
 usage: help2roff.py BUILD_DIR OUT_DIR     writes OUT_DIR/cdem-run.1 and OUT_DIR/cdem-strain.1
 
 The pages depend only on the programs' help output and VERSION (no dates), so they are
-reproducible. Layout of a page: NAME, SYNOPSIS (the usage lines), DESCRIPTION (the help's
-prose), OPTIONS or COMMANDS (two-space indented '-x'/'name' rows with their continuation
-lines), per-command usage of cdem-strain's render, mohr, repose and plot-series, EXIT
-STATUS, FILES, SEE ALSO.
+reproducible. The help layout is the one common/cli_help.h describes: usage forms, prose
+paragraphs, headed lists ("Commands:", "Options:") of two-space indented rows, notes,
+"Exit status: ...". Page layout: NAME, SYNOPSIS, DESCRIPTION, COMMANDS (cdem-strain),
+OPTIONS, one subsection per command with its own usage, description and options
+(`cdem-strain help COMMAND`), EXIT STATUS, NOTES, FILES, SEE ALSO.
 """
 import os
 import re
@@ -20,7 +21,6 @@ NAMES = {
     "cdem-run": "simulate a 2-D discrete element model of a tectonic structure",
     "cdem-strain": "analyse, render and export cdem-run results (displacement, strain, stress, pictures)",
 }
-SUBCOMMAND_HELP = ["render", "mohr", "repose", "plot-series"]
 
 
 def esc(text):
@@ -30,85 +30,99 @@ def esc(text):
 
 
 def run_help(prog, *args):
-    p = subprocess.run([prog, *args, "--help"], capture_output=True, text=True,
+    p = subprocess.run([prog, *args], capture_output=True, text=True,
                        env=dict(os.environ, LC_ALL="C"))
-    return (p.stdout + p.stderr).rstrip("\n")
+    if p.returncode != 0 or p.stderr:
+        sys.exit(f"help2roff: {prog} {' '.join(args)} exited {p.returncode}: {p.stderr}")
+    return p.stdout.rstrip("\n")
 
 
-def paragraphs(text):
+def blocks(text):
+    """Blank-line separated blocks of lines."""
     out, cur = [], []
-    lines = text.split("\n")
-    for i, line in enumerate(lines):
-        nxt = lines[i + 1] if i + 1 < len(lines) else ""
-        if line.startswith("Exit status") and cur:
-            out.append(cur); cur = []
+    for line in text.split("\n"):
         if line.strip():
             cur.append(line.rstrip())
-        elif line and nxt.startswith("  ") and cur:
-            continue  # a whitespace-only argument line inside an indented block
         elif cur:
-            out.append(cur); cur = []
+            out.append(cur)
+            cur = []
     if cur:
         out.append(cur)
     return out
 
 
-def rows(par):
-    """Two-space indented rows '  key   text' with deeper-indented continuation lines."""
+def rows(lines):
+    """Two-space indented rows 'key   text' with deeper-indented continuation lines."""
     items = []
-    cols = [m.start(2) for m in (re.match(r"^  (\S.*?)\s{2,}(\S.*)$", l) for l in par) if m]
-    col = max(set(cols), key=cols.count) if cols else 0
-    for line in par:
-        m = re.match(r"^  (\S.*?)(?:\s{2,}(\S.*))?$", line)
-        if m and not m.group(2) and col and len(line) > col and line[col - 1] == " ":
-            items.append([line[2:col].strip(), [line[col:].strip()]])
-            continue
-        if m and not line.startswith("   "):
+    for line in lines:
+        if re.match(r"^  \S", line):
+            m = re.match(r"^  (\S.*?)(?:\s{2,}(\S.*))?$", line)
             items.append([m.group(1), [m.group(2)] if m.group(2) else []])
         elif items:
             items[-1][1].append(line.strip())
     return items
 
 
+def parse(text):
+    """The parts of one help text: synopsis lines, description paragraphs, headed row
+    lists, notes paragraphs, exit status."""
+    bs = blocks(text)
+    usage = [re.sub(r"^(usage: |       )", "", l) for l in bs[0]]
+    desc, lists, notes, status = [], [], [], None
+    seen_list = False
+    for b in bs[1:]:
+        if b[0].startswith("Exit status: "):
+            status = " ".join(l.strip() for l in b)[len("Exit status: "):]
+        elif b[0].endswith(":") and not b[0].startswith(" "):
+            lists.append((b[0][:-1], rows(b[1:])))
+            seen_list = True
+        else:
+            (notes if seen_list else desc).append(b)
+    return usage, desc, lists, notes, status
+
+
+def prose(pars):
+    r = []
+    for p in pars:
+        if p[0].startswith(" "):
+            r += [".PP", ".nf"] + [esc(l) for l in p] + [".fi"]
+        else:
+            r += [".PP", esc(" ".join(l.strip() for l in p))]
+    return r
+
+
+def row_list(items):
+    r = []
+    for key, lines in items:
+        r += [".TP", f"\\fB{esc(key)}\\fR", esc(" ".join(lines))]
+    return r
+
+
 def page(name, prog, version):
-    text = run_help(prog)
-    pars = paragraphs(text)
+    usage, desc, lists, notes, status = parse(run_help(prog, "--help"))
     r = [f'.TH {name.upper()} 1 "cdem-c {version}" "cdem-c {version}" "User Commands"',
          ".SH NAME", f"{name} \\- {esc(NAMES[name])}", ".SH SYNOPSIS", ".nf"]
-    r += [esc(l) for l in pars[0]] + [".fi"]
-    body = pars[1:]
-    desc = [p for p in body if not p[0].startswith("  ") and not p[0].endswith(":")
-            and not p[0].startswith("Exit status")]
-    opts = [p for p in body if p[0].startswith("  ")]
-    cmds = [p for p in body if p[0].endswith(":")]
-    tail = [p for p in body if p[0].startswith("Exit status")]
+    r += [esc(l) for l in usage] + [".fi"]
     if desc:
-        r.append(".SH DESCRIPTION")
-        for p in desc:
-            r += [".PP", esc(" ".join(l.strip() for l in p))]
-    for p in opts:
-        r.append(".SH OPTIONS")
-        for key, lines in rows(p):
-            r += [".TP", f"\\fB{esc(key)}\\fR", esc(" ".join(lines))]
-    for p in cmds:
-        r.append(f".SH {p[0].rstrip(':').upper()}")
-        for key, lines in rows(p[1:]):
-            r += [".TP", f"\\fB{esc(key)}\\fR"]
-            r += [esc(lines[0]) if lines else "", ".br"] + [esc(l) for l in lines[1:]]
-            if r[-1] == ".br":
-                r.pop()
-    if name == "cdem-strain":
-        r.append(".SH COMMAND OPTIONS")
-        for sub in SUBCOMMAND_HELP:
-            h = [l for l in run_help(prog, sub).split("\n")
-                 if l.strip() and not l.endswith(": help")]
-            r += [".SS " + sub, ".nf"] + [esc(l) for l in h] + [".fi"]
-    for p in tail:
-        lines = " ".join(l.strip() for l in p)
-        status, _, rest = lines.partition(". ")
-        r += [".SH EXIT STATUS", esc(status.replace("Exit status: ", "") + ".")]
-        if rest:
-            r += [".SH NOTES", esc(rest)]
+        r += [".SH DESCRIPTION"] + prose(desc)
+    commands = []
+    for heading, items in lists:
+        r += [f".SH {heading.upper()}"] + row_list(items)
+        if heading == "Commands":
+            commands = [k for k, _ in items]
+    if commands:
+        r.append(".SH COMMAND USAGE AND OPTIONS")
+        for cmd in commands:
+            cu, cd, cl, cn, _ = parse(run_help(prog, "help", cmd))
+            r += [f".SS {esc(cmd)}", ".nf"] + [esc(l) for l in cu] + [".fi"]
+            r += prose(cd)
+            for heading, items in cl:
+                r += [".PP", f"{esc(heading)}:", ".RS"] + row_list(items) + [".RE"]
+            r += prose(cn)
+    if status:
+        r += [".SH EXIT STATUS", esc(status)]
+    if notes:
+        r += [".SH NOTES"] + prose(notes)
     r += [".SH FILES",
           "Parameter files are INI files (\\fBcdem\\-run \\-\\-print\\-defaults\\fR writes a complete one);",
           "results are HDF5 files with an .xmf sidecar for ParaView (docs/format.md).",

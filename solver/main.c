@@ -11,6 +11,7 @@
 #include "params.h"
 #include "run.h"
 #include "summary.h"
+#include "cli_help.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -34,40 +35,54 @@ static void on_signal(int sig) {
     stop_requested = 1;
 }
 
-static const char usage_text[] =
-    "usage: cdem-run [MODEL.ini] [-o OUT.h5] [-s section.key=value]... [-q] [--summary]\n"
-    "                [--dry-run] [--print-defaults] [--params-markdown] [--max-steps N]\n"
-    "                [--ignore-free-space]\n"
-    "                [--version] [-h|--help]\n"
-    "       cdem-run --resume RUN.h5 [-q] [--max-steps N]\n"
-    "\n"
-    "Simulates a 2-D discrete element model and writes every display increment to an HDF5\n"
-    "file. Without MODEL.ini the built-in default model is used (the paper's Figure 7A:\n"
-    "10 x 5 km, planar normal fault dipping 30 degrees).\n"
-    "\n"
-    "  -o OUT.h5            output file (default: MODEL's base name with .h5 in the current\n"
-    "                       directory, or cdem-default.h5 without a model file)\n"
-    "  -s section.key=value override one parameter (repeatable; applied after the file)\n"
-    "  -q                   quiet: no summary, no progress\n"
-    "  --summary            validate, print the model summary and exit\n"
-    "  --dry-run            as --summary, then say that nothing was simulated\n"
-    "  --print-defaults     print a complete commented parameter file of the effective\n"
-    "                       values (defaults + file + overrides) and exit\n"
-    "  --params-markdown    print the parameter table in markdown (docs/parameters.md)\n"
-    "  --max-steps N        stop after N time steps (tests, benchmarks)\n"
-    "  --resume RUN.h5      continue a stopped or killed run from its newest checkpoint\n"
-    "                       (output.checkpoint_interval); the parameters come from the\n"
-    "                       file, so MODEL.ini, -s and -o are refused; the result is\n"
-    "                       bit-identical to an uninterrupted run\n"
-    "  --par-min N          run loops of N or more items on several threads (default\n"
-    "                       16384; results are identical for any N and thread count)\n"
-    "  --ignore-free-space  run even when the output directory has less free space than\n"
-    "                       the estimated file size\n"
-    "  --version            print the version and exit\n"
-    "  -h, --help           print this help and exit\n"
-    "\n"
-    "Exit status: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM).\n"
-    "Parameters, ranges and rules: docs/parameters.md.\n";
+/* The help text, option table and synopsis of cdem-run (cli_help.h): --help prints it, the
+ * man page and the bash completion are generated from it, and tests/test_help.c checks that
+ * every option in it appears in the synopsis and is accepted by parse_args. */
+static const char *const run_forms[] = {
+    "[MODEL.ini|-] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
+    "[--print-defaults] [--params-markdown] [--max-steps N] [--par-min N] "
+    "[--ignore-free-space]",
+    "--resume RUN.h5 [-q] [--max-steps N] [--par-min N]", "-V|--version | -h|--help", NULL};
+
+static const cdem_cli_option run_options[] = {
+    {"-o", "OUT.h5",
+     "output file (default: MODEL's base name with .h5 in the current directory, or "
+     "cdem-default.h5 without a model file); an XDMF sidecar OUT.xmf is written next to it"},
+    {"-s", "section.key=value", "override one parameter (repeatable; applied after the file)"},
+    {"-q, --quiet", NULL, "quiet: no summary, no progress"},
+    {"--summary", NULL, "validate, print the model summary and exit"},
+    {"--dry-run", NULL, "as --summary, then say that nothing was simulated"},
+    {"--print-defaults", NULL,
+     "print a complete commented parameter file of the effective values (defaults + file + "
+     "overrides) and exit"},
+    {"--params-markdown", NULL, "print the parameter table in markdown (docs/parameters.md)"},
+    {"--max-steps", "N",
+     "stop after N time steps (tests, benchmarks); the file records \"stopped-early\""},
+    {"--resume", "RUN.h5",
+     "continue a stopped or killed run from its newest checkpoint "
+     "(output.checkpoint_interval); the parameters come from the file, so MODEL.ini, -s and "
+     "-o are refused; the result is bit-identical to an uninterrupted run"},
+    {"--par-min", "N",
+     "run loops of N or more items on several threads (default 16384; results are "
+     "identical for any N and thread count)"},
+    {"--ignore-free-space", NULL,
+     "run even when the output directory has less free space than the estimated file size"},
+    {"-V, --version", NULL, "print the version and exit"},
+    {NULL, NULL, NULL}};
+
+static const cdem_cli_help run_help = {
+    .program = "cdem-run",
+    .forms = run_forms,
+    .about = "Simulates a 2-D discrete element model and writes every display increment to an "
+             "HDF5 file. Without MODEL.ini the built-in default model is used (the paper's "
+             "Figure 7A: 10 x 5 km, planar normal fault dipping 30 degrees); '-' reads the "
+             "parameter file from standard input (default output stdin.h5).",
+    .options = run_options,
+    .notes = "Ctrl-C (SIGINT) or SIGTERM stops the run cleanly after the current step; the "
+             "file stays valid and 'cdem-run --resume RUN.h5' continues it. Parameters, "
+             "ranges and rules: docs/parameters.md; the user guide: docs/guide.md.",
+    .exit_status = "0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM).",
+};
 
 /* Prints a possibly multi-line message with the program prefix on every line. */
 static void print_error(const char *msg) {
@@ -112,7 +127,7 @@ static int parse_args(int argc, char **argv, cli_args *a) {
         const char *arg = argv[i];
         if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             a->help = 1;
-        } else if (strcmp(arg, "--version") == 0) {
+        } else if (strcmp(arg, "--version") == 0 || strcmp(arg, "-V") == 0) {
             a->version = 1;
         } else if (strcmp(arg, "-q") == 0 || strcmp(arg, "--quiet") == 0) {
             a->quiet = 1;
@@ -167,10 +182,13 @@ static int parse_args(int argc, char **argv, cli_args *a) {
     return EXIT_OK;
 }
 
-/* "dir/fault.ini" -> "fault.h5" (in the current directory). */
+/* "dir/fault.ini" -> "fault.h5" (in the current directory); "-" (standard input) ->
+ * "stdin.h5". */
 static char *default_output(const char *model_path) {
     if (!model_path)
         return strdup("cdem-default.h5");
+    if (!strcmp(model_path, "-"))
+        return strdup("stdin.h5");
     const char *base = strrchr(model_path, '/');
     base = base ? base + 1 : model_path;
     const char *dot = strrchr(base, '.');
@@ -202,6 +220,38 @@ static char *stored_params_text(const cdem_params *p, const cli_args *a, char *f
     cdem_params_write(p, f);
     fclose(f);
     return buf;
+}
+
+/* The whole of standard input (a parameter file), malloc'd into *text. */
+static cdem_status read_stdin(char **text, cdem_error *err) {
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        size_t got = fread(buf + len, 1, cap - 1 - len, stdin);
+        len += got;
+        if (got == 0)
+            break;
+        if (len + 1 == cap) {
+            char *nb = cap < ((size_t)64 << 20) ? realloc(buf, cap * 2) : NULL;
+            if (!nb) {
+                free(buf);
+                return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                                 "standard input: more than 64 MiB or out of memory; not a "
+                                 "parameter file");
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    if (!buf)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading standard input");
+    if (ferror(stdin)) {
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "error reading the parameters from standard input");
+    }
+    buf[len] = '\0';
+    *text = buf;
+    return CDEM_OK;
 }
 
 static void install_handlers(void) {
@@ -261,7 +311,7 @@ int main(int argc, char **argv) {
         return rc;
     }
     if (a.help) {
-        fputs(usage_text, stdout);
+        cdem_cli_help_print(stdout, &run_help);
         free(a.overrides);
         return EXIT_OK;
     }
@@ -290,8 +340,14 @@ int main(int argc, char **argv) {
     char *summary = NULL;
     rc = EXIT_ERROR;
 
-    if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK)
+    if (a.model_path && !strcmp(a.model_path, "-")) {
+        /* "-": the parameter file on standard input (generated or piped parameters) */
+        if (read_stdin(&file_text, &err) != CDEM_OK ||
+            cdem_params_parse_text(&p, file_text, "standard input", &err) != CDEM_OK)
+            goto fail;
+    } else if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK) {
         goto fail;
+    }
     for (int i = 0; i < a.n_overrides; i++)
         if (cdem_params_override(&p, a.overrides[i], &err) != CDEM_OK)
             goto fail;
@@ -302,7 +358,10 @@ int main(int argc, char **argv) {
     }
     if (cdem_params_validate(&p, &err) != CDEM_OK) {
         fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
-                a.model_path ? a.model_path : "", a.model_path ? ": " : "");
+                !a.model_path               ? ""
+                : strcmp(a.model_path, "-") ? a.model_path
+                                            : "standard input",
+                a.model_path ? ": " : "");
         goto fail;
     }
     cdem_model m;

@@ -28,6 +28,7 @@
 #include "summary.h"
 
 #include <limits.h>
+#include <sys/stat.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,6 +71,7 @@ struct cdem_run_ctx {
     cdem_sediment sed;          /* syn-tectonic sedimentation (disabled when off) */
     long k_def;                 /* deformation steps applied by the mode (settling excluded) */
     int finished;               /* 1 once the stop reason is recorded (completed/stopped-early) */
+    const char *stop_kind;      /* "completed", "stopped-early", "interrupted" once recorded */
     int ckpt_off;               /* 1 when the file layer cannot store checkpoints */
 };
 typedef struct cdem_run_ctx run_ctx;
@@ -103,7 +105,9 @@ static int phase_of(const run_ctx *r, long step) {
     return cdem_sediment_settling(&r->sed, step) ? CDEM_PHASE_SETTLING : CDEM_PHASE_DEFORMATION;
 }
 
-static void progress(run_ctx *r, int force) {
+/* The progress line; ending NULL: "N s left", else the text that replaces it on the last
+ * line ("completed", "stopped early", "interrupted"), so a run never ends on a time left. */
+static void progress_line(run_ctx *r, int force, const char *ending) {
     if (!logging(r))
         return;
     const double t = now_s();
@@ -113,14 +117,19 @@ static void progress(run_ctx *r, int force) {
     const double left = rate > 0.0 ? (double)(total - r->step) / rate : 0.0;
     const double net = cdem_bc_net_displacement(&r->bc);
     const int inc_done = r->next_inc - 1;
+    char tail[64];
+    if (ending)
+        snprintf(tail, sizeof tail, "%s after %.0f s", ending, elapsed);
+    else
+        snprintf(tail, sizeof tail, "%.0f s left", left);
     if (r->opt->progress_is_tty) {
         if (!force && t - r->t_last_log < 0.25)
             return;
         fprintf(r->opt->log,
-                "\r\033[K%s, increment %d/%d, net displacement %.1f m, %zu elements, %.0f "
-                "steps/s, %.0f s left",
+                "\r\033[K%s, increment %d (0..%d), net displacement %.1f m, %zu elements, %.0f "
+                "steps/s, %s",
                 phase_name(phase_of(r, r->step)), inc_done, r->m.n_increments_total, net, r->s.n,
-                rate, left);
+                rate, tail);
         fflush(r->opt->log);
         r->tty_line_open = 1;
     } else {
@@ -128,14 +137,18 @@ static void progress(run_ctx *r, int force) {
         if (!force && r->step - r->last_log_step < tenth && t - r->t_last_log < 30.0)
             return;
         fprintf(r->opt->log,
-                "cdem-run: %s, step %ld/%ld, increment %d/%d, net displacement %.1f m, %zu "
-                "elements, %.0f steps/s, %.0f s left\n",
+                "cdem-run: %s, step %ld/%ld, increment %d (0..%d), net displacement %.1f m, %zu "
+                "elements, %.0f steps/s, %s\n",
                 phase_name(phase_of(r, r->step)), r->step, total, inc_done, r->m.n_increments_total,
-                net, r->s.n, rate, left);
+                net, r->s.n, rate, tail);
         fflush(r->opt->log);
         r->last_log_step = r->step;
     }
     r->t_last_log = t;
+}
+
+static void progress(run_ctx *r, int force) {
+    progress_line(r, force, NULL);
 }
 
 /* 24 pre-growth layers of equal thickness between the lowest and highest free-element
@@ -258,9 +271,19 @@ static cdem_status write_sample(run_ctx *r, cdem_error *err) {
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;
 }
 
+/* The element count of increment 0 (docs/format.md, "Counting"): free elements and the
+ * rest (walls, fault ramps, mylar, footwall display), after the mode has added its own. */
+static void count_kinds(const cdem_state *s, long *n_free, long *n_boundary) {
+    *n_free = *n_boundary = 0;
+    for (size_t i = 0; i < s->n; i++)
+        ++*((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? n_boundary : n_free);
+}
+
 static cdem_status make_summary(run_ctx *r, cdem_error *err) {
     char *text = NULL;
-    CDEM_TRY(cdem_summary_text(r->p, &r->m, r->info.n_internal, r->info.n_wall, 0, &text, err));
+    long n_free, n_boundary;
+    count_kinds(&r->s, &n_free, &n_boundary);
+    CDEM_TRY(cdem_summary_text(r->p, &r->m, n_free, n_boundary, 0, &text, err));
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
@@ -363,6 +386,20 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     r->t_start = r->t_last_log = now_s();
     r->last_written_step = -1;
     return CDEM_OK;
+}
+
+/* "; continue it with: cdem-run --resume FILE" when the file holds a checkpoint to continue
+ * from, else why it cannot be continued; "" without a file. */
+static void resume_hint(const run_ctx *r, char *buf, size_t cap) {
+    buf[0] = '\0';
+    if (!r->opt->output_path)
+        return;
+    if (!r->ckpt_off && r->p->checkpoint_interval > 0)
+        snprintf(buf, cap, "; continue it with: cdem-run --resume %s", r->opt->output_path);
+    else
+        snprintf(buf, cap,
+                 "; it cannot be continued (no checkpoints: output.checkpoint_interval = %d)",
+                 r->p->checkpoint_interval);
 }
 
 /* A fresh run: creates the file, computes the first forces, writes increment 0. */
@@ -551,15 +588,18 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
             set_erosion_level(r);
             cdem_sediment_begin(&r->sed, &r->s);
             long made = cdem_integrator_make_cohesive(&r->it, &r->s);
-            if (logging(r) && !opt->progress_is_tty)
+            end_progress_line(r); /* on a terminal the line is kept above the progress line */
+            if (logging(r))
                 fprintf(opt->log, "cdem-run: end of equilibration at step %ld: %ld %s created\n",
                         step, made,
                         p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
         }
         const long settled = cdem_sediment_after_step(&r->sed, &r->it, &r->s, step);
-        if (settled > 0 && logging(r) && !opt->progress_is_tty)
+        if (settled > 0 && logging(r)) {
+            end_progress_line(r);
             fprintf(opt->log, "cdem-run: end of settling at step %ld: %ld %s created\n", step,
                     settled, p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
+        }
         if (step % interval == 0)
             CDEM_TRY(write_sample(r, err));
         while (r->next_inc <= r->m.n_increments_total && step >= r->next_inc_step) {
@@ -601,8 +641,11 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
                      total, phase_name(phase_of(r, step)), r->next_inc - 1);
             if (r->w)
                 CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "interrupted", detail, err));
-            return CDEM_FAIL(err, CDEM_ERR_INTERRUPTED, "%s; the file %s is valid", detail,
-                             opt->output_path ? opt->output_path : "(none)");
+            r->stop_kind = "interrupted";
+            char how[CDEM_PATH_MAX + 160];
+            resume_hint(r, how, sizeof how);
+            return CDEM_FAIL(err, CDEM_ERR_INTERRUPTED, "%s; the file %s is valid%s", detail,
+                             opt->output_path ? opt->output_path : "(none)", how);
         }
         if (opt->max_steps > 0 && step >= opt->max_steps && step < total) {
             if (r->last_written_step != step)
@@ -613,6 +656,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
             if (r->w)
                 CDEM_TRY(cdem_h5_writer_set_stop_reason(r->w, "stopped-early", detail, err));
             r->finished = 1;
+            r->stop_kind = "stopped-early";
             return CDEM_OK;
         }
     }
@@ -625,6 +669,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
              "%ld steps, %d increments, %ld escaping elements removed, %ld eroded", r->step,
              r->next_inc - 1, r->removed, r->eroded);
     r->finished = 1;
+    r->stop_kind = "completed";
     return r->w ? cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err) : CDEM_OK;
 }
 
@@ -693,13 +738,40 @@ long cdem_run_total_steps(const cdem_run_ctx *r) {
     return r ? r->m.total_steps : 0;
 }
 
+/* The last line of a run's log: the file, its size, the increments it holds and how the run
+ * ended, with how to continue one that stopped early. */
+static void log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
+    if (!logging(r) || !had_writer || !r->opt->output_path)
+        return;
+    struct stat sb;
+    const double mb = stat(r->opt->output_path, &sb) == 0 ? (double)sb.st_size / 1e6 : NAN;
+    const char *how = st == CDEM_OK && r->stop_kind ? r->stop_kind
+                      : st == CDEM_ERR_INTERRUPTED  ? "interrupted"
+                      : st == CDEM_ERR_NUMERIC      ? "numerical-failure"
+                      : st == CDEM_ERR_IO           ? "write-failure"
+                                                    : "error";
+    char hint[CDEM_PATH_MAX + 160] = "";
+    if (st == CDEM_OK && r->stop_kind && !strcmp(r->stop_kind, "stopped-early"))
+        resume_hint(r, hint, sizeof hint);
+    fprintf(r->opt->log,
+            "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "
+            "stop reason: %s%s)\n",
+            r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, how, hint);
+}
+
 cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
     if (!r)
         return st;
     if (logging(r)) {
-        progress(r, 1);
+        const char *ending = st == CDEM_OK && r->stop_kind && !strcmp(r->stop_kind, "stopped-early")
+                                 ? "stopped early"
+                             : st == CDEM_OK              ? "completed"
+                             : st == CDEM_ERR_INTERRUPTED ? "interrupted"
+                                                          : "failed";
+        progress_line(r, 1, ending);
         end_progress_line(r);
     }
+    const int had_writer = r->w != NULL;
     if (r->w) {
         if (st == CDEM_ERR_NUMERIC && err) {
             /* the numbers behind "time step too large": what a user can change */
@@ -728,6 +800,9 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
         cdem_status cst = cdem_h5_writer_close(r->w, st == CDEM_OK ? err : &e3);
         if (st == CDEM_OK)
             st = cst;
+        r->w = NULL;
+        if (cst == CDEM_OK)
+            log_wrote(r, st, had_writer);
     }
     run_release(r);
     return st;
@@ -809,5 +884,29 @@ cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_count_elements: NULL parameters");
     cdem_model m;
     CDEM_TRY(cdem_model_derive(p, &m, err));
-    return cdem_assembly_count(p, &m, n_internal, n_wall, err);
+    /* the assembly as the run builds it, with the mode's elements (fault ramps, ...) */
+    cdem_state st = {0};
+    cdem_assembly_info info;
+    cdem_bc bc;
+    memset(&bc, 0, sizeof bc);
+    cdem_status s = cdem_state_init(&st, 1024, 0, err);
+    if (s == CDEM_OK)
+        s = cdem_assembly_build(p, &m, &st, &info, err);
+    int bc_made = 0;
+    if (s == CDEM_OK) {
+        s = cdem_bc_init(&bc, p, &m, &st, err);
+        bc_made = s == CDEM_OK;
+    }
+    long n_free = 0, n_boundary = 0;
+    if (s == CDEM_OK)
+        count_kinds(&st, &n_free, &n_boundary);
+    if (bc_made)
+        cdem_bc_free(&bc);
+    cdem_state_free(&st);
+    CDEM_TRY(s);
+    if (n_internal)
+        *n_internal = n_free;
+    if (n_wall)
+        *n_wall = n_boundary;
+    return CDEM_OK;
 }

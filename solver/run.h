@@ -62,8 +62,10 @@ long cdem_run_current_step(const cdem_run_ctx *r);
 long cdem_run_total_steps(const cdem_run_ctx *r);
 cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err);
 
-/* Counts the elements of the assembly the parameters generate (internal and wall), for the
- * summary; generates the packing but does not run it. */
+/* Counts the elements of increment 0 of the run the parameters describe: free elements and
+ * wall, fault and other boundary elements, the latter including those the boundary mode
+ * adds (docs/format.md, "Counting"), for the summary; builds the packing and the mode but
+ * does not run them. */
 cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long *n_wall,
                                     cdem_error *err);
 

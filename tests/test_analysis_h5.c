@@ -11,6 +11,7 @@
 #include "analysis.h"
 #include "analysis_fixtures.h"
 #include "cdem2d.h"
+#include "cmd_render.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -178,6 +179,11 @@ static void test_analysis_h5_cdem2d_import(void **state) {
         if (s->id[i] == 0)
             assert_near(v[i], 2 * (5.0 + 0.02 * 100.0), 1e-5);
     free(v);
+    /* the picture label gives what the folder gives: the increment number, no displacement
+     * (issue 18: "Net displacement 0.0 m" on every increment) */
+    char label[256];
+    cdem_render_increment_label(a, 3, label, sizeof label);
+    assert_string_equal(label, "Increment 3");
     cdem_analysis_close(a);
     cdem_cdem2d_meta_free(&meta);
     for (int k = 0; k < 4; k++)

@@ -163,12 +163,12 @@ static void test_cli_summary_and_dry_run(void **state) {
     assert_int_equal(run(c, "--summary"), 0);
     char *out = slurp(c, "out.txt");
     assert_has(out, "cdem-c model summary");
-    assert_has(out, "282 increments");
+    assert_has(out, "283, numbered 0..282");
     assert_null(strstr(out, "dry run"));
     free(out);
     assert_int_equal(run(c, "--dry-run -q"), 0);
     out = slurp(c, "out.txt");
-    assert_has(out, "56 increments");
+    assert_has(out, "end of equilibration:        increment 56");
     assert_has(out, "dry run: nothing simulated");
     free(out);
     char args[1200];
@@ -192,7 +192,7 @@ static void test_cli_usage_errors_and_info(void **state) {
     assert_int_equal(run(c, "-o"), 2);
     assert_int_equal(run(c, "--help"), 0);
     char *out = slurp(c, "out.txt");
-    assert_has(out, "usage: cdem-run [MODEL.ini]");
+    assert_has(out, "usage: cdem-run [MODEL.ini|-]");
     free(out);
     assert_int_equal(run(c, "--version"), 0);
     out = slurp(c, "out.txt");
@@ -201,6 +201,24 @@ static void test_cli_usage_errors_and_info(void **state) {
     assert_int_equal(run(c, "/nonexistent/x.ini"), 1);
     err = slurp(c, "err.txt");
     assert_has(err, "cdem-run: /nonexistent/x.ini: cannot open parameter file");
+    free(err);
+}
+
+/* "cdem-run -": the parameter file on standard input (issue 18 item 8); errors name it. */
+static void test_cli_parameters_from_stdin(void **state) {
+    cli_ctx *c = *state;
+    write_file(c, "piped.ini", "[boundary]\nfault_dip = 45\n");
+    char args[2400];
+    snprintf(args, sizeof args, "- --print-defaults < '%s/piped.ini'", c->tmp);
+    assert_int_equal(run(c, args), 0);
+    char *out = slurp(c, "out.txt");
+    assert_has(out, "fault_dip = 45");
+    free(out);
+    write_file(c, "bad.ini", "[physics]\ngravity = 40\n");
+    snprintf(args, sizeof args, "- --summary < '%s/bad.ini'", c->tmp);
+    assert_int_equal(run(c, args), 1);
+    char *err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: standard input:2: gravity = 40");
     free(err);
 }
 
@@ -213,8 +231,68 @@ static void test_cli_params_markdown(void **state) {
     free(out);
 }
 
+/* One element count and one increment count everywhere (issue 18: the summary said 2091 +
+ * 405 = 2496 elements and 282 increments, the progress line and cdem-strain info 2523 and
+ * 283): the summary's "elements ... in increment 0" is the element count of increment 0 in
+ * the file, its "increments: K, numbered 0..L" is what info and the final log line say, and
+ * the progress line counts the same elements. A planar fault run: its mode adds fault-ramp
+ * elements after the packing. */
+static void test_cli_counts_agree(void **state) {
+    cli_ctx *c = *state;
+    char args[2400];
+    snprintf(args, sizeof args,
+             "-s assembly.height=2.5 -s time.equilibration=100 -s time.runtime=130 "
+             "-s time.display_interval=10 -o '%s/counts.h5'",
+             c->tmp);
+    assert_int_equal(run(c, args), 0);
+    char *out = slurp(c, "out.txt"), *err = slurp(c, "err.txt");
+    long elements = -1, free_el = -1, boundary = -1;
+    int k = -1, last = -1, equil = -1;
+    const char *at = strstr(out, "  elements:");
+    assert_non_null(at);
+    assert_int_equal(sscanf(at, "  elements: %ld in increment 0", &elements), 1);
+    assert_int_equal(sscanf(strstr(out, "  free elements:"), "  free elements: %ld", &free_el), 1);
+    assert_int_equal(sscanf(strstr(out, "  wall and fault elements:"),
+                            "  wall and fault elements: %ld", &boundary),
+                     1);
+    assert_int_equal(elements, free_el + boundary);
+    assert_int_equal(
+        sscanf(strstr(out, "  increments:"), "  increments: %d, numbered 0..%d", &k, &last), 2);
+    assert_int_equal(k, last + 1);
+    assert_int_equal(sscanf(strstr(out, "  end of equilibration:"),
+                            "  end of equilibration: increment %d", &equil),
+                     1);
+    /* the progress lines of equilibration (nothing has escaped yet) */
+    char want[256];
+    snprintf(want, sizeof want, " (0..%d), net displacement 0.0 m, %ld elements", last, elements);
+    assert_has(err, want);
+    snprintf(want, sizeof want, "; %d increments, numbered 0..%d;", k, last);
+    assert_has(err, want);
+    free(err);
+    free(out);
+    /* cdem-strain info on the file */
+    char cmd[4400];
+    snprintf(cmd, sizeof cmd, "'%.*scdem-strain' info '%s/counts.h5' > '%s/info.txt'",
+             (int)(strrchr(c->bin, '/') - c->bin + 1), c->bin, c->tmp, c->tmp);
+    assert_int_equal(system(cmd), 0);
+    char *info = slurp(c, "info.txt");
+    snprintf(want, sizeof want,
+             "increments: %d, numbered 0..%d (end of equilibration: increment %d)", k, last, equil);
+    assert_has(info, want);
+    long n0 = -1;
+    const char *row = strstr(info, "\n        0 ");
+    assert_non_null(row);
+    char phase[32];
+    long long step;
+    double time, net;
+    assert_int_equal(sscanf(row, " %*d %lld %lf %31s %lf %ld", &step, &time, phase, &net, &n0), 5);
+    assert_int_equal(n0, elements);
+    free(info);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_cli_counts_agree, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_print_defaults_round_trip, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_override_visible_in_print_defaults, setup,
                                         teardown),
@@ -223,6 +301,7 @@ int main(void) {
         cmocka_unit_test_setup_teardown(test_cli_summary_and_dry_run, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_usage_errors_and_info, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_params_markdown, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_parameters_from_stdin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

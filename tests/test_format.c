@@ -1115,6 +1115,11 @@ static void test_format_size_of_default_run(void **state) {
     assert_int_equal(s.n, 2271);
     assert_true(s.x[2000] != (double)(float)s.x[2000]);
     cdem_state_free(&s);
+    cdem_series_sample *smp = NULL; /* docs/format.md quotes these counts */
+    size_t ns = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);
+    assert_int_equal(ns, 1132);
+    free(smp);
     cdem_h5_reader_close(r);
     remove_pair(path);
     long stressed = write_synthetic_run(path, 1);
@@ -1128,17 +1133,8 @@ static void test_format_size_of_default_run(void **state) {
 
 /* ------------------------------------------------------------------ xdmf */
 
-static void test_format_xmf_sidecar(void **state) {
-    (void)state;
-    char path[1024], xmf[1100];
-    tmp_file(path, sizeof path, "side&car.h5"); /* '&' must be escaped in the XML */
-    snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(path) - 3), path);
-    write_small(path, 3, 1);
-    char cmd[2400];
-    snprintf(cmd, sizeof cmd, "xmllint --noout '%s'", xmf);
-    assert_int_equal(system(cmd), 0);
-
-    FILE *f = fopen(xmf, "r");
+static char *read_text_file(const char *path) {
+    FILE *f = fopen(path, "r");
     assert_non_null(f);
     fseek(f, 0, SEEK_END);
     long len = ftell(f);
@@ -1146,25 +1142,163 @@ static void test_format_xmf_sidecar(void **state) {
     char *text = calloc((size_t)len + 1, 1);
     assert_true(fread(text, 1, (size_t)len, f) == (size_t)len);
     fclose(f);
-    assert_non_null(strstr(text, "CollectionType=\"Temporal\""));
-    assert_non_null(strstr(text, "GeometryType=\"X_Y\""));
-    assert_non_null(strstr(text, "TopologyType=\"Polyvertex\""));
-    assert_non_null(strstr(text, "ItemType=\"HyperSlab\""));
-    /* increment 0 has no stress, increment 1 has */
-    char *g0 = strstr(text, "increment_000000"), *g1 = strstr(text, "increment_000001");
-    char *g2 = strstr(text, "increment_000002");
-    assert_true(g0 && g1 && g2 && g0 < g1 && g1 < g2);
-    char *sxx = strstr(text, ":/increments/sxx");
-    assert_true(sxx && sxx > g1 && sxx < g2);
+    return text;
+}
 
-    hid_t h5 = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    assert_true(h5 >= 0);
+/* The number in the name of the Grid that encloses p. */
+static int grid_number_at(const char *text, const char *p) {
+    while (p > text && strncmp(p, "increment_", 10) != 0)
+        p--;
+    return atoi(p + 10);
+}
+
+/* Increment `number` of path, loaded by the reader. */
+static void load_number(cdem_h5_reader *r, int number, cdem_state *st) {
+    char spec[16];
+    size_t idx = 0;
+    cdem_error err;
+    snprintf(spec, sizeof spec, "%d", number);
+    assert_int_equal(cdem_h5_reader_find_increment(r, spec, &idx, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_load_increment(r, idx, st, NULL, &err), CDEM_OK);
+}
+
+/* The XDMF 3 sidecar (ParaView's default readers, issue 18): every heavy data item is an
+ * HDF5 reference with its hyperslab in the text and the NumberType/Precision of the dataset
+ * it names (VTK's Xdmf3 reader types an array from the reference before reading; HyperSlab
+ * and X_Y items have no type and crashed ParaView 5.11); the geometry is XY from the n x 2
+ * view /increments/xy, whose rows are the increment's (x, y); the topology is a HyperSlab of
+ * one shared inline vertex list. ParaView itself reads it in make validate. */
+static void check_xdmf3(const char *xmf, const char *path, int increments, int stressed) {
+    char cmd[2400];
+    /* well-formed, and the XInclude of the vertex list resolves */
+    snprintf(cmd, sizeof cmd, "xmllint --noout --xinclude '%s'", xmf);
+    assert_int_equal(system(cmd), 0);
+    char *text = read_text_file(xmf);
+    assert_non_null(strstr(text, "<Xdmf Version=\"3.0\""));
+    assert_non_null(strstr(text, "CollectionType=\"Temporal\""));
+    assert_null(strstr(text, "GeometryType=\"X_Y\""));
+    assert_null(strstr(text, "ItemType=\"Function\""));
     const char *base = strrchr(path, '/') + 1;
     char escaped[1100] = "";
     for (const char *c = base; *c; c++)
         strcat(escaped, *c == '&' ? "&amp;" : (char[2]){*c, 0});
-    /* Every hyperslab (start 1 count) selects rows of the referenced dataset that exist,
-     * and the rows it selects hold the increment's values. */
+    hid_t h5 = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(h5 >= 0);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    int items = 0, geometries = 0;
+    for (char *p = strstr(text, "Format=\"HDF\">"); p; p = strstr(p + 1, "Format=\"HDF\">")) {
+        char *tag = p;
+        while (tag > text && strncmp(tag, "<DataItem", 9) != 0)
+            tag--;
+        char number_type[16] = "";
+        int precision = 0;
+        long long dim0 = 0, dim1 = 0;
+        int ndims = sscanf(strstr(tag, "Dimensions=\"") + 12, "%lld %lld", &dim0, &dim1);
+        assert_int_equal(sscanf(strstr(tag, "NumberType=\"") + 12, "%15[A-Za-z]", number_type), 1);
+        assert_int_equal(sscanf(strstr(tag, "Precision=\"") + 11, "%d", &precision), 1);
+        char ref[1024];
+        char *content = p + 13, *close = strstr(content, "</DataItem>");
+        snprintf(ref, sizeof ref, "%.*s", (int)(close - content), content);
+        char *bar = strchr(ref, '|'), *colon = strstr(ref, ":/");
+        assert_true(bar && colon && colon < bar);
+        *colon = *bar = '\0';
+        assert_string_equal(ref, escaped); /* relative reference to the .h5 next to it */
+        const char *obj = colon + 1;
+        hid_t ds = H5Dopen2(h5, obj, H5P_DEFAULT);
+        if (ds < 0)
+            fail_msg("%s references %s, which %s lacks", xmf, obj, path);
+        hid_t sp = H5Dget_space(ds), ty = H5Dget_type(ds);
+        hsize_t ext[2] = {0, 0};
+        const int rank = H5Sget_simple_extent_dims(sp, ext, NULL);
+        /* the number type is the dataset's, as the Xdmf3 reader asks for it */
+        const char *want = H5Tget_class(ty) == H5T_FLOAT     ? "Float"
+                           : H5Tget_sign(ty) == H5T_SGN_NONE ? "UInt"
+                                                             : "Int";
+        if (strcmp(number_type, want) != 0 || (size_t)precision != H5Tget_size(ty))
+            fail_msg("%s: %s is %s %d in the sidecar, %s %zu in the file", xmf, obj, number_type,
+                     precision, want, H5Tget_size(ty));
+        /* start:stride:count:dataspace, one number per dimension */
+        long long start = -1, stride = -1, count = -1, space = -1, s1 = 0, t1 = 0, c1 = 0, d1 = 0;
+        if (rank == 2) {
+            assert_int_equal(sscanf(bar + 1, "%lld %lld:%lld %lld:%lld %lld:%lld %lld", &start, &s1,
+                                    &stride, &t1, &count, &c1, &space, &d1),
+                             8);
+            assert_true(s1 == 0 && t1 == 1 && c1 == 2 && d1 == 2 && ndims == 2 && dim1 == 2);
+            assert_string_equal(obj, "/increments/xy");
+            geometries++;
+        } else {
+            assert_int_equal(rank, 1);
+            assert_int_equal(
+                sscanf(bar + 1, "%lld:%lld:%lld:%lld", &start, &stride, &count, &space), 4);
+            assert_int_equal(ndims, 1);
+        }
+        assert_int_equal(stride, 1);
+        assert_int_equal(count, dim0);
+        assert_true(space <= (long long)ext[0] && start + count <= space);
+        if (rank == 2) { /* the view's rows are the increment's positions */
+            cdem_state st = {0};
+            load_number(r, grid_number_at(text, p), &st);
+            assert_int_equal((long long)st.n, count);
+            double *xy = malloc((size_t)count * 2 * sizeof *xy);
+            hsize_t hs[2] = {(hsize_t)start, 0}, hc[2] = {(hsize_t)count, 2};
+            hid_t ms = H5Screate_simple(2, hc, NULL);
+            H5Sselect_hyperslab(sp, H5S_SELECT_SET, hs, NULL, hc, NULL);
+            assert_true(H5Dread(ds, H5T_NATIVE_DOUBLE, ms, sp, H5P_DEFAULT, xy) >= 0);
+            for (long long i = 0; i < count; i++)
+                assert_true(xy[2 * i] == st.x[i] && xy[2 * i + 1] == st.y[i]);
+            H5Sclose(ms);
+            free(xy);
+            cdem_state_free(&st);
+        }
+        H5Tclose(ty);
+        H5Sclose(sp);
+        H5Dclose(ds);
+        items++;
+    }
+    /* every grid: a vertex topology over its n points from the shared list 0..N-1 */
+    int topologies = 0;
+    for (char *p = strstr(text, "<Topology"); p; p = strstr(p + 1, "<Topology")) {
+        long long n = -1, start = -1, stride = -1, count = -1;
+        assert_int_equal(sscanf(strstr(p, "NumberOfElements=\"") + 18, "%lld", &n), 1);
+        char *sel = strstr(p, "Format=\"XML\">");
+        assert_int_equal(sscanf(sel + 13, "%lld %lld %lld", &start, &stride, &count), 3);
+        assert_true(start == 0 && stride == 1 && count == n);
+        assert_true(strstr(p, "xpointer(/Xdmf/Domain/DataItem[@Name=&quot;vertices&quot;])") <
+                    strstr(p, "</Topology>"));
+        topologies++;
+    }
+    char *list = strstr(text, "<DataItem Name=\"vertices\"");
+    assert_non_null(list);
+    long long nv = 0, v, expect = 0;
+    assert_int_equal(sscanf(strstr(list, "Dimensions=\"") + 12, "%lld", &nv), 1);
+    for (char *q = strchr(list, '>') + 1; sscanf(q, "%lld", &v) == 1; expect++) {
+        assert_true(v == expect);
+        q += strspn(q, " \n");
+        q += strspn(q, "0123456789");
+    }
+    assert_true(expect == nv);
+    cdem_h5_reader_close(r);
+    assert_int_equal(topologies, increments);
+    assert_int_equal(geometries, increments);
+    /* (xy) and 5 attributes per increment, 3 more with stress */
+    assert_int_equal(items, increments * 6 + 3 * stressed);
+    H5Fclose(h5);
+    free(text);
+}
+
+/* The XDMF 2 flavour (cdem-strain xdmf --xdmf2; legacy readers): HyperSlabs of the ragged
+ * datasets, X_Y geometry. */
+static void check_xdmf2(const char *xmf, const char *path, int increments, int stressed) {
+    char cmd[2400];
+    snprintf(cmd, sizeof cmd, "xmllint --noout '%s'", xmf);
+    assert_int_equal(system(cmd), 0);
+    char *text = read_text_file(xmf);
+    assert_non_null(strstr(text, "GeometryType=\"X_Y\""));
+    assert_non_null(strstr(text, "TopologyType=\"Polyvertex\""));
+    hid_t h5 = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(h5 >= 0);
     cdem_h5_reader *r = NULL;
     cdem_error err;
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
@@ -1173,20 +1307,16 @@ static void test_format_xmf_sidecar(void **state) {
          p = strstr(p + 1, "<DataItem ItemType=\"HyperSlab\"")) {
         long long start = -1, stride = -1, count = -1;
         char *sel = strstr(p, "Format=\"XML\">");
-        assert_non_null(sel);
         assert_int_equal(sscanf(sel + 13, "%lld %lld %lld", &start, &stride, &count), 3);
         assert_int_equal(stride, 1);
         assert_int_equal(strtol(strstr(p, "Dimensions=\"") + 12, NULL, 10), count);
         char *hdf = strstr(sel, "Format=\"HDF\">");
-        assert_non_null(hdf);
         long total = strtol(strstr(sel + 20, "Dimensions=\"") + 12, NULL, 10);
-        char *open_end = strchr(hdf, '>'), *close = strstr(hdf, "</DataItem>");
+        char *close = strstr(hdf, "</DataItem>");
         char ref[512];
-        snprintf(ref, sizeof ref, "%.*s", (int)(close - open_end - 1), open_end + 1);
+        snprintf(ref, sizeof ref, "%.*s", (int)(close - hdf - 13), hdf + 13);
         char *colon = strstr(ref, ":/");
         assert_non_null(colon);
-        *colon = '\0';
-        assert_string_equal(ref, escaped); /* relative reference to the .h5 next to it */
         const char *obj = colon + 1;
         hid_t ds = H5Dopen2(h5, obj, H5P_DEFAULT);
         if (ds < 0)
@@ -1194,20 +1324,10 @@ static void test_format_xmf_sidecar(void **state) {
         hid_t sp = H5Dget_space(ds);
         hsize_t n = 0;
         H5Sget_simple_extent_dims(sp, &n, NULL);
-        assert_int_equal((long)n, total);
-        assert_true(start + count <= (long long)n);
+        assert_true(total <= (long)n && start + count <= total);
         if (!strcmp(obj, "/increments/x")) {
-            /* the grid's increment: the number in the enclosing Grid name */
-            char *g = p;
-            while (g > text && strncmp(g, "increment_", 10) != 0)
-                g--;
-            int number = atoi(g + 10);
-            size_t idx = 0;
-            char spec[16];
-            snprintf(spec, sizeof spec, "%d", number);
-            assert_int_equal(cdem_h5_reader_find_increment(r, spec, &idx, &err), CDEM_OK);
             cdem_state st = {0};
-            assert_int_equal(cdem_h5_reader_load_increment(r, idx, &st, NULL, &err), CDEM_OK);
+            load_number(r, grid_number_at(text, p), &st);
             double *vals = malloc((size_t)count * sizeof *vals);
             hsize_t hs = (hsize_t)start, hc = (hsize_t)count;
             hid_t ms = H5Screate_simple(1, &hc, NULL);
@@ -1224,14 +1344,65 @@ static void test_format_xmf_sidecar(void **state) {
         items++;
     }
     cdem_h5_reader_close(r);
-    /* 3 increments x (x, y, radius, layer, id, flags, born) + stress in increment 1. */
-    assert_int_equal(items, 3 * 7 + 3);
+    assert_int_equal(items, increments * 7 + 3 * stressed);
     H5Fclose(h5);
+    free(text);
+}
+
+static void test_format_xmf_sidecar(void **state) {
+    (void)state;
+    char path[1024], xmf[1100];
+    tmp_file(path, sizeof path, "side&car.h5"); /* '&' must be escaped in the XML */
+    snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(path) - 3), path);
+    write_small(path, 3, 1); /* stress in increment 1 */
+    check_xdmf3(xmf, path, 3, 1);
+    char *text = read_text_file(xmf);
+    char *g1 = strstr(text, "increment_000001"), *g2 = strstr(text, "increment_000002");
+    char *sxx = strstr(text, ":/increments/sxx|");
+    assert_true(g1 && g2 && sxx && sxx > g1 && sxx < g2);
     free(text);
     /* No temp file is left behind. */
     char tmp[1200];
     snprintf(tmp, sizeof tmp, "%s.tmp", xmf);
     assert_int_equal(access(tmp, F_OK), -1);
+
+    /* cdem-strain xdmf: the same sidecar rebuilt from the file, both flavours; a sidecar in
+     * another folder names the file by its absolute path */
+    cdem_error err;
+    int written = 0;
+    char other[1300];
+    snprintf(other, sizeof other, "%s.again.xmf", path);
+    assert_int_equal(cdem_h5_write_xdmf(path, other, 3, &written, &err), CDEM_OK);
+    assert_int_equal(written, 3);
+    char *a = read_text_file(xmf), *b = read_text_file(other);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    assert_int_equal(cdem_h5_write_xdmf(path, other, 2, &written, &err), CDEM_OK);
+    assert_int_equal(written, 2);
+    check_xdmf2(other, path, 3, 1);
+    remove(other);
+    char folder[1200];
+    snprintf(folder, sizeof folder, "%s.d", path);
+    assert_int_equal(mkdir(folder, 0777), 0);
+    snprintf(other, sizeof other, "%s/elsewhere.xmf", folder);
+    assert_int_equal(cdem_h5_write_xdmf(path, other, 3, &written, &err), CDEM_OK);
+    char *c = read_text_file(other);
+    char absref[1200];
+    char *real = realpath(path, NULL);
+    assert_non_null(real);
+    snprintf(absref, sizeof absref, ">%s:/increments/xy|", real);
+    free(real);
+    char *amp = strchr(absref, '&'); /* escaped in the XML */
+    if (amp) {
+        memmove(amp + 5, amp + 1, strlen(amp + 1) + 1);
+        memcpy(amp, "&amp;", 5);
+    }
+    assert_non_null(strstr(c, absref));
+    free(c);
+    remove(other);
+    rmdir(folder);
+    assert_int_equal(cdem_h5_write_xdmf(path, NULL, 7, &written, &err), CDEM_ERR_INVALID);
     remove_pair(path);
 }
 

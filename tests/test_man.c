@@ -122,10 +122,16 @@ static void test_man_lists_every_option_and_command(void **state) {
     char *run_page = slurp("man/cdem-run.1"), *strain_page = slurp("man/cdem-strain.1");
     assert_non_null(run_page);
     assert_non_null(strain_page);
-    const char *options[] = {
-        "\\-o OUT.h5",         "\\-s section.key=value", "\\-\\-summary",
-        "\\-\\-dry\\-run",     "\\-\\-print\\-defaults", "\\-\\-params\\-markdown",
-        "\\-\\-max\\-steps N", "\\-\\-version"};
+    const char *options[] = {"\\-o OUT.h5",
+                             "\\-s section.key=value",
+                             "\\-\\-summary",
+                             "\\-\\-dry\\-run",
+                             "\\-\\-print\\-defaults",
+                             "\\-\\-params\\-markdown",
+                             "\\-\\-max\\-steps N",
+                             "\\-\\-version",
+                             "\\-\\-par\\-min N",
+                             "\\-V"};
     for (size_t i = 0; i < sizeof options / sizeof options[0]; i++)
         if (!strstr(run_page, options[i]))
             fail_msg("man/cdem-run.1 lacks option %s", options[i]);
@@ -140,12 +146,19 @@ static void test_man_lists_every_option_and_command(void **state) {
                               "render",
                               "plot\\-series",
                               "mohr",
-                              "repose"};
+                              "repose",
+                              "wedge",
+                              "plot\\-csv",
+                              "help"};
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++) {
         char row[128];
         snprintf(row, sizeof row, ".TP\n\\fB%s\\fR\n", commands[i]);
         if (!strstr(strain_page, row))
             fail_msg("man/cdem-strain.1 lacks command %s", commands[i]);
+        /* and a subsection with the command's own usage and options */
+        snprintf(row, sizeof row, ".SS %s\n.nf\ncdem\\-strain %s", commands[i], commands[i]);
+        if (!strstr(strain_page, row))
+            fail_msg("man/cdem-strain.1 lacks the usage of command %s", commands[i]);
     }
     /* the render options come from `cdem-strain render --help` */
     assert_non_null(strstr(strain_page, "\\-\\-above\\-tenth\\-max"));
@@ -171,8 +184,61 @@ static void test_man_detects_a_stale_page(void **state) {
     assert_null(compare_page(page, page, msg, sizeof msg));
 }
 
+/* The bash completion is generated from the same help texts (make completion) and must not
+ * be stale; and it completes: command words, a command's options, quantity names after
+ * --color, the words of a choice list, cdem-run's options (issue 18: generated from the
+ * option tables). */
+static void test_man_completion_fresh_and_working(void **state) {
+    man_ctx *c = *state;
+    char cmd[4400], generated[2100], msg[2400];
+    snprintf(generated, sizeof generated, "%s/cdem-c.bash", c->tmp);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 scripts/help2completion.py '%s' '%s' 2>&1",
+             c->build, generated);
+    assert_int_equal(run(cmd), 0);
+    const char *err = compare_page("completion/cdem-c.bash", generated, msg, sizeof msg);
+    if (err)
+        fail_msg("%s (run `make completion`)", err);
+    static const struct {
+        const char *words; /* COMP_WORDS, the last one being completed */
+        const char *want;  /* what COMPREPLY must hold, space-separated */
+    } cases[] = {
+        {"cdem-strain ren", "render"},
+        {"cdem-strain render run.h5 --col", "--color --colour --color-walls --colour-walls "
+                                            "--color-layers --colour-layers"},
+        {"cdem-strain render run.h5 --color total-max-s", "total-max-shear"},
+        {"cdem-strain render run.h5 --vectors ''", "incr total"},
+        {"cdem-strain compute run.h5 --format ''", "csv h5"},
+        {"cdem-strain help plot", "plot-series plot-csv"},
+        {"cdem-strain info run.h5 --j", "--json"},
+        {"cdem-run --par", "--params-markdown --par-min"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char out[2048];
+        snprintf(out, sizeof out, "%s/reply.txt", c->tmp);
+        snprintf(cmd, sizeof cmd,
+                 "bash -c 'source completion/cdem-c.bash; COMP_WORDS=(%s); "
+                 "COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); "
+                 "case ${COMP_WORDS[0]} in cdem-run) _cdem_run;; *) _cdem_strain;; esac; "
+                 "echo \"${COMPREPLY[*]}\"' > '%s'",
+                 cases[i].words, out);
+        /* the words go through the shell: '' stands for an empty word */
+        char *quoted = strstr(cmd, "''");
+        if (quoted)
+            memcpy(quoted, "\"\"", 2);
+        assert_int_equal(run(cmd), 0);
+        char *reply = slurp(out);
+        assert_non_null(reply);
+        reply[strcspn(reply, "\n")] = '\0';
+        if (strcmp(reply, cases[i].want) != 0)
+            fail_msg("completing '%s' gave '%s', expected '%s'", cases[i].words, reply,
+                     cases[i].want);
+        free(reply);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_man_completion_fresh_and_working, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_pages_match_help, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_lists_every_option_and_command, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_detects_a_stale_page, setup, teardown),

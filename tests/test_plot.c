@@ -138,6 +138,7 @@ static void write_series_file(const char *path) {
                                   .time = 10.0 * k,
                                   .kinetic_energy = (double)k * k,
                                   .n_elements = 1,
+                                  .axial_strain = 0.002 * k,
                                   .sea_level = NAN};
         assert_int_equal(cdem_h5_writer_append_series(w, &smp, &err), CDEM_OK);
     }
@@ -207,6 +208,22 @@ static void test_plot_series_command_draws_the_line(void **state) {
     assert_int_equal(cdem_cmd_plot_series(6, argv3), 1);
     char *argv4[] = {"plot-series", h5, "--y", "contacts"};
     assert_int_equal(cdem_cmd_plot_series(4, argv4), 2);
+    /* any column as x (issue 18: --x axial_strain was refused): the stress-strain layout */
+    char *argv7[] = {"plot-series", h5,        "--y", "kinetic_energy", "--x", "axial_strain", "-o",
+                     png,           "--width", "800", "--height",       "500"};
+    assert_int_equal(cdem_cmd_plot_series(12, argv7), 0);
+    img = cairo_image_surface_create_from_png(png);
+    assert_int_equal(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+    for (int k = 0; k < NS; k++)
+        x[k] = 0.002 * k;
+    p.fix_y = 0;
+    assert_int_equal(cdem_plot_layout_compute(&p, 0, 0, 800, 500, &lay, &err), CDEM_OK);
+    cdem_plot_to_device(&lay, 0.012, 36.0, &dx, &dy); /* sample k = 6 */
+    on = pixel(img, dx, dy);
+    assert_true((on & 255) > ((on >> 16) & 255) + 60);
+    cairo_surface_destroy(img);
+    char *argv8[] = {"plot-series", h5, "--y", "contacts", "--x", "nonsense", "-o", pdf};
+    assert_int_equal(cdem_cmd_plot_series(8, argv8), 2);
 }
 
 /* fontconfig, which cairo's text uses, keeps a process-lifetime configuration that only

@@ -53,7 +53,7 @@ static void test_qexport_h5_round_trip(void **st) {
     snprintf(path, sizeof path, "%s/qexport_%d.h5", tmp ? tmp : "/tmp", (int)getpid());
     cdem_qexport_h5 *h;
     assert_int_equal(cdem_qexport_h5_create(path, q, &h, &err), CDEM_OK);
-    assert_int_equal(cdem_qexport_h5_write(h, 282, &s, v, &err), CDEM_OK);
+    assert_int_equal(cdem_qexport_h5_write(h, 282, 1234.5, &s, v, &err), CDEM_OK);
     assert_int_equal(cdem_qexport_h5_close(h, &err), CDEM_OK);
     hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     assert_true(file >= 0);

@@ -126,16 +126,31 @@ static void test_render_cli_all_increments(void **state) {
     assert_int_equal(run(cmd, out, sizeof out), 0);
     DIR *d = opendir(dir);
     assert_non_null(d);
+    /* numbers zero-padded to the width of the last one, so the names sort in increment
+     * order (issue 18: fr0, fr1, fr10 sorted fr10 before fr2) */
+    char first[64];
+    const int width = snprintf(NULL, 0, "%d", g_increments - 1);
+    snprintf(first, sizeof first, "inc%0*d.png", width, 0);
+    assert_true(width >= 2); /* the run has 10 increments or more: padding is exercised */
     int count = 0, has_first = 0;
     for (struct dirent *e; (e = readdir(d));) {
-        if (!strncmp(e->d_name, "inc", 3) && strstr(e->d_name, ".png"))
+        if (!strncmp(e->d_name, "inc", 3) && strstr(e->d_name, ".png")) {
             count++;
-        if (!strcmp(e->d_name, "inc0.png"))
+            assert_int_equal(strlen(e->d_name), strlen(first));
+        }
+        if (!strcmp(e->d_name, first))
             has_first = 1;
     }
     closedir(d);
     assert_int_equal(count, g_increments);
     assert_true(has_first);
+    /* into a folder that does not exist yet, two levels deep */
+    snprintf(cmd, sizeof cmd,
+             "'%s' render '%s' --increment all --width 100 -o '%s/album/a' --prefix fr", g_strain,
+             g_run, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    snprintf(dir, sizeof dir, "%s/album/a/fr%0*d.png", g_tmp, width, g_increments - 1);
+    assert_int_equal(access(dir, R_OK), 0);
 }
 
 static int gif_frames(const char *path) {

@@ -142,7 +142,9 @@ static void test_run_stops_early_and_on_signal(void **st) {
     cdem_params p = small_params();
     cdem_error err;
     cdem_run_options o = quiet_options(path);
-    o.max_steps = 300;
+    cdem_model m;
+    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    o.max_steps = m.equil_steps + 40; /* just past the end of equilibration */
     /* on a tty: one line redrawn in place (carriage return, erase line) */
     char *logbuf = NULL;
     size_t loglen = 0;
@@ -156,6 +158,21 @@ static void test_run_stops_early_and_on_signal(void **st) {
     assert_non_null(strstr(logbuf, "steps/s"));
     assert_null(strstr(logbuf, "cdem-run: equilibration, step")); /* no plain log lines */
     assert_int_equal(logbuf[loglen - 1], '\n');                   /* line closed at the end */
+    /* the end-of-equilibration line is not overdrawn by the progress line (issue 18) */
+    assert_non_null(strstr(logbuf, "\ncdem-run: end of equilibration at step "));
+    /* the last progress line says how the run ended, not a time left */
+    const char *last = strrchr(logbuf, '\r');
+    assert_non_null(last);
+    assert_non_null(strstr(last, "stopped early after "));
+    assert_null(strstr(last, " s left"));
+    /* and the final line names the file, its size and how to continue */
+    char want[1200];
+    snprintf(want, sizeof want, "cdem-run: wrote %s (", path);
+    assert_non_null(strstr(last, want));
+    assert_non_null(strstr(last, " MB; "));
+    snprintf(want, sizeof want,
+             "stop reason: stopped-early; continue it with: cdem-run --resume %s)\n", path);
+    assert_non_null(strstr(last, want));
     free(logbuf);
     o.quiet = 1;
     o.log = NULL;
@@ -166,7 +183,7 @@ static void test_run_stops_early_and_on_signal(void **st) {
     assert_int_equal(
         cdem_h5_reader_increment_info(r, cdem_h5_reader_increment_count(r) - 1, &info, &err),
         CDEM_OK);
-    assert_int_equal(info.step, 300);
+    assert_int_equal(info.step, o.max_steps);
     cdem_h5_reader_close(r);
 
     volatile sig_atomic_t flag = 1; /* as if SIGINT arrived before the first step */
@@ -174,6 +191,9 @@ static void test_run_stops_early_and_on_signal(void **st) {
     o.stop_requested = &flag;
     assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_INTERRUPTED);
     assert_non_null(strstr(err.msg, "stopped by a signal after step 1"));
+    char resume[1200]; /* the message says how to continue */
+    snprintf(resume, sizeof resume, "continue it with: cdem-run --resume %s", path);
+    assert_non_null(strstr(err.msg, resume));
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
     assert_string_equal(cdem_h5_reader_stop_reason(r), "interrupted");
     assert_int_equal(cdem_h5_reader_increment_count(r), 2); /* start + final */

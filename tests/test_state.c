@@ -159,7 +159,7 @@ static void test_state_copy_is_deep(void **state) {
     cdem_state c;
     assert_int_equal(cdem_state_init(&c, 2, 0, &err), CDEM_OK);
     fill(&c, 2);
-    assert_int_equal(cdem_state_copy(&b, &c, &err), CDEM_OK);
+    assert_int_equal(cdem_state_assign(&b, &c, &err), CDEM_OK);
     assert_int_equal(b.n, 2);
     assert_int_equal(b.has_stress, 0);
     assert_null(b.sxx);
@@ -169,6 +169,30 @@ static void test_state_copy_is_deep(void **state) {
     cdem_state_free(&a);
     cdem_state_free(&b);
     cdem_state_free(&c);
+}
+
+/* The destination of a copy is an output: an uninitialised variable (here: garbage bytes,
+ * as on the stack) must not be read or freed. Before the fix, cdem_state_copy freed the
+ * destination's pointers, and a test that copied into an uninitialised `cdem_state before;`
+ * crashed make asan depending on what the stack held. */
+static void test_state_copy_into_uninitialised_destination(void **state) {
+    (void)state;
+    cdem_state a, garbage;
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&a, 4, 1, &err), CDEM_OK);
+    fill(&a, 5);
+    memset(&garbage, 0xA5, sizeof garbage); /* pointers 0xA5A5...: freeing them aborts */
+    assert_int_equal(cdem_state_copy(&garbage, &a, &err), CDEM_OK);
+    assert_int_equal(garbage.n, 5);
+    assert_int_equal(garbage.has_stress, 1);
+    assert_true(garbage.x[4] == a.x[4] && garbage.id[4] == a.id[4]);
+    /* assign reuses an initialised destination without leaking (LeakSanitizer checks) */
+    for (int k = 0; k < 3; k++)
+        assert_int_equal(cdem_state_assign(&garbage, &a, &err), CDEM_OK);
+    assert_int_equal(cdem_state_assign(&garbage, &garbage, &err), CDEM_OK);
+    assert_int_equal(garbage.n, 5);
+    cdem_state_free(&garbage);
+    cdem_state_free(&a);
 }
 
 static void test_state_id_map_finds_slots(void **state) {
@@ -209,6 +233,7 @@ int main(void) {
         cmocka_unit_test(test_state_enable_stress_later),
         cmocka_unit_test(test_state_compact_keeps_order),
         cmocka_unit_test(test_state_copy_is_deep),
+        cmocka_unit_test(test_state_copy_into_uninitialised_destination),
         cmocka_unit_test(test_state_id_map_finds_slots),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

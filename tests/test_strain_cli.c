@@ -131,7 +131,49 @@ static void test_strain_cli_compute_csv(void **state) {
     H5Gget_info(g, &gi);
     assert_int_equal(gi.nlinks, NINC);
     H5Gclose(g);
+    /* every group has the n x 2 view of x and y for the XDMF 3 sidecar */
+    hid_t xy = H5Dopen2(f, "increments/000006/xy", H5P_DEFAULT);
+    assert_true(xy >= 0);
+    H5Dclose(xy);
     H5Fclose(f);
+    /* ... and the file its own sidecar (issue 18), which names it and resolves */
+    char xmf[1300], text[65536];
+    snprintf(xmf, sizeof xmf, "%s/q.xmf", g_tmp);
+    snprintf(cmd, sizeof cmd, "xmllint --noout --xinclude %s && cat %s", xmf, xmf);
+    assert_int_equal(run(cmd, text, sizeof text), 0);
+    assert_non_null(strstr(text, ">q.h5:/increments/000006/xy|0 0:1 1:"));
+    assert_non_null(strstr(text, "<Attribute Name=\"cum-max-shear\""));
+    assert_non_null(strstr(text, "<Grid Name=\"increment_000006\""));
+}
+
+/* cdem-strain xdmf: a renamed run file gets a sidecar naming it (issue 18: renaming the pair
+ * broke the old one); --xdmf2 writes the legacy flavour; files that are neither a run nor a
+ * compute file are refused. ParaView itself reads these in make validate. */
+static void test_strain_cli_xdmf(void **state) {
+    (void)state;
+    char cmd[8192], out[65536];
+    snprintf(cmd, sizeof cmd, "cp %s %s/renamed.h5 && %s xdmf %s/renamed.h5", g_run, g_tmp, g_exe,
+             g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    char want[1300];
+    snprintf(want, sizeof want, "%s/renamed.xmf\n", g_tmp);
+    assert_string_equal(out, want);
+    snprintf(cmd, sizeof cmd,
+             "xmllint --noout --xinclude %s/renamed.xmf && grep -c "
+             "'>renamed.h5:/increments/xy|' %s/renamed.xmf",
+             g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(atoi(out), NINC);
+    snprintf(cmd, sizeof cmd,
+             "%s xdmf %s/renamed.h5 --xdmf2 -o %s/legacy.xdmf2 && grep -c "
+             "'GeometryType=\"X_Y\"' %s/legacy.xdmf2",
+             g_exe, g_tmp, g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_non_null(strstr(out, "legacy.xdmf2\n"));
+    assert_int_equal(atoi(strchr(out, '\n') + 1), NINC);
+    snprintf(cmd, sizeof cmd, "echo text > %s/not.h5 && %s xdmf %s/not.h5", g_tmp, g_exe, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "not.h5"));
 }
 
 static void test_strain_cli_element_limits_info(void **state) {
@@ -167,6 +209,17 @@ static void test_strain_cli_exports_and_import(void **state) {
     }
     snprintf(path, sizeof path, "%s/mod1.txt", g_tmp);
     assert_int_not_equal(access(path, R_OK), 0);
+    /* a folder that does not exist yet (two levels) is created (issue 18) */
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-4 %s/new/sspx", g_exe, g_run,
+             g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    snprintf(path, sizeof path, "%s/new/sspx/cdem4.txt", g_tmp);
+    assert_int_equal(access(path, R_OK), 0);
+    /* but not for a bad range: nothing is created then */
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-99 %s/never", g_exe, g_run, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    snprintf(path, sizeof path, "%s/never", g_tmp);
+    assert_int_not_equal(access(path, F_OK), 0);
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(cmd, sizeof cmd,
              "%s import-cdem2d %s/cdem2d_basic -o %s/imp.h5 && %s compute "
@@ -176,6 +229,17 @@ static void test_strain_cli_exports_and_import(void **state) {
     /* element 0 starts at (100, 100) and moves 5 + 0.02 y = 7 m per increment; the end of
      * equilibration is increment 1, so at increment 3 it sits at x = 121 with u = 14 m */
     assert_non_null(strstr(out, "\n0,121.000000,100.000000,14\n"));
+    /* info of an imported run: no step, time or displacement invented (issue 18) */
+    snprintf(cmd, sizeof cmd, "%s info %s/imp.h5", g_exe, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    int number, elements;
+    char step[16], time[16], phase[32], net[16];
+    const char *row = strstr(out, "\n        3 ");
+    assert_non_null(row);
+    assert_int_equal(
+        sscanf(row, "%d %15s %15s %31s %15s %d", &number, step, time, phase, net, &elements), 6);
+    assert_string_equal(net, "-");
+    assert_string_equal(step, "-");
 }
 
 static void test_strain_cli_export_biaxial(void **state) {
@@ -230,6 +294,47 @@ static void test_strain_cli_export_biaxial(void **state) {
     assert_int_equal(rows, 12);
 }
 
+/* series (CSV of /series) and info --json (issue 18 item 8): checked against the file by
+ * Debian's python (h5py, json). */
+static void test_strain_cli_series_and_json(void **state) {
+    (void)state;
+    char cmd[8192], out[65536];
+    snprintf(cmd, sizeof cmd, "%s/biax.h5", g_tmp); /* written by the export-biaxial test */
+    if (access(cmd, R_OK) != 0)
+        skip();
+    snprintf(
+        cmd, sizeof cmd,
+        "%s series %s/biax.h5 -o %s/series.csv && /usr/bin/python3 -c '"
+        "import csv, h5py, math, sys\n"
+        "rows = list(csv.DictReader(open(sys.argv[1])))\n"
+        "f = h5py.File(sys.argv[2], \"r\")\n"
+        "cols = list(f[\"series\"])\n"
+        "assert sorted(rows[0]) == sorted(cols), (sorted(rows[0]), cols)\n"
+        "assert len(rows) == len(f[\"series/step\"])\n"
+        "for c in cols:\n"
+        "    for r, v in zip(rows, f[\"series/\" + c][:]):\n"
+        "        assert (math.isnan(v) and r[c] == \"nan\") or float(r[c]) == v, (c, r[c], v)\n"
+        "print(len(rows))' %s/series.csv %s/biax.h5",
+        g_exe, g_tmp, g_tmp, g_tmp, g_tmp);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_int_equal(atoi(out), 12);
+    snprintf(cmd, sizeof cmd,
+             "%s info %s --json | /usr/bin/python3 -c '"
+             "import json, sys\n"
+             "d = json.load(sys.stdin)\n"
+             "assert d[\"increment_count\"] == len(d[\"increments\"]) == %d\n"
+             "assert d[\"first_increment\"] == 0 and d[\"last_increment\"] == %d\n"
+             "assert d[\"end_of_equilibration\"] == 2 and d[\"stop_reason\"] == \"completed\"\n"
+             "assert d[\"summary\"] == \"CLI test summary\"\n"
+             "i = d[\"increments\"][4]\n"
+             "assert i[\"phase\"] == \"deformation\" and i[\"net_displacement\"] == 10.0\n"
+             "assert i[\"sea_level\"] is None and i[\"has_stress\"] is False\n"
+             "print(\"ok\")'",
+             g_exe, g_run, NINC, NINC - 1);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_string_equal(out, "ok\n");
+}
+
 static void test_strain_cli_errors(void **state) {
     (void)state;
     char cmd[8192], out[8192];
@@ -244,6 +349,20 @@ static void test_strain_cli_errors(void **state) {
     snprintf(cmd, sizeof cmd, "%s compute %s --increment last --quantity sxx", g_exe, g_run);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "needs stress"));
+    /* nothing on stdout before such an error: no CSV header alone (issue 18) */
+    const char *incs[] = {"last", "all"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(cmd, sizeof cmd, "(%s compute %s --increment %s --quantity sxx 2>/dev/null)",
+                 g_exe, g_run, incs[k]);
+        assert_int_equal(run(cmd, out, sizeof out), 1);
+        if (out[0])
+            fail_msg("compute --increment %s --quantity sxx printed '%s' before failing", incs[k],
+                     out);
+        snprintf(cmd, sizeof cmd, "%s compute %s --increment %s --quantity sxx", g_exe, g_run,
+                 incs[k]);
+        assert_int_equal(run(cmd, out, sizeof out), 1);
+        assert_non_null(strstr(out, "physics.calculate_stress = on"));
+    }
     snprintf(cmd, sizeof cmd, "%s compute %s --quantity uplift", g_exe, g_run);
     assert_int_equal(run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "--increment"));
@@ -269,7 +388,9 @@ int main(void) {
         cmocka_unit_test(test_strain_cli_element_limits_info),
         cmocka_unit_test(test_strain_cli_exports_and_import),
         cmocka_unit_test(test_strain_cli_export_biaxial),
+        cmocka_unit_test(test_strain_cli_series_and_json),
         cmocka_unit_test(test_strain_cli_errors),
+        cmocka_unit_test(test_strain_cli_xdmf),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

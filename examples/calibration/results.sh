@@ -11,7 +11,7 @@ commit=$(git log -1 --format=%h -- ../../common ../../solver ../../analysis 2>/d
 head=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 dirty=$(git status --porcelain -- ../../common ../../solver ../../analysis 2>/dev/null | head -n 1)
 
-elements() { "$STRAIN" info "$1" | sed -n 's/^ *internal elements: *//p' | head -n 1; }
+elements() { "$STRAIN" info "$1" | sed -n 's/^ *\(free\|internal\) elements: *//p' | head -n 1; }
 # fitted C, its error, phi, its error (MPa, deg) from a mohr.txt
 fit() { sed -n 's/^cohesion = \([0-9.e+-]*\) +- \([0-9.e+-]*\) MPa, friction angle = \([0-9.e+-]*\) +- \([0-9.e+-]*\) deg.*/\1 \2 \3 \4/p' "$1"; }
 peaks() { sed -n 's/.*peak q = \([0-9.e+-]*\) MPa.*/\1/p' "$1" | awk '{printf "%s%.1f", (NR>1?" / ":""), $1}'; }

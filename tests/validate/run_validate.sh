@@ -15,8 +15,15 @@
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
 #  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c).
+#  8b. ParaView (Debian's, headless under xvfb-run) opens the XDMF sidecars of the default
+#     run, of the stress run, of a compute --format h5 file and an --xdmf2 sidecar, reads
+#     every time step and array, compares them with the HDF5 files and renders a picture
+#     (tests/validate/check_paraview.py); skipped, saying so, when ParaView is not installed.
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
 #     analyses and pictures; a few minutes on 2 cores).
+# 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
+#     (tests/docs/run_doc_blocks.py --all; make test runs the quick ones);
+# 11. docs/measured.md equals a fresh measurement of the default model (make measured).
 BUILD=${1:-build}
 RUN="$BUILD/cdem-run"
 CHECK="/usr/bin/python3 tests/validate/check_planar.py"
@@ -102,11 +109,27 @@ PYEOF
 check stress-run "$RUN" -q -o "$TMP/stress.h5" -s physics.calculate_stress=on -s time.runtime=410
 check stress-column $PY tests/validate/check_stress_column.py "$TMP/stress.h5"
 
+# 8b. ParaView's own readers on the sidecars (docs/format.md, "XDMF sidecar").
+if command -v pvpython >/dev/null 2>&1 && command -v xvfb-run >/dev/null 2>&1; then
+    check paraview-sidecars sh -c "'$STRAIN' compute '$TMP/stress.h5' --increment all \
+        --quantity sigma1 --format h5 -o '$TMP/stress-sigma1.h5' &&
+        '$STRAIN' xdmf '$TMP/default.h5' --xdmf2 -o '$TMP/default.xdmf2' &&
+        xvfb-run -a pvpython tests/validate/check_paraview.py --png '$BUILD/validate-paraview.png' \
+        '$TMP/default.xmf' '$TMP/stress.xmf' '$TMP/stress-sigma1.xmf' '$TMP/default.xdmf2'"
+else
+    echo "validate: paraview-sidecars: SKIPPED (pvpython or xvfb-run is not installed;" \
+        "apt-get install paraview xvfb to run it)"
+fi
+
 # 8. kill survival: 200 SIGKILLs of a short cdem-run at seeded random moments; every file
 #    left behind opens and every increment it lists loads (docs/reliability.md).
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
 check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
+
+check doc-blocks /usr/bin/python3 tests/docs/run_doc_blocks.py --all "$BUILD"
+check docs-measured sh -c "/usr/bin/python3 scripts/measure_docs.py '$BUILD' > '$TMP/measured.md' &&
+    diff -u docs/measured.md '$TMP/measured.md'"
 
 echo "validate: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
