@@ -1,21 +1,29 @@
 /* contact: the pair force laws of SPEC section 4 (bonded and frictional-cohesive), evaluated
- * for one pair with its history. Every contact law implements the same checklist:
- *   - eval: force on the first element of the pair from (separation vector, sum of radii,
- *     relative velocity, dt) and the pair's history (tangential displacement, flags);
- *   - state change rules: when cohesion/bond is created (cdem_contact_make_cohesive, called
- *     by the run loop at the end of equilibration), lost (slip, separation) or broken.
+ * for one pair with its history, in one kernel (cdem_contact_touching / cdem_contact_eval)
+ * that the integrator's force loop, the tests and everything else call. The granular laws
+ * differ only in how the cohesion C0 enters the shear strength; each is one inline function
+ * in its own file (law_normal_cohesion.h, the default; law_coulomb.h; law_spring_cohesion.h;
+ * the interface in law.h) selected by material.granular_law. State change rules, the same
+ * for every law:
+ *   - cohesion/bond created: at the end of equilibration for every touching pair
+ *     (cdem_integrator_make_cohesive); with cohesive_contacts = formed also for every
+ *     contact that forms afterwards (cdem_contact_law_phase sets cohesive_new);
+ *   - lost: at the first slip (first_slip on) or when the pair separates;
+ *   - the packing phase: while equilibrating, friction x settling_friction
+ *     (cdem_contact_law_phase; the run loop says which phase a step is in).
  * The law is a plain value (cdem_contact_law) built once from params + model; the pair
  * history is owned by the pair list (neighbour.h), keyed by the element ids, so it survives
- * list rebuilds, re-sorting and element removal. Evaluation is a static inline function:
- * pure, thread-safe for distinct pairs (one writer per pair slot).
+ * list rebuilds, re-sorting and element removal. Evaluation is inline and pure, thread-safe
+ * for distinct pairs (one writer per pair slot).
  * Sign convention: n = (xj - xi)/r, t = (-ny, nx); the returned force acts on i (j gets
  * minus it). Normal force on i = Kn (r - R) n (negative along n = repulsion when r < R).
- * Tangential: Xs += ((vj - vi) . t) dt; force on i = +Ks Xs t (the spring drags i along j).
- * The scalar Xs lives in the contact frame, so it rotates with the pair automatically.
- * Heterogeneity (SPEC 3, manual Set-up 9-11): element-element pairs are refined at each list
- * rebuild into material classes (weak, layered, layered+weak, flexural slip) by
- * cdem_contact_refine from the two elements' layers and CDEM_FLAG_WEAK; the hot loop only
- * indexes the per-class arrays. Units: m, m/s, s, N (per metre of thickness). */
+ * Tangential: Xs += ((vj - vi) . t) dt; force on i = +Fs t, Fs from the law (the spring
+ * drags i along j). The scalar Xs lives in the contact frame, so it rotates with the pair.
+ * Classes: element, wall, base (the base row: material.base_*, by default the wall's
+ * values), fault; element-element pairs are refined at each list rebuild into heterogeneity
+ * classes (weak, layered, layered+weak, flexural slip) by cdem_contact_refine from the two
+ * elements' layers and CDEM_FLAG_WEAK; the hot loop only indexes the per-class arrays.
+ * Units: m, m/s, s, N (per metre of thickness). */
 #ifndef CDEM_CONTACT_H
 #define CDEM_CONTACT_H
 
