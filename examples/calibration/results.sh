@@ -75,6 +75,10 @@ if have keep200; then
     row 5A "weaker: C about 1 MPa (within 1.5), phi about 34 deg (within 4)" "C = $kc MPa, phi = $kp deg" "$(within "$kc" 1 1.5), $(within "$kp" 34 4)"
     kr=$(repose "$OUT/repose-keep200.txt")
     row 6C "repose angle close to phi (within 5 deg)" "$kr vs $kp deg" "$(within "$kr" "$kp" 5)"
+    if [ -f "$OUT/repose-keep200-damp0.2.txt" ]; then
+        kd=$(repose "$OUT/repose-keep200-damp0.2.txt")
+        row "6C, variant" "the same collapse with the damping per unit mass of 1000 m (physics.deformation_damping = 0.2)" "$kd vs $kp deg" "$(within "$kd" "$kp" 5)"
+    fi
 fi
 if have scaled200; then
     set -- $(fit "$OUT/mohr-scaled200.txt")
