@@ -56,7 +56,7 @@ static void test_sediment_deposit_below_sea_level_without_overlap(void **st) {
     (void)st;
     cdem_params p = small_params();
     cdem_model m;
-    cdem_state s, before;
+    cdem_state s, before = {0};
     cdem_sediment sd;
     cdem_error err;
     setup(&p, &m, &s, &sd);
