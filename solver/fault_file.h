@@ -23,6 +23,7 @@
 typedef struct {
     size_t n;      /* number of vertices, >= 2 */
     double *x, *y; /* m, vertices from the base up-dip: x strictly decreasing, y increasing */
+    long *line;    /* line of each vertex in its vertex file (NULL for the listric curve) */
 } cdem_fault_polyline;
 
 /* Reads the vertex file `path`. x0 (m) is where the first vertex must lie (fault location x
@@ -30,6 +31,13 @@ typedef struct {
  * CDEM_ERR_PARSE, CDEM_ERR_RANGE) name the file and line. On failure pl is left empty. */
 cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_fault_polyline *pl,
                                  cdem_error *err);
+
+/* Checks a polyline read from path against the model it is used in, naming the line of the
+ * first vertex or segment that fails (CDEM_ERR_RANGE): every vertex at 0 <= x and y <= y_max
+ * (m; a vertex at y = 1e9 m once laid fault elements up to it: 5 GB of memory; the caller
+ * chooses y_max from the model's height), and every segment at least min_segment (m) long. */
+cdem_status cdem_fault_file_check_extent(const cdem_fault_polyline *pl, const char *path,
+                                         double y_max, double min_segment, cdem_error *err);
 
 /* Builds the listric curve from (x0, 0) up to y = height (m, > 0) with basal dip dip0_deg
  * (degrees, (0, 90]) in n_seg >= 1 segments of equal height (midpoint dips). */

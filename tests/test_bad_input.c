@@ -127,7 +127,8 @@ static void test_bad_input_cdem2d_nul_byte(void **state) {
 }
 
 /* Review of the fuzzed readers: radii so large that the id-matching grid cannot be built
- * failed with a message that named no file. Now it names the results file. */
+ * failed with a message that named no file. Then it named the results file; now the row
+ * with the radius is refused, naming the file and line. */
 static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
     (void)state;
     char dir[1024], p0[1100], p1[1100];
@@ -144,8 +145,10 @@ static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
     cdem_status st = cdem_cdem2d_import(dir, count_sink, &calls, &meta, &err);
     cdem_cdem2d_meta_free(&meta);
     assert_int_not_equal(st, CDEM_OK);
-    assert_int_equal(calls, 1); /* the first increment needs no matching */
-    assert_non_null(strstr(err.msg, p1));
+    /* since issue 19 (item 8) the radius itself is refused, on its row */
+    assert_int_equal(calls, 0);
+    assert_non_null(strstr(err.msg, p0));
+    assert_non_null(strstr(err.msg, ":1: radius 1e+308 must be > 0 and at most"));
     remove(p0);
     remove(p1);
     rmdir(dir);
