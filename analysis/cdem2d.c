@@ -166,6 +166,21 @@ static cdem_status list_increments(const char *dir, long **nums, size_t *count, 
             (*nums)[j] = (*nums)[j - 1];
             (*nums)[j - 1] = t;
         }
+    /* modelresults_0.txt and modelresults_00.txt are both increment 0 (found by fuzzing:
+     * the importer passed on two increments with one number) */
+    for (size_t i = 1; st == CDEM_OK && i < *count; i++)
+        if ((*nums)[i] == (*nums)[i - 1])
+            st = CDEM_FAIL(err, CDEM_ERR_PARSE,
+                           "%s holds two results files for increment %ld (a number written "
+                           "with and without leading zeros, e.g. modelresults_%ld.txt and "
+                           "modelresults_0%ld.txt): keep one",
+                           dir, (*nums)[i], (*nums)[i], (*nums)[i]);
+    if (st != CDEM_OK) {
+        free(*nums);
+        *nums = NULL;
+        *count = 0;
+        return st;
+    }
     if (*count == 0)
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
                          "%s holds no modelresults_N.txt files: not a cdem2D simulation folder",

@@ -45,6 +45,33 @@ static cdem_status pl_push(cdem_fault_polyline *pl, size_t *cap, double x, doubl
     return CDEM_OK;
 }
 
+/* Length of the plain decimal number at s ([+-]digits[.digits][e[+-]digits]), 0 if none.
+ * strtod alone also reads hexadecimal ("0x1p-1074"), "inf" and "nan". */
+static size_t decimal_length(const char *s) {
+    const char *p = s;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    for (; *p >= '0' && *p <= '9'; p++)
+        digits++;
+    if (*p == '.')
+        for (p++; *p >= '0' && *p <= '9'; p++)
+            digits++;
+    if (!digits)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        const char *q = p + 1;
+        if (*q == '+' || *q == '-')
+            q++;
+        if (*q >= '0' && *q <= '9') {
+            while (*q >= '0' && *q <= '9')
+                q++;
+            p = q;
+        }
+    }
+    return (size_t)(p - s);
+}
+
 /* Parses one number field of [*p, end); advances *p. 0 on success. */
 static int parse_field(char **p, double *v) {
     char *s = *p;
@@ -55,7 +82,7 @@ static int parse_field(char **p, double *v) {
     char *e = NULL;
     errno = 0;
     const double d = strtod(s, &e);
-    if (e == s || errno == ERANGE || !isfinite(d) ||
+    if (e == s || e != s + decimal_length(s) || errno == ERANGE || !isfinite(d) ||
         !(*e == '\0' || *e == ' ' || *e == '\t' || *e == ','))
         return 2; /* not a number */
     *v = d;
@@ -122,6 +149,16 @@ static cdem_status read_lines(FILE *f, const char *path, double x0, double tol,
                                  "and higher y than the previous point (%g, %g) m (the fault "
                                  "dips toward +x and is listed from the base up-dip)",
                                  path, lineno, xy[0], xy[1], px, py);
+            /* the fault's x at a height is interpolated (and below the base extrapolated)
+             * along a segment: a segment rising 5e-324 m over 1400 m gave x = inf */
+            const double dip = atan2(xy[1] - py, px - xy[0]) * 180.0 / M_PI;
+            if (!(dip >= CDEM_FAULT_MIN_DIP))
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "fault file %s, line %ld: the segment from (%g, %g) m to (%g, "
+                                 "%g) m dips %.3g degrees; every segment must dip at least %g "
+                                 "degrees (a flatter one gives no position of the fault at a "
+                                 "height)",
+                                 path, lineno, px, py, xy[0], xy[1], dip, CDEM_FAULT_MIN_DIP);
         }
         CDEM_TRY(pl_push(pl, &cap, pl->n == 0 ? x0 : xy[0], pl->n == 0 ? 0.0 : xy[1], lineno, err));
     }

@@ -1,8 +1,9 @@
 /* fault_file: the curve of a listric or irregular fault, as a polyline in the model frame
  * (origin at the bottom-left inner corner, x right, y up; the base surface is y = 0).
  * Sources: an irregular-fault vertex file (cdem_fault_file_read: one "x y" per line in m,
- * whitespace or comma separated, '#' comments, blank lines and CRLF accepted; first point at
- * (fault location x width, 0), every later one at lower x and higher y), or the listric
+ * whitespace or comma separated, '#' comments, blank lines and CRLF accepted; plain decimal
+ * numbers; first point at (fault location x width, 0), every later one at lower x and higher
+ * y, every segment dipping at least CDEM_FAULT_MIN_DIP), or the listric
  * curve (cdem_fault_file_listric: dip(y) = d0 + (90 - d0) (y / H)^k, k = 1, i.e. the dip
  * grows linearly with height from d0 at the base to 90 at the top of the assembly H; its
  * horizontal extent is H ln(1 / sin d0) / (90 - d0 in radians)). Both dip toward +x.
@@ -17,6 +18,8 @@
 
 /* Exponent k of the listric dip law dip(y) = d0 + (90 - d0) (y / H)^k. */
 #define CDEM_LISTRIC_EXPONENT 1.0
+/* Smallest dip (degrees) of a segment of a vertex file. */
+#define CDEM_FAULT_MIN_DIP 1.0
 /* Segments of the listric polyline built by bc_listric (equal heights). */
 #define CDEM_LISTRIC_SEGMENTS 200
 
