@@ -18,9 +18,11 @@ GROUPS = [  # (title, source files, what to do)
      "line (or the -s argument). `cdem-run --print-defaults` writes a valid file to start "
      "from; docs/parameters.md lists every key, range and rule between keys."),
     ("Fault vertex files (irregular-fault)", ["solver/fault_file.c"],
-     "Fix the named line of the vertex file: two numbers `x y` in metres per line; first point "
-     "at (fault_location x width x unit_scaling, 0); every later point at lower x and higher y. "
-     "The path is relative to the directory cdem-run runs in."),
+     "Fix the named line of the vertex file: two plain decimal numbers `x y` in metres per "
+     "line; first point at (fault_location x width x unit_scaling, 0); every later point at "
+     "lower x and higher y, every segment dipping at least 1 degree and at least half the "
+     "smallest radius long, no point above twice the model's height. The path is relative to "
+     "the directory cdem-run runs in."),
     ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
       "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
       "solver/run.c", "solver/sediment.c", "solver/integrate.c", "solver/contact.c", "solver/neighbour.c",
