@@ -41,6 +41,7 @@ struct cdem_analysis {
     cdem_limits stress_lim[N_STRESS];
     int have_total_lim[N_DISP]; /* cached total-displacement limits present */
     cdem_limits total_lim[N_DISP];
+    char *name; /* the run in messages (its file), or NULL */
 };
 
 /* ---------------------------------------------------------------- memory source */
@@ -138,9 +139,17 @@ void cdem_analysis_close(cdem_analysis *a) {
         cdem_state_free(&a->slot[k].state);
     cdem_strain_cum_free(&a->cum);
     free(a->infos);
+    free(a->name);
     if (a->src.close)
         a->src.close(a->ctx);
     free(a);
+}
+
+void cdem_analysis_set_name(cdem_analysis *a, const char *name) {
+    if (!a)
+        return;
+    free(a->name);
+    a->name = name ? strdup(name) : NULL;
 }
 
 size_t cdem_analysis_count(const cdem_analysis *a) {
@@ -187,8 +196,10 @@ cdem_status cdem_analysis_find(const cdem_analysis *a, const char *spec, size_t 
             *index = i;
             return CDEM_OK;
         }
-    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "increment %ld does not exist (the run has %d..%d)", v,
-                     (int)a->infos[0].number, (int)a->infos[a->n - 1].number);
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                     "%s%sincrement %ld does not exist (the run has %d..%d)",
+                     a->name ? a->name : "", a->name ? ": " : "", v, (int)a->infos[0].number,
+                     (int)a->infos[a->n - 1].number);
 }
 
 cdem_status cdem_analysis_state(cdem_analysis *a, size_t index, const cdem_state **s,

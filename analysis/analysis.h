@@ -54,6 +54,10 @@ cdem_status cdem_analysis_open_states(const cdem_state *states, const cdem_incre
 
 void cdem_analysis_close(cdem_analysis *a);
 
+/* Names the run in messages that concern the whole run ("RUN.h5: increment 3 does not
+ * exist"); cdem_analysis_open sets the file's path. name is copied; NULL clears it. */
+void cdem_analysis_set_name(cdem_analysis *a, const char *name);
+
 size_t cdem_analysis_count(const cdem_analysis *a);
 const cdem_increment_info *cdem_analysis_info(const cdem_analysis *a, size_t index);
 /* Index of the end-of-equilibration increment. */

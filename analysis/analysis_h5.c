@@ -41,5 +41,7 @@ cdem_status cdem_analysis_open(const char *path, cdem_analysis **out, cdem_error
     st = cdem_analysis_open_source(&h5_ops, r, &p, out, err);
     if (st != CDEM_OK)
         cdem_error_prefix(err, "%s", path);
+    else
+        cdem_analysis_set_name(*out, path);
     return st;
 }

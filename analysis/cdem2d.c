@@ -166,6 +166,21 @@ static cdem_status list_increments(const char *dir, long **nums, size_t *count, 
             (*nums)[j] = (*nums)[j - 1];
             (*nums)[j - 1] = t;
         }
+    /* modelresults_0.txt and modelresults_00.txt are both increment 0 (found by fuzzing:
+     * the importer passed on two increments with one number) */
+    for (size_t i = 1; st == CDEM_OK && i < *count; i++)
+        if ((*nums)[i] == (*nums)[i - 1])
+            st = CDEM_FAIL(err, CDEM_ERR_PARSE,
+                           "%s holds two results files for increment %ld (a number written "
+                           "with and without leading zeros, e.g. modelresults_%ld.txt and "
+                           "modelresults_0%ld.txt): keep one",
+                           dir, (*nums)[i], (*nums)[i], (*nums)[i]);
+    if (st != CDEM_OK) {
+        free(*nums);
+        *nums = NULL;
+        *count = 0;
+        return st;
+    }
     if (*count == 0)
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
                          "%s holds no modelresults_N.txt files: not a cdem2D simulation folder",
@@ -228,11 +243,24 @@ typedef struct {
     size_t stress_row; /* next element to receive stress */
 } fill_ctx;
 
+/* Bounds of an imported row (m): far beyond any model, yet small enough that sums, squares
+ * and the cell grid of the id matching stay finite (x = 1e308 or a radius of 1e300 were
+ * imported once, and turned into infinities downstream). */
+#define IMPORT_MAX_COORD  1e7
+#define IMPORT_MAX_RADIUS 1e5
+
 static cdem_status result_row(void *user, const double *v, const char *path, long line,
                               cdem_error *err) {
     fill_ctx *c = user;
-    if (!(v[2] > 0.0))
-        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s:%ld: radius %g must be > 0", path, line, v[2]);
+    if (!(v[2] > 0.0) || v[2] > IMPORT_MAX_RADIUS)
+        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s:%ld: radius %g must be > 0 and at most %g m",
+                         path, line, v[2], IMPORT_MAX_RADIUS);
+    for (int k = 0; k < 2; k++)
+        if (!(fabs(v[k]) <= IMPORT_MAX_COORD))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s:%ld: %s = %g m is outside the range -%g..%g m allowed for a "
+                             "position",
+                             path, line, k ? "y" : "x", v[k], IMPORT_MAX_COORD, IMPORT_MAX_COORD);
     if (v[3] < 0.0 || v[3] > 1e6 || v[3] != floor(v[3]))
         return CDEM_FAIL(err, CDEM_ERR_PARSE,
                          "%s:%ld: layer %g must be a whole number >= 0 (0 = wall)", path, line,
@@ -389,6 +417,11 @@ cdem_status cdem_cdem2d_import(const char *dir, cdem_cdem2d_sink sink, void *use
         if (st == CDEM_OK)
             st = parse_rows(text, path, 4, "x y radius layer", result_row, &fc, err);
         free(text);
+        if (st == CDEM_OK && cur.n == 0) /* an increment without elements: truncated copy? */
+            st = CDEM_FAIL(err, CDEM_ERR_PARSE,
+                           "%s holds no element rows (x y radius layer): an empty or cut-off "
+                           "results file",
+                           path);
         if (st == CDEM_OK && meta->has_forces) {
             snprintf(path, sizeof path, "%s/modelforces_%ld.txt", dir, nums[k]);
             st = read_text(path, &text, 0, err);

@@ -131,6 +131,14 @@ static int fail(const char *cmd, const cdem_error *err) {
     return 1;
 }
 
+/* fail, naming the run file the command read when the message does not. */
+static int fail_on(const char *cmd, const char *file, const cdem_error *err) {
+    if (!file || !err->msg[0] || strstr(err->msg, file))
+        return fail(cmd, err);
+    fprintf(stderr, "cdem-strain %s: %s: %s\n", cmd, file, err->msg);
+    return 1;
+}
+
 static int parse_size(const char *text, int *out) {
     char *end;
     errno = 0;
@@ -648,7 +656,7 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
         st = repose_figure(&a, &s, (int)info.number, &res, &err);
     cdem_state_free(&s);
     cdem_h5_reader_close(r);
-    return st == CDEM_OK ? 0 : fail(a.cmd, &err);
+    return st == CDEM_OK ? 0 : fail_on(a.cmd, a.files[0], &err);
 }
 
 /* ---------------------------------------------------------------- voids */

@@ -7,6 +7,7 @@
 #include "gif.h"
 #include "outfile.h"
 #include "render.h"
+#include "runlock.h"
 
 #include <errno.h>
 #include <math.h>
@@ -37,8 +38,12 @@ typedef struct {
     cdem_gif_options go;    /* GIF options */
 } render_args;
 
-static int fail(const cdem_error *err) {
-    fprintf(stderr, "cdem-strain render: %s\n", err->msg);
+/* Prints err, naming the run file (path, may be NULL) when the message does not. */
+static int fail(const char *path, const cdem_error *err) {
+    if (path && err->msg[0] && !strstr(err->msg, path))
+        fprintf(stderr, "cdem-strain render: %s: %s\n", path, err->msg);
+    else
+        fprintf(stderr, "cdem-strain render: %s\n", err->msg);
     return 1;
 }
 
@@ -437,16 +442,16 @@ static int run_render(const render_args *a) {
     cdem_analysis *an = NULL;
     const cdem_quantity *q = NULL;
     if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
-        return fail(&err);
+        return fail(NULL, &err);
     if (cdem_analysis_open(a->path, &an, &err) != CDEM_OK)
-        return fail(&err);
+        return fail(a->path, &err);
     int rc = 0;
     size_t n = cdem_analysis_count(an);
     cdem_render_options o = a->ro;
     o.growth1_layers = cdem_analysis_params(an)->growth_sequence1_layers;
     if (n == 0) {
         CDEM_FAIL(&err, CDEM_ERR_NOTFOUND, "%s: the file has no increments", a->path);
-        rc = fail(&err);
+        rc = fail(a->path, &err);
         goto done;
     }
     int series = a->gif || !strcmp(a->increment, "all");
@@ -455,7 +460,7 @@ static int run_render(const render_args *a) {
     } else if (series) {
         double box[4];
         if (series_box(an, o.margin, box, &err) != CDEM_OK) {
-            rc = fail(&err);
+            rc = fail(a->path, &err);
             goto done;
         }
         set_zoom(&o, box);
@@ -467,13 +472,13 @@ static int run_render(const render_args *a) {
         if (build_scene(an, 0, a, q, &d, &err) != CDEM_OK ||
             (!height && cdem_render_auto_height(&d.sc, &o, &height, &err) != CDEM_OK)) {
             scene_free(&d);
-            rc = fail(&err);
+            rc = fail(a->path, &err);
             goto done;
         }
         scene_free(&d);
         gif_ctx g = {an, a, q, &o};
         if (cdem_gif_write(a->gif, n, o.width, height, gif_frame, &g, &a->go, &err) != CDEM_OK) {
-            rc = fail(&err);
+            rc = fail(a->path, &err);
             goto done;
         }
         printf("%s: %zu increments\n", a->gif, cdem_gif_frame_order(n, &a->go, NULL));
@@ -482,7 +487,7 @@ static int run_render(const render_args *a) {
         goto done;
     if (!strcmp(a->increment, "all")) {
         if (cdem_outfile_make_dirs(a->output, &err) != CDEM_OK) {
-            rc = fail(&err);
+            rc = fail(a->path, &err);
             goto done;
         }
         /* numbers zero-padded to the width of the largest, so the files sort in increment
@@ -493,7 +498,7 @@ static int run_render(const render_args *a) {
             snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                      (int)cdem_analysis_info(an, i)->number, a->format);
             if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK) {
-                rc = fail(&err);
+                rc = fail(a->path, &err);
                 /* no partial series that looks complete: remove this run's pictures */
                 for (size_t j = 0; j < i; j++) {
                     snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
@@ -508,7 +513,7 @@ static int run_render(const render_args *a) {
         size_t index;
         if (cdem_analysis_find(an, a->increment, &index, &err) != CDEM_OK ||
             render_one(an, index, a, q, &o, a->output, &err) != CDEM_OK)
-            rc = fail(&err);
+            rc = fail(a->path, &err);
         else
             printf("%s\n", a->output);
     }
@@ -563,13 +568,15 @@ static int wait_for_stop(const sigset_t *set, double seconds) {
 
 /* --follow: watches a run file that cdem-run is writing (SWMR read, docs/format.md) and
  * re-renders its newest increment whenever a new one arrives; ends when the run's stop
- * reason is no longer "running" (after rendering its last increment) or on Ctrl-C. */
+ * reason is no longer "running" (after rendering its last increment), when the run's
+ * writer is gone without recording a stop (killed: its lock is free, runlock.h), or on
+ * Ctrl-C. */
 static int run_follow(const render_args *a) {
     cdem_error err;
     cdem_error_clear(&err);
     const cdem_quantity *q = NULL;
     if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
-        return fail(&err);
+        return fail(NULL, &err);
     sigset_t set;
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
@@ -581,11 +588,12 @@ static int run_follow(const render_args *a) {
     for (double waited = 0.0; cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK;
          waited += a->interval) {
         if (err.code != CDEM_ERR_NOTFOUND || waited >= 60.0)
-            return fail(&err);
+            return fail(a->path, &err);
         if (wait_for_stop(&set, a->interval))
             return 0;
     }
     int32_t shown = -1;
+    int writer_gone = 0; /* 1: no live writer holds the file's lock (checked last time) */
     for (;;) {
         int stopped = strcmp(cdem_h5_reader_stop_reason(r), "running") != 0;
         size_t n = cdem_h5_reader_increment_count(r);
@@ -594,7 +602,7 @@ static int run_follow(const render_args *a) {
             last.number != shown) {
             int32_t number = -1;
             if (follow_render(a, q, &number, &err) != CDEM_OK) {
-                rc = fail(&err);
+                rc = fail(a->path, &err);
                 break;
             }
             if (number >= 0 && number != shown) {
@@ -608,9 +616,21 @@ static int run_follow(const render_args *a) {
                    cdem_h5_reader_stop_reason(r), (int)shown);
             break;
         }
+        if (writer_gone) { /* the file was read again after its writer's lock was free */
+            fprintf(stderr,
+                    "cdem-strain render: %s: its writer is gone without recording how the run "
+                    "ended (killed?); the file keeps its %zu complete increments, the last one "
+                    "rendered (%d); continue the run with cdem-run --resume %s\n",
+                    a->path, n, (int)shown, a->path);
+            rc = 1;
+            break;
+        }
         if (wait_for_stop(&set, a->interval))
             break;
-        if (cdem_h5_reader_format_version(r) >= 2 && cdem_h5_reader_unclosed(r) &&
+        /* Asked before the file is read again, so that a run that has just finished is seen
+         * finished (its stop reason is written before its lock is released). */
+        writer_gone = cdem_h5_reader_unclosed(r) && cdem_runlock_probe(a->path, NULL, 0) == 0;
+        if (!writer_gone && cdem_h5_reader_format_version(r) >= 2 && cdem_h5_reader_unclosed(r) &&
             cdem_h5_reader_refresh(r, NULL, &err) == CDEM_OK)
             continue;
         /* Not in SWMR-read mode (a version-1 file, or one opened before its writer entered
@@ -618,7 +638,7 @@ static int run_follow(const render_args *a) {
         cdem_h5_reader_close(r);
         r = NULL;
         if (cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK) {
-            rc = fail(&err);
+            rc = fail(a->path, &err);
             break;
         }
     }

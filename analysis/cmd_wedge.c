@@ -35,6 +35,14 @@ static int fail(const char *cmd, const cdem_error *err) {
     return 1;
 }
 
+/* fail, naming the run file the command read when the message does not. */
+static int fail_on(const char *cmd, const char *file, const cdem_error *err) {
+    if (!file || !err->msg[0] || strstr(err->msg, file))
+        return fail(cmd, err);
+    fprintf(stderr, "cdem-strain %s: %s: %s\n", cmd, file, err->msg);
+    return 1;
+}
+
 /* Value of option argv[*i] ("--opt VALUE" or "--opt=VALUE") when it is `flag`; NULL
  * otherwise; *missing = 1 when the flag has no value. */
 static const char *opt_value(int argc, char **argv, int *i, const char *flag, int *missing) {
@@ -159,7 +167,7 @@ int cdem_cmd_wedge(int argc, char **argv) {
     }
     free(rows);
     cdem_analysis_close(a);
-    return st == CDEM_OK ? 0 : fail(cmd, &err);
+    return st == CDEM_OK ? 0 : fail_on(cmd, file, &err);
 }
 
 /* ---------------------------------------------------------------- plot-csv */

@@ -3,26 +3,36 @@
  * Design notes a maintainer may question (docs/format.md has the measurements):
  *  - Files are V110 (superblock v3, object header v2): every piece of metadata carries a
  *    checksum, so flipped bytes fail a checksum instead of being parsed. Raw chunks carry
- *    Fletcher-32. Strings are fixed-length: variable-length ones live in the global heap,
- *    which has no checksum, and HDF5 1.10 crashes on a corrupt one.
+ *    Fletcher-32 (the element data also compressed, the index and the series not). Strings are
+ *    fixed-length: variable-length ones live in the global heap, which has no checksum, and
+ *    HDF5 1.10 crashes on a corrupt one.
  *  - Version 2 is SWMR: all objects are created first (HDF5 1.10 forbids creating objects in
  *    SWMR-write mode), then the file is only appended to. The index row of an increment is
- *    written and flushed after its data: the commit record.
+ *    written, flushed and synced (fdatasync) after its data, itself flushed and synced: the
+ *    commit record, which survives a power cut too.
+ *  - A writer holds the path's lock (runlock.h) for its whole life: one writer per path,
+ *    and readers can tell a running writer from a dead one.
  *  - Each increment starts at a chunk boundary, so compressed chunks are written once.
- *  - The reader reads the superblock's status flags itself: SWMR-read for a running or
- *    killed version-2 writer, "clear_status_flags" (read-only, what h5clear uses) for an
- *    unclosed version-1 file. It also compares the superblock's end-of-file with the real
- *    size, which catches truncation before HDF5 parses anything.
+ *  - The reader reads the superblock's status flags itself: SWMR-read (with bounded metadata
+ *    retries) while a writer holds the lock, otherwise the file is complete and opened as
+ *    one ("clear_status_flags" and "skip_eof_check", read-only, what h5clear uses): HDF5's
+ *    SWMR retries never end on a damaged file. It also compares the superblock's end-of-file
+ *    with the real size, which catches truncation before HDF5 parses anything.
  *  - Object time stamps are off: same input, same bytes except the attribute "created".
  *  - HDF5's error printing is off; its error stack becomes part of cdem_error messages.
  *  - append_series is called from the time-step loop: it never allocates (fixed buffer). */
+/* renameat2 (RENAME_NOREPLACE): never replace a file that appeared meanwhile */
+#define _GNU_SOURCE
 #include "h5format.h"
 #include "xdmf.h"
+
+#include "runlock.h"
 
 #include <hdf5.h>
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -32,6 +42,7 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <time.h>
+#include <unistd.h>
 
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
  * after byte shuffle; levels 6 and 9 saved 0.2 % more for 20-30 % more CPU. Per-increment
@@ -48,6 +59,12 @@
 /* Largest element count an increment may have to be loaded (~2 GB of state; cdem-run's
  * largest model has ~10^5 elements): a corrupt count is refused before allocating. */
 #define READER_MAX_ELEMENTS ((hsize_t)20000000)
+/* Metadata read attempts of a SWMR reader (reader_setup): HDF5 sleeps 1, 2, 4, ... ns
+ * between attempts, so n attempts wait about 2^n ns in all before a read fails: 28 wait
+ * 0.27 s (measured: a damaged file fails after 0.3 s at 28, 1.1 s at 30, 4.3 s at 32), about
+ * 10^5 times longer than a writer takes to write the piece of metadata a reader may have
+ * caught half-written. */
+#define SWMR_READ_ATTEMPTS 28
 
 /* ------------------------------------------------------------------ errors */
 
@@ -56,13 +73,33 @@ typedef struct {
     int count;      /* descriptions collected so far */
 } h5_err_text;
 
+/* HDF5 describes a failed read or write of the file as "file write failed: time = ...,
+ * filename = 'run.h5.creating', file descriptor = 3, errno = 28, error message = 'No space
+ * left on device', buf = 0x..., ..., bytes actually written = 18446744073709551615, ...":
+ * the temporary name, pointers and a -1 printed unsigned. Only "file write failed: No space
+ * left on device" says something to a user (our message names the file and what it kept).
+ * Returns desc shortened that way into buf, or desc itself when it is not such a line. */
+static const char *plain_h5_desc(const char *desc, char *buf, size_t cap) {
+    const char *msg = strstr(desc, "error message = '");
+    const char *colon = strchr(desc, ':');
+    if (!msg || !colon || colon > msg)
+        return desc;
+    msg += strlen("error message = '");
+    const char *end = strchr(msg, '\'');
+    snprintf(buf, cap, "%.*s: %.*s", (int)(colon - desc), desc,
+             (int)(end ? (size_t)(end - msg) : strlen(msg)), msg);
+    return buf;
+}
+
 static herr_t collect_h5_error(unsigned n, const H5E_error2_t *e, void *data) {
     (void)n;
     h5_err_text *t = data;
     if (t->count >= 3 || !e->desc || !e->desc[0])
         return 0;
     size_t len = strlen(t->text);
-    snprintf(t->text + len, sizeof t->text - len, "%s%s", t->count ? "; " : "", e->desc);
+    char plain[256];
+    snprintf(t->text + len, sizeof t->text - len, "%s%s", t->count ? "; " : "",
+             plain_h5_desc(e->desc, plain, sizeof plain));
     for (char *c = t->text + len; *c; c++)
         if (*c == '\n' || *c == '\r')
             *c = ' '; /* one-line messages */
@@ -481,17 +518,83 @@ struct cdem_h5_writer {
     size_t n_entries, cap_entries;  /* used / allocated entries */
     size_t xmf_written;             /* entries in the sidecar on disk */
     int has_xy;                     /* 1: /increments/xy exists (XDMF 3 sidecar) */
+    cdem_runlock *lock;             /* the path's lock (PATH.lock), held until close */
+    int sync;                       /* 1: sync (fdatasync) every commit (_set_sync) */
+    int placed;                     /* 1 once the file is at path (before: PATH.creating) */
 };
 
 static cdem_status flush_file(cdem_h5_writer *w, cdem_error *err) {
     if (H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0) {
         w->failed = 1;
+        if (!w->placed)
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot create the run file: writing it (as %s.creating) failed "
+                          "(disk full?); that temporary file was removed and nothing was "
+                          "replaced",
+                          w->path, w->path);
         return H5FAIL(err, CDEM_ERR_IO,
                       "%s: cannot flush the file (disk full?); the file keeps the %llu "
                       "increments completed before",
                       w->path, (unsigned long long)w->index_len);
     }
     return CDEM_OK;
+}
+
+/* H5Fflush hands the bytes to the operating system, which may keep them in memory for
+ * seconds: a killed process loses nothing, a power cut may lose the commit record or, worse,
+ * keep the record and lose the data it points to (the kernel writes pages in any order).
+ * A sync after the data and again after the record orders them on the disk. fdatasync, not
+ * fsync: it writes the data and the metadata needed to read it back (the file's size), not
+ * the time stamps, which saves a journal commit where nothing else changed. */
+static cdem_status sync_file(cdem_h5_writer *w, cdem_error *err) {
+    if (!w->sync)
+        return CDEM_OK;
+    void *handle = NULL;
+    if (H5Fget_vfd_handle(w->file, H5P_DEFAULT, &handle) < 0 || !handle) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot reach the file's descriptor to flush it to disk; the file keeps "
+                      "the %llu increments completed before",
+                      w->path, (unsigned long long)w->index_len);
+    }
+    int fd = *(int *)handle; /* the default (sec2) driver's handle is its descriptor */
+    if (fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+        w->failed = 1;
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: cannot flush the file to disk: %s; the file keeps the %llu "
+                         "increments committed before",
+                         w->path, strerror(errno), (unsigned long long)w->index_len);
+    }
+    return CDEM_OK;
+}
+
+/* flush_file, then to stable storage when durability is on. */
+static cdem_status commit_flush(cdem_h5_writer *w, cdem_error *err) {
+    CDEM_TRY(flush_file(w, err));
+    return sync_file(w, err);
+}
+
+/* After a rename, the directory entry is durable only once the folder is synced. */
+static void sync_folder_of(const char *path) {
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        if (fsync(fd) != 0)
+            errno = 0; /* best effort: some filesystems refuse fsync on folders */
+        close(fd);
+    }
+}
+
+void cdem_h5_writer_set_sync(cdem_h5_writer *w, int sync) {
+    if (w)
+        w->sync = sync ? 1 : 0;
 }
 
 /* Writes count values at rows [start, start + count) of the 1-D dataset ds, extending it
@@ -543,12 +646,25 @@ static int read_all_rows(hid_t ds, hid_t mt, hsize_t n, void *dst) {
     return read_rows(ds, mt, 0, n, dst);
 }
 
-/* Checks one index row against the extents of the element datasets; NULL when it is
- * valid, otherwise what is wrong. */
-static const char *bad_index_row(const index_row *row, int32_t prev_number, hsize_t data_ext,
+/* Checks one index row against the previous row (NULL for the first) and the extents of
+ * the element datasets; NULL when it is valid, otherwise what is wrong. Files written
+ * before the index carried a checksum (Fletcher-32) rely on these checks alone: a flipped
+ * bit gave a time of 461 s in a 220 s run, or a net displacement of 5.7e78 m. */
+static const char *bad_index_row(const index_row *row, const index_row *prev, hsize_t data_ext,
                                  hsize_t stress_ext) {
-    if (row->number < 0 || row->number <= prev_number)
+    if (row->number < 0 || (prev && row->number <= prev->number))
         return "increment numbers must be >= 0 and increasing";
+    if (row->step < 0 || (prev && row->step < prev->step))
+        return "its step is negative or smaller than the previous increment's";
+    if (!isfinite(row->time) || row->time < 0.0 || (prev && row->time < prev->time))
+        return "its time is not a finite number of seconds, >= 0 and >= the previous "
+               "increment's";
+    if (row->phase < CDEM_PHASE_EQUILIBRATION || row->phase > CDEM_PHASE_SETTLING)
+        return "its phase is not 0, 1 or 2";
+    if (!isfinite(row->net_displacement) || !isfinite(row->axial_strain) ||
+        !isfinite(row->differential_stress) || isinf(row->sea_level))
+        return "its net displacement, axial strain, differential stress or sea level is not a "
+               "finite number";
     if (row->n < 0 || (hsize_t)row->n > MAX_ELEMENTS)
         return "element count n out of range";
     if (row->offset < 0 || (hsize_t)row->offset > data_ext ||
@@ -650,7 +766,16 @@ static int writer_xmf_grid(void *ctx, size_t k, cdem_xdmf_grid *g) {
 static cdem_status write_xmf(cdem_h5_writer *w, cdem_error *err) {
     const cdem_xdmf_doc doc = {w->h5_name, xmf_flavour(w->has_xy, w->h5_name, CDEM_XDMF3),
                                w->n_entries, writer_xmf_grid, w};
-    CDEM_TRY(cdem_xdmf_write_file(w->xmf_path, &doc, err));
+    if (cdem_xdmf_write_file(w->xmf_path, &doc, err) != CDEM_OK) {
+        /* A sidecar failure leaves the run file as it is: the message says so, names both
+         * files and what the run file keeps (the sidecar only serves ParaView and VisIt). */
+        char why[CDEM_ERROR_MSG_MAX];
+        snprintf(why, sizeof why, "%s", err ? err->msg : "write error");
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: the run file keeps its %llu complete increments, but its XDMF "
+                         "sidecar %s (for ParaView) could not be written: %.600s",
+                         w->path, (unsigned long long)w->index_len, w->xmf_path, why);
+    }
     w->xmf_written = w->n_entries;
     return CDEM_OK;
 }
@@ -723,21 +848,30 @@ static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cde
     return st;
 }
 
-/* Creates an empty extendible 1-D dataset loc/name. compress: shuffle + deflate +
- * Fletcher-32. */
+/* Filters of an extendible dataset. */
+typedef enum {
+    FILTER_NONE,     /* raw chunks (checkpoint slots: the blob carries its own checksum) */
+    FILTER_COMPRESS, /* byte shuffle + deflate + Fletcher-32 (element data) */
+    FILTER_CHECKSUM, /* Fletcher-32 only (index, series): a flipped bit is a read error, not
+                        a time of 461 s in a 220 s run; the filtered chunk keeps its size
+                        (data + 4 bytes), so HDF5 still rewrites it in place on append */
+} dataset_filter;
+
+/* Creates an empty extendible 1-D dataset loc/name with the given filters. */
 static hid_t create_extendible(hid_t loc, const char *name, hid_t ftype, hsize_t chunk,
-                               int compress) {
+                               dataset_filter filter) {
     hsize_t zero = 0, unlimited = H5S_UNLIMITED;
     hid_t sp = H5Screate_simple(1, &zero, &unlimited);
     hid_t dcpl = untimed_plist(H5P_DATASET_CREATE);
     H5Pset_chunk(dcpl, 1, &chunk);
     H5Pset_dset_no_attrs_hint(dcpl, 1);
-    H5Pset_fill_time(dcpl, compress ? H5D_FILL_TIME_ALLOC : H5D_FILL_TIME_NEVER);
-    if (compress) {
+    H5Pset_fill_time(dcpl, filter != FILTER_NONE ? H5D_FILL_TIME_ALLOC : H5D_FILL_TIME_NEVER);
+    if (filter == FILTER_COMPRESS) {
         H5Pset_shuffle(dcpl);
         H5Pset_deflate(dcpl, DEFLATE_LEVEL);
-        H5Pset_fletcher32(dcpl);
     }
+    if (filter != FILTER_NONE)
+        H5Pset_fletcher32(dcpl);
     hid_t ds = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     hid_t es = keep_errors(ds < 0);
     H5Pclose(dcpl);
@@ -785,14 +919,16 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
         st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the groups", w->path);
     for (size_t c = 0; st == CDEM_OK && c < N_SERIES; c++) {
         hid_t ft = series_columns[c].type == COL_I64 ? H5T_STD_I64LE : H5T_IEEE_F64LE;
-        w->series[c] = create_extendible(gs, series_columns[c].name, ft, SERIES_CHUNK, 0);
+        w->series[c] =
+            create_extendible(gs, series_columns[c].name, ft, SERIES_CHUNK, FILTER_CHECKSUM);
         if (w->series[c] < 0)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /series/%s", w->path,
                         series_columns[c].name);
     }
     for (size_t k = 0; st == CDEM_OK && k < N_ELEMENT_FIELDS; k++) {
         const element_field *fd = &element_fields[k];
-        w->data[k] = create_extendible(gi, fd->name, el_file_type(fd->type), CHUNK_ELEMS, 1);
+        w->data[k] =
+            create_extendible(gi, fd->name, el_file_type(fd->type), CHUNK_ELEMS, FILTER_COMPRESS);
         if (w->data[k] < 0)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /increments/%s", w->path,
                         fd->name);
@@ -808,7 +944,7 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
     hid_t ft = -1;
     if (st == CDEM_OK) {
         ft = make_compound(index_members, N_INDEX_MEMBERS, sizeof(index_row), 1);
-        w->index = ft >= 0 ? create_extendible(gi, "index", ft, INDEX_CHUNK, 0) : -1;
+        w->index = ft >= 0 ? create_extendible(gi, "index", ft, INDEX_CHUNK, FILTER_CHECKSUM) : -1;
         if (w->index < 0)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create dataset /increments/index", w->path);
         if (ft >= 0)
@@ -817,8 +953,8 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
     if (st == CDEM_OK) {
         ft = make_compound(ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 1);
         w->ckpt_index = ft >= 0 ? create_fixed(gc, "index", ft, 2) : -1;
-        w->ckpt_data[0] = create_extendible(gc, "slot0", H5T_STD_U8LE, CKPT_CHUNK, 0);
-        w->ckpt_data[1] = create_extendible(gc, "slot1", H5T_STD_U8LE, CKPT_CHUNK, 0);
+        w->ckpt_data[0] = create_extendible(gc, "slot0", H5T_STD_U8LE, CKPT_CHUNK, FILTER_NONE);
+        w->ckpt_data[1] = create_extendible(gc, "slot1", H5T_STD_U8LE, CKPT_CHUNK, FILTER_NONE);
         if (w->ckpt_index < 0 || w->ckpt_data[0] < 0 || w->ckpt_data[1] < 0)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the /checkpoint datasets", w->path);
         if (ft >= 0)
@@ -868,6 +1004,7 @@ static void writer_release(cdem_h5_writer *w) {
         H5Tclose(w->ckpt_mtype);
     if (w->file >= 0)
         H5Fclose(w->file);
+    cdem_runlock_release(w->lock); /* last: nothing of ours is touched after this */
     free(w->path);
     free(w->xmf_path);
     free(w->buf);
@@ -890,19 +1027,39 @@ static cdem_status start_swmr(cdem_h5_writer *w, cdem_error *err) {
     return CDEM_OK;
 }
 
+/* Puts tmp at path: rename when an existing file may be replaced (replace = 1), otherwise
+ * a rename that fails instead of replacing a file that appeared after the checks. */
+static int put_in_place(const char *tmp, const char *path, int replace) {
+    if (replace)
+        return rename(tmp, path);
+    if (renameat2(AT_FDCWD, tmp, AT_FDCWD, path, RENAME_NOREPLACE) == 0)
+        return 0;
+    if (errno != EINVAL && errno != ENOSYS)
+        return -1;
+    /* a filesystem without RENAME_NOREPLACE: a hard link fails on an existing name too */
+    if (link(tmp, path) != 0)
+        return -1;
+    return unlink(tmp) == 0 || errno == ENOENT ? 0 : -1;
+}
+
 /* The file is built under a temporary name (tmp) and renamed to w->path once its layout
- * is complete and SWMR writing has started: whatever is found at w->path opens. */
+ * is complete and SWMR writing has started: whatever is found at w->path opens.
+ * replace: 1 when a file at w->path may be replaced (it was checked under the lock). */
 static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, const char *tmp,
-                                cdem_error *err) {
+                                int replace, cdem_error *err) {
     hid_t fapl = writer_fapl();
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
-    w->file = H5Fcreate(tmp, H5F_ACC_TRUNC, fcpl, fapl);
+    /* EXCL: the stale tmp of a killed run was removed under the lock; anything there now is
+     * not ours to truncate */
+    w->file = H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl);
     hid_t es = keep_errors(w->file < 0);
     H5Pclose(fapl);
     H5Pclose(fcpl);
     restore_errors(es);
     if (w->file < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot create the output file", w->path);
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot create the run file (as the temporary %s); nothing was written",
+                      w->path, tmp);
 
     char created[32] = "";
     time_t now = time(NULL);
@@ -923,12 +1080,23 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, co
     CDEM_TRY(create_layout(w, err));
     CDEM_TRY(flush_file(w, err));
     CDEM_TRY(start_swmr(w, err));
-    CDEM_TRY(flush_file(w, err));
-    if (rename(tmp, w->path) != 0)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot rename %s to it: %s", w->path, tmp,
-                         strerror(errno));
+    CDEM_TRY(commit_flush(w, err));
+    if (put_in_place(tmp, w->path, replace) != 0) {
+        int e = errno;
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: cannot put the new run file in place (rename from %s): %s%s; "
+                         "nothing was replaced",
+                         w->path, tmp, strerror(e),
+                         e == EEXIST ? " (a file appeared there while the run was set up)" : "");
+    }
+    w->placed = 1;
+    if (w->sync)
+        sync_folder_of(w->path);
     return write_xmf(w, err);
 }
+
+static cdem_status check_replace(const char *path, cdem_h5_replace policy, int *replace,
+                                 cdem_error *err);
 
 /* Allocates a writer with every handle unset. */
 static cdem_status writer_alloc(const char *path, cdem_h5_writer **out, cdem_error *err) {
@@ -942,6 +1110,7 @@ static cdem_status writer_alloc(const char *path, cdem_h5_writer **out, cdem_err
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
         w->data[k] = -1;
     w->last_number = -1;
+    w->sync = 1;
     w->path = dup_str(path);
     w->xmf_path = cdem_xdmf_path_for(path);
     w->buf = malloc(SERIES_BUFFER * sizeof *w->buf);
@@ -961,6 +1130,12 @@ static cdem_status writer_alloc(const char *path, cdem_h5_writer **out, cdem_err
 
 cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,
                                   cdem_error *err) {
+    return cdem_h5_writer_create_checked(path, meta, CDEM_H5_REPLACE_ANY, out, err);
+}
+
+cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta *meta,
+                                          cdem_h5_replace replace_policy, cdem_h5_writer **out,
+                                          cdem_error *err) {
     if (out)
         *out = NULL;
     if (!path || !*path || !meta || !meta->params || !out)
@@ -976,10 +1151,25 @@ cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, c
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
     }
     snprintf(tmp, n, "%s.creating", path);
-    cdem_status st = writer_setup(w, meta, tmp, err);
+    /* One writer per path for the writer's whole life: a second run of the same output would
+     * otherwise remove this one's temporary file and rename its own over this one's. */
+    int locked = 0, replace = 0;
+    cdem_status st = cdem_runlock_acquire(path, meta->source, &w->lock, err);
+    if (st == CDEM_OK) {
+        locked = 1;
+        st = check_replace(path, replace_policy, &replace, err);
+    }
+    /* a killed run's leftover (we hold the lock, so no live writer owns it) */
+    if (st == CDEM_OK && unlink(tmp) != 0 && errno != ENOENT)
+        st = CDEM_FAIL(err, CDEM_ERR_IO,
+                       "%s: cannot remove %s, left by an earlier run that was killed: %s", path,
+                       tmp, strerror(errno));
+    if (st == CDEM_OK)
+        st = writer_setup(w, meta, tmp, replace, err);
     if (st != CDEM_OK) {
+        if (locked)
+            remove(tmp); /* ours: removed while the lock is still held */
         writer_release(w);
-        remove(tmp);
         free(tmp);
         return st;
     }
@@ -1042,7 +1232,7 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
                           (unsigned long long)w->index_len);
         }
     }
-    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(commit_flush(w, err)); /* the data is on disk before the record points to it */
     index_row row = {
         .number = info->number,
         .phase = info->phase,
@@ -1064,7 +1254,7 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
                       "keeps the %llu increments before",
                       w->path, (int)info->number, (unsigned long long)w->index_len);
     }
-    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(commit_flush(w, err));
     w->index_len++;
     if (n) {
         w->data_ext = w->data_len + n;
@@ -1114,6 +1304,16 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
     if (H5Dflush(w->stop_detail) < 0 || H5Dflush(w->stop_reason) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s'", w->path,
                       reason ? reason : "");
+    /* not sync_file: after a failed write it would mark nothing new, and w->failed must not
+     * turn a recorded stop reason into an error */
+    if (w->sync && !w->failed) {
+        void *handle = NULL;
+        if (H5Fget_vfd_handle(w->file, H5P_DEFAULT, &handle) >= 0 && handle &&
+            fdatasync(*(int *)handle) != 0 && errno != EINVAL && errno != EROFS)
+            return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s' to disk: %s",
+                             w->path, reason ? reason : "", strerror(errno));
+        H5Eclear2(H5E_DEFAULT);
+    }
     return CDEM_OK;
 }
 
@@ -1293,6 +1493,33 @@ static cdem_status precheck_superblock(const char *path, int *status, cdem_error
     return st;
 }
 
+/* The end of the file according to its v2/v3 superblock (base address + end-of-file
+ * address), or 0 when it cannot be read. */
+static uint64_t superblock_eoa(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    static const unsigned char sig[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+    unsigned char b[64];
+    uint64_t eoa = 0;
+    for (uint64_t at = 0; at < ((uint64_t)1 << 40); at = at ? 2 * at : 512) {
+        if (fseek(f, (long)at, SEEK_SET) != 0)
+            break;
+        size_t got = fread(b, 1, sizeof b, f);
+        if (got < 12)
+            break;
+        if (memcmp(b, sig, 8) != 0)
+            continue;
+        int so = b[9];
+        if ((b[8] == 2 || b[8] == 3) && (so == 2 || so == 4 || so == 8) &&
+            got >= (size_t)(12 + 4 * so))
+            eoa = le_u64(b + 12, so) + le_u64(b + 12 + 2 * so, so);
+        break;
+    }
+    fclose(f);
+    return eoa;
+}
+
 static int cmp_incr(const void *a, const void *b) {
     int32_t x = ((const incr_entry *)a)->info.number, y = ((const incr_entry *)b)->info.number;
     return (x > y) - (x < y);
@@ -1437,6 +1664,22 @@ static cdem_status read_text_dataset(cdem_h5_reader *r, const char *name, char *
     return CDEM_OK;
 }
 
+/* Reads rows [0, n) of a checksummed dataset. A live writer rewrites the last chunk of the
+ * index and of the series in place at every append, so a SWMR reader can catch a chunk
+ * half-written, and its Fletcher-32 check then fails: such a read is tried again a few times
+ * (about 0.6 s in all); a file without a live writer is read once. 0 or -1. */
+static int read_rows_retrying(const cdem_h5_reader *r, hid_t ds, hid_t mt, hsize_t n, void *dst) {
+    for (int attempt = 0;; attempt++) {
+        if (read_all_rows(ds, mt, n, dst) == 0)
+            return 0;
+        if (!r->swmr || attempt >= 6)
+            return -1;
+        H5Eclear2(H5E_DEFAULT);
+        struct timespec ts = {0, (long)(10 * 1000 * 1000) << attempt}; /* 10 .. 320 ms */
+        nanosleep(&ts, NULL);
+    }
+}
+
 /* Version 2: (re)reads the index and the stop reason. In SWMR-read mode every dataset is
  * refreshed first: the index before the element datasets, so that the element datasets are
  * at least as long as the rows the index lists (the writer writes them in the other order).
@@ -1495,9 +1738,11 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
     cdem_status st = CDEM_OK;
     if ((rows && !ix) || mt < 0)
         st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", r->path);
-    else if (rows && read_all_rows(r->index, mt, rows, ix) < 0)
+    else if (rows && read_rows_retrying(r, r->index, mt, rows, ix) < 0)
         st = H5FAIL(err, CDEM_ERR_FORMAT,
-                    "%s: cannot read /increments/index (corrupt, or members missing?)", r->path);
+                    "%s: /increments/index (the list of increments) is damaged or unreadable: "
+                    "no increment of this file can be trusted",
+                    r->path);
     if (mt >= 0)
         H5Tclose(mt);
     if (st == CDEM_OK && rows > r->cap_incr) {
@@ -1512,20 +1757,22 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
     }
     r->n_incr = 0;
     r->n_skipped = 0;
-    int32_t prev = -1;
     for (hsize_t i = 0; st == CDEM_OK && i < rows; i++) {
-        const char *why = bad_index_row(&ix[i], prev, data_ext, stress_ext);
+        const char *why = bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext);
         if (why) {
-            if (r->unclosed) {
-                r->n_skipped = (size_t)(rows - i);
+            /* A writer that died (or is writing) can leave its last row unwritten, never an
+             * earlier one: a bad row before a good one is damage. */
+            if (r->unclosed && i == rows - 1) {
+                r->n_skipped = 1;
                 break;
             }
-            st =
-                CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/index row %llu (increment %d): %s",
-                          r->path, (unsigned long long)i, (int)ix[i].number, why);
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: /increments/index row %llu (increment %d): %s (step %lld, time "
+                           "%.17g s, net displacement %.17g m): damaged file",
+                           r->path, (unsigned long long)i, (int)ix[i].number, why,
+                           (long long)ix[i].step, ix[i].time, ix[i].net_displacement);
             break;
         }
-        prev = ix[i].number;
         incr_entry *e = &r->incr[r->n_incr++];
         memset(e, 0, sizeof *e);
         e->info.number = ix[i].number;
@@ -1583,26 +1830,42 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     CDEM_TRY(precheck_superblock(path, &status, err));
     r->unclosed = status != 0;
     /* A writer that still runs or died leaves the v3 superblock's status flags set; HDF5
-     * then refuses a plain open. A version-2 writer runs in SWMR-write mode (flags 0x05):
-     * SWMR-read opens such a file, running or killed, and sees it grow (H5Drefresh). A
-     * version-1 writer (flags 0x01), or a version-2 writer killed before it entered SWMR
-     * mode, needs "clear_status_flags", the file-access property h5clear uses; on a
-     * read-only open it only skips the check (the file is not changed). File locking is
-     * off in both cases so that a live writer's lock does not block the reader. */
+     * then refuses a plain open. Whether the writer still runs is what its lock says
+     * (runlock.h; a symbolic link is followed to the file the writer named):
+     *  - alive (or cannot tell): SWMR-read, which sees the file grow (H5Drefresh). HDF5
+     *    retries a metadata read whose checksum fails, because the writer may be rewriting
+     *    that piece; between attempts it sleeps 1, 2, 4, ... ns, 100 attempts by default:
+     *    2^100 ns, i.e. for ever on a damaged file (a reader sat in H5C_protect ->
+     *    H5_nanosleep for more than 300 s). SWMR_READ_ATTEMPTS bounds the total wait;
+     *  - dead (killed, or a copy of its file): the file is complete, so it is opened as one,
+     *    without SWMR and its retries: "clear_status_flags" (the file-access property h5clear
+     *    uses; on a read-only open it only skips the check, the file is not changed) and
+     *    "skip_eof_check" (a killed writer may have reserved space it never wrote).
+     * A version-1 writer (flags 0x01) never ran in SWMR mode: also the second way.
+     * File locking (HDF5's own) is off either way so that a live writer does not block the
+     * reader, and a process may open the same file twice (render --follow; HDF5 refuses a
+     * second open whose locking setting differs). */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    /* Always off for readers: a process may open the same file twice (cdem-strain render
-     * --follow), and HDF5 refuses a second open whose locking setting differs. */
     H5Pset_file_locking(fapl, 0, 1);
+    int live = 0;
     if (status & 0x04) {
+        char *real = realpath(path, NULL);
+        live = cdem_runlock_probe(real ? real : path, NULL, 0) != 0;
+        free(real);
+    }
+    if (live) {
+        H5Pset_metadata_read_attempts(fapl, SWMR_READ_ATTEMPTS);
         r->file = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
         r->swmr = r->file >= 0;
         if (r->file < 0)
             H5Eclear2(H5E_DEFAULT);
+        H5Pset_metadata_read_attempts(fapl, 1);
     }
     if (r->file < 0) {
         if (r->unclosed) {
-            hbool_t clear = 1;
-            H5Pset(fapl, "clear_status_flags", &clear);
+            hbool_t yes = 1;
+            H5Pset(fapl, "clear_status_flags", &yes);
+            H5Pset(fapl, "skip_eof_check", &yes);
         }
         r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     }
@@ -1622,6 +1885,11 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
 
     char *fmt = NULL;
     int rc = get_str_attr(r->file, "format", &fmt);
+    if (rc < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT,
+                      "%s: damaged file: HDF5 opens it but its root attribute 'format' cannot "
+                      "be read (corrupt HDF5 metadata)",
+                      path);
     if (rc != 0 || strcmp(fmt, CDEM_FORMAT_NAME) != 0) {
         cdem_status st = H5FAIL(err, CDEM_ERR_FORMAT,
                                 "%s: an HDF5 file but not a cdem file: root attribute 'format' "
@@ -1993,13 +2261,33 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
     for (size_t c = 0; st == CDEM_OK && c < N_SERIES && len > 0; c++) {
         const series_column *sc = &series_columns[c];
         hid_t mt = sc->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
-        if (read_all_rows(ds[c], mt, len, col) < 0) {
-            st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read dataset /series/%s (corrupt?)",
-                        r->path, sc->name);
+        if (read_rows_retrying(r, ds[c], mt, len, col) < 0) {
+            st = H5FAIL(err, CDEM_ERR_FORMAT,
+                        "%s: the time series column /series/%s is damaged or unreadable", r->path,
+                        sc->name);
             break;
         }
         for (hsize_t i = 0; i < len; i++)
             memcpy((char *)&out[i] + sc->offset, (char *)col + i * 8, 8);
+    }
+    /* Samples come in time order. A writer that died (or is writing) may leave the last
+     * samples unwritten (zeros): the series then ends before them. Anywhere else a sample out
+     * of order is damage (files written before the series carried a checksum). */
+    for (hsize_t i = 0; st == CDEM_OK && i < len; i++) {
+        const cdem_series_sample *q = &out[i], *p = i ? &out[i - 1] : NULL;
+        if (q->step >= 0 && isfinite(q->time) && q->time >= 0.0 &&
+            (!p || (q->step > p->step && q->time >= p->time)))
+            continue;
+        if (r->unclosed) {
+            len = i;
+            break;
+        }
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                       "%s: /series sample %llu (step %lld, time %.17g s) is out of order (the "
+                       "previous one is step %lld, time %.17g s; steps must increase and times "
+                       "must be finite, >= 0 and not decrease): damaged file",
+                       r->path, (unsigned long long)i, (long long)q->step, q->time,
+                       p ? (long long)p->step : -1LL, p ? p->time : 0.0);
     }
     for (size_t c = 0; c < opened && c < N_SERIES; c++)
         if (ds[c] >= 0)
@@ -2105,6 +2393,28 @@ double cdem_h5_estimate_file_size(double n_elements, double n_increments, int wi
     return 65536.0 + n_increments * (512.0 + n_elements * per);
 }
 
+/* Checkpoint and sidecar sizes for cdem_h5_estimate_run_space, measured on cdem-run files
+ * (docs/format.md, "Size"): a checkpoint holds about CKPT_BYTES_PER_ELEMENT bytes per
+ * element (state, neighbour list, contact histories) plus the parameter text and the
+ * summary; a sidecar increment is about XMF_BYTES_PER_INCREMENT bytes of XML. */
+#define CKPT_BYTES_FIXED        65536.0
+#define CKPT_BYTES_PER_ELEMENT  400.0
+#define XMF_BYTES_PER_INCREMENT 3400.0
+#define XMF_BYTES_STRESS        1300.0
+
+double cdem_h5_estimate_run_space(double n_elements, double n_increments, int with_stress,
+                                  int with_checkpoints) {
+    double total = cdem_h5_estimate_file_size(n_elements, n_increments, with_stress);
+    if (with_checkpoints) {
+        /* a slot is a whole number of chunks, allocated in full; two slots */
+        double blob = CKPT_BYTES_FIXED + n_elements * CKPT_BYTES_PER_ELEMENT;
+        total += 2.0 * ceil(blob / CKPT_CHUNK) * CKPT_CHUNK;
+    }
+    /* the sidecar, and its temporary copy while it is rewritten */
+    total += 2.0 * n_increments * (XMF_BYTES_PER_INCREMENT + (with_stress ? XMF_BYTES_STRESS : 0));
+    return total;
+}
+
 cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err) {
     if (!r || !p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_params: bad arguments");
@@ -2155,15 +2465,99 @@ cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem
     else
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     struct statvfs sv;
-    if (statvfs(dir, &sv) != 0)
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot examine the output directory %s: %s", path,
-                         dir, strerror(errno));
+    if (statvfs(dir, &sv) != 0) {
+        int e = errno;
+        if (e == ENOENT)
+            return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "cannot write %s: folder %s does not exist",
+                             path, dir);
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "cannot write %s: cannot reach folder %s: %s",
+                         path, dir, strerror(e));
+    }
     double avail = (double)sv.f_bavail * (double)sv.f_frsize;
     if (avail < bytes_needed)
         return CDEM_FAIL(err, CDEM_ERR_IO,
                          "%s: the output needs about %.1f MB but %s has %.1f MB free", path,
                          bytes_needed / 1e6, dir, avail / 1e6);
     return CDEM_OK;
+}
+
+/* What is at path, for the messages of check_replace: *is_cdem becomes 1 for a file the
+ * reader opens as a cdem file; desc receives e.g. 'a cdem run file (stop reason
+ * "completed", 41 increments)' or 'not an HDF5 file'. */
+static void describe_existing(const char *path, int *is_cdem, int *resumable, char *desc,
+                              size_t cap) {
+    *is_cdem = *resumable = 0;
+    cdem_error e;
+    cdem_error_clear(&e);
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &e) != CDEM_OK) {
+        const char *why = e.msg;
+        size_t n = strlen(path);
+        if (strncmp(why, path, n) == 0 && why[n] == ':') /* the message starts with the path */
+            why += n + 2;
+        snprintf(desc, cap, "%s%.300s", e.code == CDEM_ERR_FORMAT ? "" : "unreadable: ", why);
+        return;
+    }
+    *is_cdem = 1;
+    const char *stop = cdem_h5_reader_stop_reason(r);
+    *resumable = strcmp(cdem_h5_reader_source(r), "cdem-run") == 0 &&
+                 strcmp(stop, "completed") != 0 && cdem_h5_reader_format_version(r) >= 2;
+    snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\", %zu increments",
+             cdem_h5_reader_source(r), stop, cdem_h5_reader_increment_count(r));
+    cdem_h5_reader_close(r);
+}
+
+/* The policy for a file already at path; *replace becomes 1 when it may be replaced by a
+ * rename, 0 when there is nothing there (the writer's rename then refuses to replace). */
+static cdem_status check_replace(const char *path, cdem_h5_replace policy, int *replace,
+                                 cdem_error *err) {
+    *replace = 0;
+    struct stat sb;
+    if (lstat(path, &sb) != 0) {
+        if (errno == ENOENT)
+            return CDEM_OK;
+        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot examine the output path: %s", path,
+                         strerror(errno));
+    }
+    if (S_ISDIR(sb.st_mode))
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT, "%s: the output path is a folder", path);
+    if (policy == CDEM_H5_REPLACE_ANY) {
+        *replace = 1;
+        return CDEM_OK;
+    }
+    if (!S_ISREG(sb.st_mode))
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "%s already exists and is not a regular file (a link, a device, a "
+                         "pipe?); a run never replaces it: choose another output file",
+                         path);
+    int is_cdem = 0, resumable = 0;
+    char desc[600];
+    describe_existing(path, &is_cdem, &resumable, desc, sizeof desc);
+    if (!is_cdem)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "%s already exists and is not a cdem run file (%s); it is never "
+                         "replaced by a run file, not even with --force: choose another output "
+                         "file",
+                         path, desc);
+    if (policy == CDEM_H5_REPLACE_NEVER)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "%s already exists (%s); it was left as it is: choose another output "
+                         "file (-o), remove it, or replace it on purpose with --force%s%s",
+                         path, desc,
+                         resumable ? "; to continue that run instead: cdem-run "
+                                     "--resume "
+                                   : "",
+                         resumable ? path : "");
+    *replace = 1;
+    return CDEM_OK;
+}
+
+cdem_status cdem_h5_output_check(const char *path, cdem_h5_replace replace, cdem_error *err) {
+    if (!path || !*path)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_output_check: no path");
+    CDEM_TRY(cdem_runlock_check(path, err));
+    int dummy = 0;
+    return check_replace(path, replace, &dummy, err);
 }
 
 /* ------------------------------------------------------------ checkpoints */
@@ -2329,7 +2723,7 @@ cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapsh
                       "full?); the previous checkpoint stays valid",
                       w->path, len, slot);
     }
-    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(commit_flush(w, err));
     ckpt_row row = {seq, w->last_number, w->last_step, (int64_t)len, fnv1a64(w->ckpt_buf, len)};
     hsize_t start = (hsize_t)slot, one = 1;
     hid_t fs = H5Dget_space(w->ckpt_index), ms = H5Screate_simple(1, &one, NULL);
@@ -2346,13 +2740,14 @@ cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapsh
         w->failed = 1;
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write /checkpoint/index", w->path);
     }
-    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(commit_flush(w, err));
     w->ckpt[slot] = row;
     return CDEM_OK;
 }
 
 static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t keep_step,
                                 cdem_error *err) {
+    w->placed = 1;
     int flags = 0;
     CDEM_TRY(precheck_superblock(w->path, &flags, err));
     hid_t fapl = writer_fapl();
@@ -2362,15 +2757,36 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     hid_t es = keep_errors(w->file < 0);
     H5Pclose(fapl);
     restore_errors(es);
-    if (w->file < 0)
-        return H5FAIL(err, CDEM_ERR_IO,
-                      "%s: cannot open the run file for writing (is its writer still running?)",
+    if (w->file < 0) {
+        /* The writer holds the file's lock, so no other writer is running: the file itself is
+         * the problem. A killed run's file can be cut short (full disk, interrupted copy),
+         * and HDF5 opens such a file for writing no more. */
+        struct stat sb;
+        uint64_t eoa = superblock_eoa(w->path);
+        if (stat(w->path, &sb) == 0 && eoa > (uint64_t)sb.st_size) {
+            H5Eclear2(H5E_DEFAULT);
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                             "%s: cannot be resumed: the file is truncated (it has %llu bytes, "
+                             "its HDF5 superblock says %llu; cut short by a full disk or an "
+                             "interrupted copy?); it was not changed, and the increments that "
+                             "survived the cut can still be read (cdem-strain info)",
+                             w->path, (unsigned long long)sb.st_size, (unsigned long long)eoa);
+        }
+        return H5FAIL(err, CDEM_ERR_FORMAT,
+                      "%s: cannot be resumed: HDF5 cannot open it for writing (damaged file?); "
+                      "it was not changed",
                       w->path);
+    }
     char *fmt = NULL;
     int32_t version = 0;
     int rc = get_str_attr(w->file, "format", &fmt);
     int bad = rc != 0 || strcmp(fmt, CDEM_FORMAT_NAME) != 0;
     free(fmt);
+    if (bad && rc < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT,
+                      "%s: cannot be resumed: its root attribute 'format' is unreadable (corrupt "
+                      "HDF5 metadata); it was not changed",
+                      w->path);
     if (bad)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: not a cdem file (root attribute 'format')",
                       w->path);
@@ -2418,10 +2834,9 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /increments/index", w->path);
     }
     hsize_t keep = 0;
-    int32_t prev = -1;
     while (keep < rows && ix[keep].number <= keep_inc &&
-           !bad_index_row(&ix[keep], prev, data_ext, stress_ext))
-        prev = ix[keep++].number;
+           !bad_index_row(&ix[keep], keep ? &ix[keep - 1] : NULL, data_ext, stress_ext))
+        keep++;
     cdem_status st = CDEM_OK;
     w->data_len = w->stress_len = 0;
     for (hsize_t i = 0; i < keep && st == CDEM_OK; i++) {
@@ -2489,7 +2904,7 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     for (int s = 0; s < 2; s++)
         if (w->ckpt[s].sequence < 0)
             w->ckpt[s].sequence = 0;
-    CDEM_TRY(flush_file(w, err));
+    CDEM_TRY(commit_flush(w, err));
     CDEM_TRY(start_swmr(w, err));
     CDEM_TRY(write_xmf(w, err));
     return CDEM_OK;
@@ -2505,7 +2920,9 @@ cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increme
     writer_hdf5_init();
     cdem_h5_writer *w = NULL;
     CDEM_TRY(writer_alloc(path, &w, err));
-    cdem_status st = reopen_setup(w, keep_through_increment, keep_through_step, err);
+    cdem_status st = cdem_runlock_acquire(path, "cdem-run --resume", &w->lock, err);
+    if (st == CDEM_OK)
+        st = reopen_setup(w, keep_through_increment, keep_through_step, err);
     if (st != CDEM_OK) {
         writer_release(w);
         return st;

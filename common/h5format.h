@@ -7,7 +7,9 @@
  * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs).
  * Every object is created with the file; the writer then runs in HDF5 SWMR-write mode, so a
  * writer killed at any moment leaves every completed increment readable and a reader can
- * follow a running simulation (cdem_h5_reader_refresh).
+ * follow a running simulation (cdem_h5_reader_refresh). A writer holds the path's lock
+ * (runlock.h) from creation to close: one writer per path, and a reader knows whether the
+ * writer is alive (a dead writer's file is read as a complete file).
  * Ownership: writer and reader are opaque handles; _close releases them (NULL allowed).
  * Thread safety: one handle per thread; HDF5 itself is not called concurrently.
  * Units: SI (m, s, N/m) as documented per field. */
@@ -63,6 +65,16 @@ typedef struct {
     double sea_level;           /* m, NaN when none */
 } cdem_series_sample;
 
+/* What the writer may do with a file already at the output path.
+ * Whatever the policy, the old file stays untouched until the new one is complete enough to
+ * open (it replaces the old one by a rename). */
+typedef enum {
+    CDEM_H5_REPLACE_ANY = 0, /* replace whatever is there (the library's first behaviour) */
+    CDEM_H5_REPLACE_NEVER,   /* refuse any existing file (cdem-run without --force) */
+    CDEM_H5_REPLACE_CDEM,    /* replace only a cdem file (cdem-run --force, import-cdem2d);
+                                never a parameter file, notes or a damaged file */
+} cdem_h5_replace;
+
 /* Everything stored once per file. Strings may be NULL (stored empty). */
 typedef struct {
     const cdem_params *params;   /* the full parameter record (required) */
@@ -75,10 +87,20 @@ typedef struct {
 /* ---------------------------------------------------------------- writer */
 typedef struct cdem_h5_writer cdem_h5_writer;
 
-/* Creates path (truncating), writes the metadata and the .xmf sidecar placeholder, and
- * flushes. Fails with CDEM_ERR_IO naming the path if it cannot be created. */
+/* Creates path, writes the metadata and the .xmf sidecar placeholder, and flushes. The
+ * writer holds the path's lock (runlock.h, PATH.lock) from here until _close, so a second
+ * writer of the same path fails at once (CDEM_ERR_CONFLICT naming the first) and readers
+ * know the file is being written. The file is built as PATH.creating and renamed to path
+ * once its layout is complete; a file already at path is replaced then. Fails with
+ * CDEM_ERR_IO naming the path if it cannot be created. */
 cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,
                                   cdem_error *err);
+
+/* The same, with a policy for a file already at path (CDEM_ERR_CONFLICT, saying what is
+ * there and what to do, when it may not be replaced; checked under the lock). */
+cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta *meta,
+                                          cdem_h5_replace replace, cdem_h5_writer **out,
+                                          cdem_error *err);
 
 /* Appends one increment (all s->n elements; stress when s->has_stress), updates the .xmf
  * sidecar and flushes the file. */
@@ -96,6 +118,19 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
 
 /* Flushes everything and closes; w may be NULL. Returns the first error met. */
 cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err);
+
+/* Durability (on by default): every commit (an increment's index row, a checkpoint's index
+ * row, the stop reason) is flushed to stable storage with fsync before the writer goes on,
+ * and the data it commits is flushed before it, so a power cut keeps every committed
+ * increment. sync = 0 leaves that to the operating system (a killed process still keeps
+ * everything; a power cut may not): cdem-run --no-fsync, for throwaway runs. */
+void cdem_h5_writer_set_sync(cdem_h5_writer *w, int sync);
+
+/* Checks, before a run is set up, that a writer could create path under the policy
+ * replace: no live writer holds the path (CDEM_ERR_CONFLICT naming it), and an existing
+ * file is allowed to be replaced (CDEM_ERR_CONFLICT saying what it is and what to do).
+ * The writer repeats these checks under its lock; this one only makes refusals immediate. */
+cdem_status cdem_h5_output_check(const char *path, cdem_h5_replace replace, cdem_error *err);
 
 /* ------------------------------------------------------------ checkpoints */
 /* Stores snap as the file's checkpoint, belonging to the increment written last (a resumed
@@ -171,12 +206,20 @@ cdem_status cdem_h5_write_xdmf(const char *h5_path, const char *xmf_path, int fl
 
 /* Estimated size in bytes of a run file with n_elements elements in each of n_increments
  * increments (stress stored when with_stress), from the measured compression of the
- * default run (docs/format.md, "Size"); for the free-space check before a run. */
+ * default run (docs/format.md, "Size"). Element data, index and series only. */
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress);
+
+/* Estimated disk space a whole run needs (for the free-space check before it): the file as
+ * above, its two checkpoint slots when with_checkpoints (each a whole number of 1 MiB
+ * chunks holding one checkpoint of n_elements elements) and the .xmf sidecar, counted twice
+ * because it is rewritten through a temporary copy. */
+double cdem_h5_estimate_run_space(double n_elements, double n_increments, int with_stress,
+                                  int with_checkpoints);
 
 /* Checks, before a run starts, that the directory of path has at least bytes_needed bytes
  * free for an unprivileged user (statvfs). Fails with CDEM_ERR_IO naming the directory, the
- * estimate and the free space when it has not (or when it cannot be examined). */
+ * estimate and the free space when it has not; with CDEM_ERR_NOTFOUND when the directory
+ * cannot be reached (missing, not a folder, no permission), naming it. */
 cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */

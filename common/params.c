@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #define P_OFF(field) offsetof(cdem_params, field)
 
@@ -383,6 +384,33 @@ static const char *type_noun(cdem_param_type t) {
 
 /* ---------- assignment: the one path for file lines, defaults and overrides ---------- */
 
+/* 1 when v is a plain decimal number ([+-]digits[.digits][e[+-]digits]). strtod also reads
+ * hexadecimal ("0x10" is 16), "infinity" and "nan", which a parameter file never means: a
+ * hex value would be taken silently for another number. */
+static int decimal_text(const char *v) {
+    const char *p = v;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    while (isdigit((unsigned char)*p))
+        p++, digits++;
+    if (*p == '.')
+        for (p++; isdigit((unsigned char)*p); p++)
+            digits++;
+    if (digits == 0)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-')
+            p++;
+        if (!isdigit((unsigned char)*p))
+            return 0;
+        while (isdigit((unsigned char)*p))
+            p++;
+    }
+    return *p == '\0';
+}
+
 /* Sets one parameter from its value text. where = "model.ini:12" or "-s a.b=c"; the message
  * reads "<where>: <key> = <value>: <problem>". */
 static cdem_status assign_value(cdem_params *p, const cdem_param_def *d, const char *value,
@@ -407,6 +435,8 @@ static cdem_status assign_value(cdem_params *p, const cdem_param_def *d, const c
         double v = 0.0;
         if (d->type == CDEM_PTYPE_DOUBLE) {
             v = strtod(value, &end);
+            if (!decimal_text(value))
+                end = (char *)value; /* refused below as "not a number" */
         } else {
             long long iv = strtoll(value, &end, 10);
             v = (double)iv;
@@ -680,6 +710,14 @@ cdem_status cdem_params_load(cdem_params *p, const char *path, char **text_out, 
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot open parameter file: %s", path,
                          strerror(errno));
+    struct stat sb; /* a folder opens, and then every read fails with a bare "read error" */
+    if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: is %s, not a parameter file (a text file of "
+                         "[section] and key = value lines)",
+                         path, S_ISDIR(sb.st_mode) ? "a folder" : "not a regular file");
+    }
     size_t cap = 4096, len = 0;
     char *buf = malloc(cap);
     if (!buf) {

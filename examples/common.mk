@@ -41,9 +41,12 @@ quick = $(if $(filter 1,$(QUICK)),$(1))
 
 # cdem-run quietly at low priority. The output is written in place (renaming it would
 # break the .xmf sidecar that names it); .DELETE_ON_ERROR and make's own clean-up on
-# interrupt remove a partial .h5, so it is never taken as finished.
+# interrupt remove a partial .h5, so it is never taken as finished (these figure pipelines
+# re-run a failed simulation rather than continue it with --resume; docs/guide.md's sweep
+# keeps it instead). --force: make re-runs a target that is out of date, and cdem-run
+# replaces an existing file only when told so.
 # $(call simulate,MODEL.ini,OUT.h5,EXTRA -s ARGS)
-simulate = nice -n $(NICE) $(CDEM_RUN) -q $(1) $(3) -o $(2)
+simulate = nice -n $(NICE) $(CDEM_RUN) -q --force $(1) $(3) -o $(2)
 
 # Renderings: 1000 px wide PNGs.
 RENDER = $(CDEM_STRAIN) render --width 1000

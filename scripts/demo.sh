@@ -6,7 +6,8 @@ set -eu
 BUILD=${1:-build}
 OUT=${CDEM_DEMO_OUT:-out}
 mkdir -p "$OUT"
-"$BUILD/cdem-run" -o "$OUT/default.h5"
+# --force: a demo run of an earlier `make demo` is replaced (cdem-run keeps existing files)
+"$BUILD/cdem-run" --force -o "$OUT/default.h5"
 "$BUILD/cdem-strain" info "$OUT/default.h5" | grep -E "^(stop reason|increments):"
 "$BUILD/cdem-strain" compute "$OUT/default.h5" --increment last --quantity total-max-shear \
     -o "$OUT/default-total-max-shear.csv"

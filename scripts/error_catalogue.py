@@ -18,9 +18,11 @@ GROUPS = [  # (title, source files, what to do)
      "line (or the -s argument). `cdem-run --print-defaults` writes a valid file to start "
      "from; docs/parameters.md lists every key, range and rule between keys."),
     ("Fault vertex files (irregular-fault)", ["solver/fault_file.c"],
-     "Fix the named line of the vertex file: two numbers `x y` in metres per line; first point "
-     "at (fault_location x width x unit_scaling, 0); every later point at lower x and higher y. "
-     "The path is relative to the directory cdem-run runs in."),
+     "Fix the named line of the vertex file: two plain decimal numbers `x y` in metres per "
+     "line; first point at (fault_location x width x unit_scaling, 0); every later point at "
+     "lower x and higher y, every segment dipping at least 1 degree and at least half the "
+     "smallest radius long, no point above twice the model's height. The path is relative to "
+     "the directory cdem-run runs in."),
     ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
       "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
       "solver/run.c", "solver/sediment.c", "solver/integrate.c", "solver/contact.c", "solver/neighbour.c",
@@ -29,12 +31,17 @@ GROUPS = [  # (title, source files, what to do)
      "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
      "`keep_constants = off` at small unit scaling or use the default constants; "
      "\"settling > displacement\" gives the display_interval and equilibration that work."),
-    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c", "common/xdmf.c",
-                           "common/outfile.c"],
-     "The file is not a cdem file, is truncated (a run killed while writing: re-run it), of "
-     "another format version (re-run with this cdem-run), or the increment/dataset asked for "
-     "does not exist (`cdem-strain info RUN.h5` lists the increments). A file left open by a "
-     "crashed writer can be cleared with `h5clear -s RUN.h5`."),
+    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c", "common/runlock.c",
+                           "common/xdmf.c", "common/outfile.c"],
+     "The file is not a cdem file, is damaged (a checksum failed: copy it again or re-run) or "
+     "truncated (cut short by a full disk or an interrupted copy), of another format version "
+     "(re-run with this cdem-run), or the increment/dataset asked for does not exist "
+     "(`cdem-strain info RUN.h5` lists the increments). A run killed while writing keeps its "
+     "complete increments (`cdem-run --resume RUN.h5` continues it; cdem-strain reads it as "
+     "it is, other HDF5 tools after `h5clear -s RUN.h5`). \"is being written by another "
+     "process\" names the run writing the file: wait for it, stop it or write elsewhere. An "
+     "existing output is replaced only with `--force`, and a file that is not a cdem run file "
+     "never."),
     ("cdem2D import", ["analysis/cdem2d.c"],
      "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
      "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "

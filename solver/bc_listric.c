@@ -157,6 +157,12 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
     if (c->irregular) {
         CDEM_TRY(
             cdem_fault_file_read(p->fault_file, c->x_fault, 0.5 * m->radius[0], &c->line, err));
+        /* the fault elements are laid along the curve up to its highest vertex (lay_fault): a
+         * vertex at y = 1e9 m laid millions of them. Twice the model's height leaves room for
+         * a vertex file written for a taller model of the same fault. */
+        CDEM_TRY(cdem_fault_file_check_extent(&c->line, p->fault_file,
+                                              2.0 * (fmax(wall_top, top) + m->total_displacement),
+                                              0.5 * m->radius[0], err));
         c->dip_base_deg =
             atan2(c->line.y[1] - c->line.y[0], c->line.x[0] - c->line.x[1]) * 180.0 / M_PI;
     } else {

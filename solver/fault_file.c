@@ -6,16 +6,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 void cdem_fault_file_free(cdem_fault_polyline *pl) {
     if (!pl)
         return;
     free(pl->x);
     free(pl->y);
+    free(pl->line);
     memset(pl, 0, sizeof *pl);
 }
 
-static cdem_status pl_push(cdem_fault_polyline *pl, size_t *cap, double x, double y,
+static cdem_status pl_push(cdem_fault_polyline *pl, size_t *cap, double x, double y, long line,
                            cdem_error *err) {
     if (pl->n == *cap) {
         const size_t nc = *cap ? 2 * *cap : 16;
@@ -29,12 +31,45 @@ static cdem_status pl_push(cdem_fault_polyline *pl, size_t *cap, double x, doubl
             return CDEM_FAIL(err, CDEM_ERR_NOMEM, "fault polyline: out of memory for %zu vertices",
                              nc);
         pl->y = ny;
+        long *nl = realloc(pl->line, nc * sizeof *nl);
+        if (!nl)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "fault polyline: out of memory for %zu vertices",
+                             nc);
+        pl->line = nl;
         *cap = nc;
     }
     pl->x[pl->n] = x;
     pl->y[pl->n] = y;
+    pl->line[pl->n] = line;
     pl->n++;
     return CDEM_OK;
+}
+
+/* Length of the plain decimal number at s ([+-]digits[.digits][e[+-]digits]), 0 if none.
+ * strtod alone also reads hexadecimal ("0x1p-1074"), "inf" and "nan". */
+static size_t decimal_length(const char *s) {
+    const char *p = s;
+    if (*p == '+' || *p == '-')
+        p++;
+    int digits = 0;
+    for (; *p >= '0' && *p <= '9'; p++)
+        digits++;
+    if (*p == '.')
+        for (p++; *p >= '0' && *p <= '9'; p++)
+            digits++;
+    if (!digits)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        const char *q = p + 1;
+        if (*q == '+' || *q == '-')
+            q++;
+        if (*q >= '0' && *q <= '9') {
+            while (*q >= '0' && *q <= '9')
+                q++;
+            p = q;
+        }
+    }
+    return (size_t)(p - s);
 }
 
 /* Parses one number field of [*p, end); advances *p. 0 on success. */
@@ -47,7 +82,7 @@ static int parse_field(char **p, double *v) {
     char *e = NULL;
     errno = 0;
     const double d = strtod(s, &e);
-    if (e == s || errno == ERANGE || !isfinite(d) ||
+    if (e == s || e != s + decimal_length(s) || errno == ERANGE || !isfinite(d) ||
         !(*e == '\0' || *e == ' ' || *e == '\t' || *e == ','))
         return 2; /* not a number */
     *v = d;
@@ -114,8 +149,18 @@ static cdem_status read_lines(FILE *f, const char *path, double x0, double tol,
                                  "and higher y than the previous point (%g, %g) m (the fault "
                                  "dips toward +x and is listed from the base up-dip)",
                                  path, lineno, xy[0], xy[1], px, py);
+            /* the fault's x at a height is interpolated (and below the base extrapolated)
+             * along a segment: a segment rising 5e-324 m over 1400 m gave x = inf */
+            const double dip = atan2(xy[1] - py, px - xy[0]) * 180.0 / M_PI;
+            if (!(dip >= CDEM_FAULT_MIN_DIP))
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "fault file %s, line %ld: the segment from (%g, %g) m to (%g, "
+                                 "%g) m dips %.3g degrees; every segment must dip at least %g "
+                                 "degrees (a flatter one gives no position of the fault at a "
+                                 "height)",
+                                 path, lineno, px, py, xy[0], xy[1], dip, CDEM_FAULT_MIN_DIP);
         }
-        CDEM_TRY(pl_push(pl, &cap, pl->n == 0 ? x0 : xy[0], pl->n == 0 ? 0.0 : xy[1], err));
+        CDEM_TRY(pl_push(pl, &cap, pl->n == 0 ? x0 : xy[0], pl->n == 0 ? 0.0 : xy[1], lineno, err));
     }
     if (ferror(f))
         return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: read error after line %ld", path,
@@ -146,6 +191,14 @@ cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_f
     FILE *f = fopen(path, "r");
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: cannot open: %s", path, strerror(errno));
+    struct stat sb; /* a folder opens, and then every read fails with a bare "read error" */
+    if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return CDEM_FAIL(
+            err, CDEM_ERR_IO,
+            "fault file %s: is %s, not a text file of x y points (boundary.fault_file)", path,
+            S_ISDIR(sb.st_mode) ? "a folder" : "not a regular file");
+    }
     /* A NUL byte would end a line early without notice (fgets): refuse binary files. */
     char chunk[4096];
     size_t got, offset = 0;
@@ -166,6 +219,37 @@ cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_f
     if (st != CDEM_OK)
         cdem_fault_file_free(pl);
     return st;
+}
+
+cdem_status cdem_fault_file_check_extent(const cdem_fault_polyline *pl, const char *path,
+                                         double y_max, double min_segment, cdem_error *err) {
+    for (size_t k = 0; k < pl->n; k++) {
+        const long line = pl->line ? pl->line[k] : (long)k + 1;
+        if (pl->x[k] < 0.0)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "fault file %s, line %ld: point (%g, %g) m lies left of the model "
+                             "(x must be >= 0 m, the inner side of its left wall)",
+                             path, line, pl->x[k], pl->y[k]);
+        if (pl->y[k] > y_max)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "fault file %s, line %ld: point (%g, %g) m lies far above the "
+                             "model (y must be <= %g m: twice the top of its walls and assembly "
+                             "plus the whole displacement; above its last point the fault goes "
+                             "on vertically anyway)",
+                             path, line, pl->x[k], pl->y[k], y_max);
+        if (k > 0) {
+            const double len = hypot(pl->x[k] - pl->x[k - 1], pl->y[k] - pl->y[k - 1]);
+            if (!(len >= min_segment))
+                return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                                 "fault file %s, line %ld: the segment from (%g, %g) m to (%g, "
+                                 "%g) m is %g m long; segments must be at least %g m (half the "
+                                 "smallest element radius: the precision the first point is "
+                                 "held to; fault elements are laid one radius apart)",
+                                 path, line, pl->x[k - 1], pl->y[k - 1], pl->x[k], pl->y[k], len,
+                                 min_segment);
+        }
+    }
+    return CDEM_OK;
 }
 
 cdem_status cdem_fault_file_listric(double x0, double height, double dip0_deg, size_t n_seg,

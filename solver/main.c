@@ -3,20 +3,26 @@
  * Reads a parameter file (or uses the built-in default model), applies -s overrides in
  * command-line order, validates, prints the model summary and runs the simulation through
  * cdem_run() (solver/run.h). This is the only place that prints messages and chooses exit
- * codes: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM; the output
- * file is still valid and records where it stopped). Messages go to stderr as
+ * codes: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM/SIGHUP; the
+ * output file is still valid and records where it stopped). An existing output is never
+ * replaced without --force, and a file that is not a cdem run file never. Messages go to stderr as
  * "cdem-run: <message>", one line per problem; the summary and the --print-defaults /
  * --params-markdown texts go to stdout so they can be redirected into files. */
+#include "h5format.h"
 #include "model.h"
 #include "params.h"
 #include "run.h"
+#include "runlock.h"
 #include "summary.h"
 #include "cli_help.h"
 
+#include <errno.h>
+#include <limits.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifndef CDEM_VERSION
@@ -40,14 +46,20 @@ static void on_signal(int sig) {
  * every option in it appears in the synopsis and is accepted by parse_args. */
 static const char *const run_forms[] = {
     "[MODEL.ini|-] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
-    "[--print-defaults] [--params-markdown] [--max-steps N] [--par-min N] "
-    "[--ignore-free-space]",
-    "--resume RUN.h5 [-q] [--max-steps N] [--par-min N]", "-V|--version | -h|--help", NULL};
+    "[--print-defaults] [--params-markdown] [--max-steps N] [--par-min N] [--force] "
+    "[--ignore-free-space] [--no-fsync]",
+    "--resume RUN.h5 [-q] [--max-steps N] [--par-min N] [--no-fsync]",
+    "-V|--version | -h|--help", NULL};
 
 static const cdem_cli_option run_options[] = {
     {"-o", "OUT.h5",
      "output file (default: MODEL's base name with .h5 in the current directory, or "
-     "cdem-default.h5 without a model file); an XDMF sidecar OUT.xmf is written next to it"},
+     "cdem-default.h5 without a model file); an XDMF sidecar OUT.xmf is written next to it; "
+     "an existing file is not replaced (see --force), and a file that another run is "
+     "writing is refused"},
+    {"--force", NULL,
+     "replace an existing OUT.h5 that is a cdem run file (never any other file, nor the "
+     "parameter or fault file)"},
     {"-s", "section.key=value", "override one parameter (repeatable; applied after the file)"},
     {"-q, --quiet", NULL, "quiet: no summary, no progress"},
     {"--summary", NULL, "validate, print the model summary and exit"},
@@ -67,6 +79,9 @@ static const cdem_cli_option run_options[] = {
      "identical for any N and thread count)"},
     {"--ignore-free-space", NULL,
      "run even when the output directory has less free space than the estimated file size"},
+    {"--no-fsync", NULL,
+     "do not flush each committed increment to the disk: faster on slow disks, but a power "
+     "cut (not a kill) may lose increments; for throwaway runs"},
     {"-V, --version", NULL, "print the version and exit"},
     {NULL, NULL, NULL}};
 
@@ -78,10 +93,11 @@ static const cdem_cli_help run_help = {
              "Figure 7A: 10 x 5 km, planar normal fault dipping 30 degrees); '-' reads the "
              "parameter file from standard input (default output stdin.h5).",
     .options = run_options,
-    .notes = "Ctrl-C (SIGINT) or SIGTERM stops the run cleanly after the current step; the "
+    .notes = "Ctrl-C (SIGINT), SIGTERM or SIGHUP stops the run cleanly after the current step; the "
              "file stays valid and 'cdem-run --resume RUN.h5' continues it. Parameters, "
              "ranges and rules: docs/parameters.md; the user guide: docs/guide.md.",
-    .exit_status = "0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM).",
+    .exit_status = "0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM/SIGHUP: "
+                   "the run finishes its time step and records where it stopped).",
 };
 
 /* Prints a possibly multi-line message with the program prefix on every line. */
@@ -119,7 +135,27 @@ typedef struct {
     const char *resume_path; /* --resume RUN.h5, or NULL */
     long par_min;            /* --par-min, 0 = default */
     int ignore_free_space;   /* --ignore-free-space */
+    int force;               /* --force */
+    int no_fsync;            /* --no-fsync */
 } cli_args;
+
+/* A whole number > 0 for option opt; refuses trailing text, signs and values that do not
+ * fit in a long (strtol would silently give LONG_MAX for a 23-digit number). */
+static int parse_count(const char *opt, const char *text, long *out) {
+    char *end = NULL;
+    errno = 0;
+    long n = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || text[0] == '-' || text[0] == '+' || n <= 0) {
+        fprintf(stderr, "cdem-run: %s %s: expected a whole number > 0\n", opt, text);
+        return EXIT_USAGE;
+    }
+    if (errno == ERANGE) {
+        fprintf(stderr, "cdem-run: %s %s: too large (at most %ld)\n", opt, text, LONG_MAX);
+        return EXIT_USAGE;
+    }
+    *out = n;
+    return EXIT_OK;
+}
 
 /* Returns EXIT_OK or EXIT_USAGE (message already printed). */
 static int parse_args(int argc, char **argv, cli_args *a) {
@@ -151,14 +187,15 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
         } else if (strcmp(arg, "--ignore-free-space") == 0) {
             a->ignore_free_space = 1;
+        } else if (strcmp(arg, "--force") == 0) {
+            a->force = 1;
+        } else if (strcmp(arg, "--no-fsync") == 0) {
+            a->no_fsync = 1;
         } else if (strcmp(arg, "--max-steps") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a number of time steps", arg);
-            char *end = NULL;
-            long n = strtol(argv[++i], &end, 10);
-            if (end == argv[i] || *end != '\0' || n <= 0)
-                return usage_error("--max-steps %s: expected a whole number > 0", argv[i]);
-            a->max_steps = n;
+            if (parse_count(arg, argv[++i], &a->max_steps) != EXIT_OK)
+                return EXIT_USAGE;
         } else if (strcmp(arg, "--resume") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs the run file to continue", arg);
@@ -166,11 +203,8 @@ static int parse_args(int argc, char **argv, cli_args *a) {
         } else if (strcmp(arg, "--par-min") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a number of items", arg);
-            char *end = NULL;
-            long n = strtol(argv[++i], &end, 10);
-            if (end == argv[i] || *end != '\0' || n <= 0)
-                return usage_error("--par-min %s: expected a whole number > 0", argv[i]);
-            a->par_min = n;
+            if (parse_count(arg, argv[++i], &a->par_min) != EXIT_OK)
+                return EXIT_USAGE;
         } else if (arg[0] == '-' && arg[1] != '\0') {
             return usage_error("unknown option %s", arg);
         } else if (!a->model_path) {
@@ -254,6 +288,11 @@ static cdem_status read_stdin(char **text, cdem_error *err) {
     return CDEM_OK;
 }
 
+/* SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session) all stop the run cleanly:
+ * the time step finishes, a checkpoint and a final increment are written and the stop
+ * reason says "interrupted". SIGXFSZ (a ulimit -f file size limit) would kill the process
+ * without a word; ignored, the write fails with EFBIG instead, and the run stops with
+ * "write-failure", a message naming the file and every committed increment kept. */
 static void install_handlers(void) {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -261,13 +300,50 @@ static void install_handlers(void) {
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
+    sa.sa_handler = SIG_IGN;
+    sigaction(SIGXFSZ, &sa, NULL);
+}
+
+/* 1 when a and b name the same file: the same text, or the same existing inode. */
+static int same_file(const char *a, const char *b) {
+    if (!a || !b)
+        return 0;
+    if (strcmp(a, b) == 0)
+        return 1;
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
+/* Refuses an output that is one of the run's inputs, then (before the model is set up, so
+ * the refusal is immediate) an output another run is writing or that may not be replaced.
+ * The writer repeats the last two checks under its lock. */
+static int check_output(const cli_args *a, const cdem_params *p, const char *out, cdem_error *err) {
+    const char *inputs[2] = {a->model_path,
+                             p->mode == CDEM_MODE_IRREGULAR_FAULT ? p->fault_file : NULL};
+    const char *what[2] = {"the parameter file", "the fault vertex file (boundary.fault_file)"};
+    for (int k = 0; k < 2; k++)
+        if (inputs[k] && inputs[k][0] && same_file(out, inputs[k])) {
+            fprintf(stderr,
+                    "cdem-run: the output file %s is %s %s, an input of this run: it is never "
+                    "overwritten; choose another output file with -o\n",
+                    out, what[k], inputs[k]);
+            return EXIT_USAGE;
+        }
+    if (cdem_h5_output_check(out, a->force ? CDEM_H5_REPLACE_CDEM : CDEM_H5_REPLACE_NEVER, err) !=
+        CDEM_OK) {
+        print_error(err->msg);
+        return EXIT_ERROR;
+    }
+    return EXIT_OK;
 }
 
 /* --resume: the parameters are those stored in the file; anything that could change the
  * physics (a model file, -s overrides) is refused, as is -o (the file itself continues). */
 static int resume(const cli_args *a, cdem_error *err) {
     if (a->model_path || a->n_overrides > 0 || a->output_path || a->summary_only || a->dry_run ||
-        a->print_defaults) {
+        a->print_defaults || a->force) {
         fprintf(stderr,
                 "cdem-run: --resume %s continues the run with the parameters stored in the file; "
                 "it cannot be combined with %s (they could change the results; a resumed run is "
@@ -276,10 +352,16 @@ static int resume(const cli_args *a, cdem_error *err) {
                 a->model_path        ? "a model file"
                 : a->n_overrides > 0 ? "-s overrides"
                 : a->output_path     ? "-o (the run file itself is continued)"
+                : a->force           ? "--force (the run file itself is continued)"
                                      : "--summary/--dry-run/--print-defaults");
         return EXIT_USAGE;
     }
     install_handlers();
+    /* immediate refusal when the run is still being written (its writer's lock) */
+    if (cdem_runlock_check(a->resume_path, err) != CDEM_OK) {
+        print_error(err->msg);
+        return EXIT_ERROR;
+    }
     cdem_run_options opt = {
         .output_path = a->resume_path,
         .params_text = NULL,
@@ -289,6 +371,7 @@ static int resume(const cli_args *a, cdem_error *err) {
         .stop_requested = &stop_requested,
         .max_steps = a->max_steps,
         .par_min = a->par_min,
+        .no_fsync = a->no_fsync,
     };
     cdem_status st = cdem_run_resume(a->resume_path, &opt, err);
     if (st == CDEM_OK)
@@ -367,6 +450,18 @@ int main(int argc, char **argv) {
     cdem_model m;
     if (cdem_model_derive(&p, &m, &err) != CDEM_OK)
         goto fail;
+    int running = !a.summary_only && !a.dry_run;
+    if (running) {
+        out_path = a.output_path ? strdup(a.output_path) : default_output(a.model_path);
+        if (!out_path) {
+            fprintf(stderr, "cdem-run: out of memory\n");
+            goto done;
+        }
+        rc = check_output(&a, &p, out_path, &err);
+        if (rc != EXIT_OK)
+            goto done;
+        rc = EXIT_ERROR;
+    }
 
     int want_summary = a.summary_only || a.dry_run || !a.quiet;
     if (want_summary) {
@@ -393,7 +488,6 @@ int main(int argc, char **argv) {
         goto done;
     }
 
-    out_path = a.output_path ? strdup(a.output_path) : default_output(a.model_path);
     char *params_text = stored_params_text(&p, &a, file_text);
     file_text = NULL; /* owned by params_text now (or freed) */
     if (!out_path || !params_text) {
@@ -414,6 +508,8 @@ int main(int argc, char **argv) {
         .max_steps = a.max_steps,
         .par_min = a.par_min,
         .ignore_free_space = a.ignore_free_space,
+        .replace = a.force ? CDEM_H5_REPLACE_CDEM : CDEM_H5_REPLACE_NEVER,
+        .no_fsync = a.no_fsync,
     };
     cdem_status st = cdem_run(&p, &opt, &err);
     free(params_text);

@@ -412,10 +412,13 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
         .source = "cdem-run",
     };
     if (r->opt->output_path && !r->opt->ignore_free_space) {
-        /* A full disk is reported now, not hours into the run. */
-        const double need = cdem_h5_estimate_file_size(
-            (double)r->s.n, (double)r->m.n_increments_total + 1.0, r->p->calculate_stress);
-        if (cdem_h5_check_free_space(r->opt->output_path, need, err) != CDEM_OK) {
+        /* A full disk is reported now, not hours into the run: the file, its checkpoint
+         * slots and its sidecar. */
+        const double need =
+            cdem_h5_estimate_run_space((double)r->s.n, (double)r->m.n_increments_total + 1.0,
+                                       r->p->calculate_stress, r->p->checkpoint_interval > 0);
+        cdem_status st = cdem_h5_check_free_space(r->opt->output_path, need, err);
+        if (st == CDEM_ERR_IO) { /* too little space (other codes: the folder itself) */
             char msg[CDEM_ERROR_MSG_MAX];
             snprintf(msg, sizeof msg, "%s", err ? err->msg : "not enough free space");
             return CDEM_FAIL(err, CDEM_ERR_IO,
@@ -423,9 +426,13 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
                              "space, write elsewhere (-o) or run anyway with --ignore-free-space",
                              msg, r->s.n, r->m.n_increments_total + 1);
         }
+        CDEM_TRY(st);
     }
-    if (r->opt->output_path)
-        CDEM_TRY(cdem_h5_writer_create(r->opt->output_path, &meta, &r->w, err));
+    if (r->opt->output_path) {
+        CDEM_TRY(
+            cdem_h5_writer_create_checked(r->opt->output_path, &meta, r->opt->replace, &r->w, err));
+        cdem_h5_writer_set_sync(r->w, !r->opt->no_fsync);
+    }
     r->step = 0;
     r->next_inc = 0;
     CDEM_TRY(cdem_integrator_prime(&r->it, &r->s, err));
@@ -689,8 +696,10 @@ static cdem_status open_body(run_ctx *r, const cdem_snapshot *resume, cdem_error
     if (!resume)
         return start_fresh(r, err);
     CDEM_TRY(restore(r, resume, err));
-    if (r->opt->output_path)
+    if (r->opt->output_path) {
         CDEM_TRY(cdem_h5_writer_reopen(r->opt->output_path, r->next_inc - 1, r->step, &r->w, err));
+        cdem_h5_writer_set_sync(r->w, !r->opt->no_fsync);
+    }
     if (logging(r))
         fprintf(r->opt->log, "cdem-run: resumed %s at step %ld of %ld, after increment %d\n",
                 r->opt->output_path ? r->opt->output_path : "a run", r->step, r->m.total_steps,

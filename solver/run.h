@@ -10,6 +10,7 @@
 #define CDEM_RUN_H
 
 #include "cdem_error.h"
+#include "h5format.h"
 #include "params.h"
 #include "snapshot.h"
 
@@ -27,8 +28,11 @@ typedef struct {
     long par_min;                          /* > 0: the integrator's par_min (loops shorter than this
                                               run on one thread; determinism tests); 0: default */
     int ignore_free_space;                 /* 1: skip the free-space check before the run */
-    double dt_factor; /* tests only (fault injection): > 0 multiplies the derived time step,
-                         e.g. 10 to make a run blow up; 0 = the time step of the model */
+    double dt_factor;        /* tests only (fault injection): > 0 multiplies the derived time step,
+                                e.g. 10 to make a run blow up; 0 = the time step of the model */
+    cdem_h5_replace replace; /* a file already at output_path: ANY (0) replaces it; cdem-run
+                                uses NEVER, or CDEM with --force */
+    int no_fsync;            /* 1: no fsync at commits (cdem-run --no-fsync, throwaway runs) */
 } cdem_run_options;
 
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was

@@ -94,6 +94,65 @@ static void test_bad_input_fault_file_nul_byte(void **state) {
 }
 
 static cdem_status count_sink(void *user, const cdem_increment_info *info, const cdem_state *s,
+                              cdem_error *err);
+
+/* fuzz_fault_file (issue 19's make fuzz run): "0,0x1p-1074" read as a vertex 4.9e-324 m
+ * above the base, 1400 m to the left: the first segment was flat, and the fault's x below
+ * the base (extrapolated along it) came out infinite. Hexadecimal numbers are refused now,
+ * and so is a segment dipping less than CDEM_FAULT_MIN_DIP in decimal (1e-300). */
+static void test_bad_input_fault_file_flat_segment(void **state) {
+    (void)state;
+    char dir[1024], path[1100];
+    tmp_dir(dir, sizeof dir, "fault_flat");
+    snprintf(path, sizeof path, "%s/fault.txt", dir);
+    static const struct {
+        const char *text; /* the file */
+        const char *want; /* in the message */
+    } bad[] = {
+        {"1399, 0\n0,0x1p-1074", "line 2: '0,0x1p-1074': field 2 is not a number"},
+        {"1400 0\n0 1e-300\n", "line 2: the segment from (1400, 0) m to (0, 1e-300) m dips"},
+        {"1400 0\n1000 5\n", "dips 0.716 degrees; every segment must dip at least 1 degrees"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        write_bytes(path, bad[k].text, strlen(bad[k].text));
+        cdem_fault_polyline pl;
+        cdem_error err;
+        cdem_error_clear(&err);
+        assert_int_not_equal(cdem_fault_file_read(path, 1400.0, 25.0, &pl, &err), CDEM_OK);
+        if (!strstr(err.msg, bad[k].want) || !strstr(err.msg, path))
+            fail_msg("case %zu: %s", k, err.msg);
+        assert_int_equal(pl.n, 0);
+    }
+    remove(path);
+    rmdir(dir);
+}
+
+/* fuzz_cdem2d (issue 19's make fuzz run): modelresults_0.txt and modelresults_00.txt were
+ * both imported as increment 0, two increments with one number. Refused now, naming both. */
+static void test_bad_input_cdem2d_duplicate_increment_number(void **state) {
+    (void)state;
+    char dir[1024], p0[1100], p00[1100];
+    tmp_dir(dir, sizeof dir, "cdem2d_dup");
+    snprintf(p0, sizeof p0, "%s/modelresults_0.txt", dir);
+    snprintf(p00, sizeof p00, "%s/modelresults_00.txt", dir);
+    static const char data[] = "100 100 50 1\n";
+    write_bytes(p0, data, sizeof data - 1);
+    write_bytes(p00, data, sizeof data - 1);
+    int calls = 0;
+    cdem_cdem2d_meta meta;
+    cdem_error err;
+    cdem_error_clear(&err);
+    assert_int_equal(cdem_cdem2d_import(dir, count_sink, &calls, &meta, &err), CDEM_ERR_PARSE);
+    cdem_cdem2d_meta_free(&meta);
+    assert_int_equal(calls, 0);
+    assert_non_null(strstr(err.msg, dir));
+    assert_non_null(strstr(err.msg, "two results files for increment 0"));
+    remove(p0);
+    remove(p00);
+    rmdir(dir);
+}
+
+static cdem_status count_sink(void *user, const cdem_increment_info *info, const cdem_state *s,
                               cdem_error *err) {
     (void)info;
     (void)s;
@@ -127,7 +186,8 @@ static void test_bad_input_cdem2d_nul_byte(void **state) {
 }
 
 /* Review of the fuzzed readers: radii so large that the id-matching grid cannot be built
- * failed with a message that named no file. Now it names the results file. */
+ * failed with a message that named no file. Then it named the results file; now the row
+ * with the radius is refused, naming the file and line. */
 static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
     (void)state;
     char dir[1024], p0[1100], p1[1100];
@@ -144,8 +204,10 @@ static void test_bad_input_cdem2d_huge_radius_names_file(void **state) {
     cdem_status st = cdem_cdem2d_import(dir, count_sink, &calls, &meta, &err);
     cdem_cdem2d_meta_free(&meta);
     assert_int_not_equal(st, CDEM_OK);
-    assert_int_equal(calls, 1); /* the first increment needs no matching */
-    assert_non_null(strstr(err.msg, p1));
+    /* since issue 19 (item 8) the radius itself is refused, on its row */
+    assert_int_equal(calls, 0);
+    assert_non_null(strstr(err.msg, p0));
+    assert_non_null(strstr(err.msg, ":1: radius 1e+308 must be > 0 and at most"));
     remove(p0);
     remove(p1);
     rmdir(dir);
@@ -192,6 +254,8 @@ int main(void) {
         cmocka_unit_test(test_bad_input_fault_file_nul_byte),
         cmocka_unit_test(test_bad_input_cdem2d_nul_byte),
         cmocka_unit_test(test_bad_input_cdem2d_huge_radius_names_file),
+        cmocka_unit_test(test_bad_input_fault_file_flat_segment),
+        cmocka_unit_test(test_bad_input_cdem2d_duplicate_increment_number),
         cmocka_unit_test(test_bad_input_h5_forged_element_count),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -13,6 +13,8 @@
 #include "contact.h"
 #include "fault_file.h"
 
+#include <unistd.h>
+
 #define X0  1400.0 /* fault_location 0.35 x WIDTH */
 #define DIP 45.0
 #define K   40
@@ -339,6 +341,34 @@ static void test_bc_listric_errors(void **st) {
              d && *d ? d : "tests/data");
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "fault_bad_first.txt, line 1: first point"));
+    /* issue 19, item 8: a vertex far above the model (it once laid fault elements up to
+     * y = 1e9 m: 5 GB), a 1e-7 m segment, a folder as the vertex file */
+    const char *t = getenv("CDEM_TEST_TMP");
+    static const struct {
+        const char *text; /* vertex file */
+        const char *want; /* in the message */
+    } bad[] = {
+        {"1400 0\n1169 400\n1098 1e9\n", "line 3: point (1098, 1e+09) m lies far above the model"},
+        {"1400 0\n1399.9999999 0.0000001\n1169 400\n", "line 2: the segment from (1400, 0) m"},
+        {"1400 0\n1169 400\n-5 800\n", "line 3: point (-5, 800) m lies left of the model"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        p = listric_params(CDEM_MODE_IRREGULAR_FAULT);
+        snprintf(p.fault_file, sizeof p.fault_file, "%s/bad_fault_%d_%zu.txt", t && *t ? t : "/tmp",
+                 (int)getpid(), k);
+        FILE *f = fopen(p.fault_file, "w");
+        assert_non_null(f);
+        fputs(bad[k].text, f);
+        fclose(f);
+        assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
+        if (!strstr(err.msg, bad[k].want) || !strstr(err.msg, p.fault_file))
+            fail_msg("fault file %zu: %s", k, err.msg);
+        remove(p.fault_file);
+    }
+    p = listric_params(CDEM_MODE_IRREGULAR_FAULT);
+    snprintf(p.fault_file, sizeof p.fault_file, "%s", t && *t ? t : "/tmp");
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_IO);
+    assert_non_null(strstr(err.msg, "is a folder"));
     /* none of the refusals touched the state */
     for (size_t i = 0; i < s.n; i++)
         assert_false(s.flags[i] & (CDEM_FLAG_FOOTWALL | CDEM_FLAG_FAULT));

@@ -109,7 +109,7 @@ static void check_removal(cdem_walls_choice walls) {
         assert_true(found);
     }
     /* deformation: no boundary moves, net 0 */
-    cdem_state before;
+    cdem_state before = {0};
     memset(&before, 0, sizeof before);
     assert_int_equal(cdem_state_copy(&before, &s, &err), CDEM_OK);
     for (long j = 1; j <= 100; j++)

@@ -154,12 +154,60 @@ static void test_cdem2d_missing_folder(void **st) {
     cdem_cdem2d_meta_free(&meta);
 }
 
+/* Writes a folder of three increments, the rows of increment 1 given, into dir. */
+static void write_folder(const char *dir, const char *rows1) {
+    char cmd[2200], path[1200];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
+    assert_int_equal(system(cmd), 0);
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/modelresults_%d.txt", dir, k);
+        FILE *f = fopen(path, "w");
+        assert_non_null(f);
+        fputs(k == 1 ? rows1 : "100 100 50 1\n280 100 75 1\n460 100 50 0\n", f);
+        fclose(f);
+    }
+}
+
+/* Rows that once imported and became infinities downstream (issue 19, item 8): positions of
+ * +-1e308 m, a radius of 1e300 m; and an empty results file (an increment without
+ * elements). Each is refused naming the file and line. */
+static void test_cdem2d_absurd_rows(void **st) {
+    (void)st;
+    const char *t = getenv("CDEM_TEST_TMP");
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/cdem2d_absurd", t && *t ? t : "/tmp");
+    static const struct {
+        const char *rows; /* increment 1 */
+        const char *want; /* in the message */
+    } bad[] = {
+        {"1e308 100 50 1\n280 100 75 1\n", "modelresults_1.txt:1: x = 1e+308 m is outside"},
+        {"100 100 50 1\n280 -1e308 75 1\n", "modelresults_1.txt:2: y = -1e+308 m is outside"},
+        {"100 100 1e300 1\n", "modelresults_1.txt:1: radius 1e+300 must be > 0 and at most"},
+        {"", "modelresults_1.txt holds no element rows"},
+        {"# only a comment\n\n", "modelresults_1.txt holds no element rows"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        write_folder(dir, bad[k].rows);
+        collected c = {0};
+        cdem_cdem2d_meta meta;
+        cdem_error err;
+        assert_int_equal(cdem_cdem2d_import(dir, collect, &c, &meta, &err), CDEM_ERR_PARSE);
+        if (!strstr(err.msg, bad[k].want))
+            fail_msg("case %zu: %s", k, err.msg);
+        assert_int_equal(c.n, 1); /* increment 0 was fine */
+        cdem_cdem2d_meta_free(&meta);
+        free_collected(&c);
+    }
+    char cmd[1100];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_cdem2d_basic_folder),
-        cmocka_unit_test(test_cdem2d_crlf_with_forces),
-        cmocka_unit_test(test_cdem2d_malformed_row),
-        cmocka_unit_test(test_cdem2d_missing_folder),
+        cmocka_unit_test(test_cdem2d_basic_folder),  cmocka_unit_test(test_cdem2d_crlf_with_forces),
+        cmocka_unit_test(test_cdem2d_malformed_row), cmocka_unit_test(test_cdem2d_missing_folder),
+        cmocka_unit_test(test_cdem2d_absurd_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

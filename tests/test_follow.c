@@ -95,6 +95,47 @@ static void test_follow_renders_new_increments(void **state) {
 }
 
 /* Usage errors of --follow. */
+/* A killed run's file (stop reason "running", nobody holding its lock): --follow renders the
+ * last increment and ends with a message instead of waiting for ever (issue 19, item 1: a
+ * reader must not wait for a writer that is gone). */
+static void test_follow_ends_when_the_writer_is_gone(void **state) {
+    (void)state;
+    const char *tmp = getenv("CDEM_TEST_TMP");
+    const char *data = getenv("CDEM_TEST_DATA");
+    char dir[1024], run[1100], live[1100], cmd[4200];
+    snprintf(dir, sizeof dir, "%s/follow_dead_%d", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    snprintf(run, sizeof run, "%s/killed.h5", dir);
+    snprintf(live, sizeof live, "%s/live.png", dir);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp '%s/damaged/killed.h5' '%s'", dir,
+             data && *data ? data : "tests/data", run);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd,
+             "timeout 60 '%s/cdem-strain' render '%s' --follow -o '%s' --interval 0.1 "
+             "> '%s/out.txt' 2>&1",
+             build_dir(), run, live, dir);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int st = system(cmd);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double secs = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    assert_true(WIFEXITED(st));
+    if (WEXITSTATUS(st) == 124)
+        fail_msg("render --follow still waited for a dead writer after %.0f s", secs);
+    assert_int_equal(WEXITSTATUS(st), 1);
+    char out[4096] = "";
+    snprintf(cmd, sizeof cmd, "%s/out.txt", dir);
+    FILE *f = fopen(cmd, "r");
+    assert_non_null(f);
+    size_t got = fread(out, 1, sizeof out - 1, f);
+    out[got] = '\0';
+    fclose(f);
+    assert_non_null(strstr(out, "its writer is gone"));
+    assert_non_null(strstr(out, "cdem-run --resume"));
+    assert_int_equal(access(live, F_OK), 0); /* its last increment was rendered */
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 static void test_follow_usage_errors(void **state) {
     (void)state;
     char cmd[2048];
@@ -113,6 +154,7 @@ static void test_follow_usage_errors(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_follow_renders_new_increments),
+        cmocka_unit_test(test_follow_ends_when_the_writer_is_gone),
         cmocka_unit_test(test_follow_usage_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -680,7 +680,8 @@ static void test_format_not_cdem_files(void **state) {
     cdem_h5_writer *w = NULL;
     assert_int_equal(cdem_h5_writer_create("/nonexistent-dir/x/run.h5", &meta, &w, &err),
                      CDEM_ERR_IO);
-    assert_non_null(strstr(err.msg, "/nonexistent-dir/x/run.h5: cannot create"));
+    assert_non_null(strstr(err.msg, "cannot write /nonexistent-dir/x/run.h5: folder "
+                                    "/nonexistent-dir/x does not exist"));
     assert_null(w);
     assert_int_equal(cdem_h5_writer_close(NULL, &err), CDEM_OK);
     cdem_h5_reader_close(NULL);
@@ -1909,8 +1910,9 @@ static void test_format_free_space_check(void **state) {
     assert_int_equal(cdem_h5_check_free_space(path, 1e18, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, path));
     assert_non_null(strstr(err.msg, "needs about 1000000000000.0 MB but"));
-    assert_int_equal(cdem_h5_check_free_space("/nonexistent-dir/x/run.h5", 1.0, &err), CDEM_ERR_IO);
-    assert_non_null(strstr(err.msg, "cannot examine the output directory /nonexistent-dir/x"));
+    assert_int_equal(cdem_h5_check_free_space("/nonexistent-dir/x/run.h5", 1.0, &err),
+                     CDEM_ERR_NOTFOUND);
+    assert_non_null(strstr(err.msg, "folder /nonexistent-dir/x does not exist"));
     /* The estimate is within 15 % of the measured default-size run (9.27 MB, no stress). */
     double est = cdem_h5_estimate_file_size(2271, 283, 0);
     assert_true(est > 0.85 * 9.27e6 && est < 1.15 * 9.27e6);
@@ -1945,6 +1947,230 @@ const char *__lsan_default_suppressions(void) {
     return "leak:libhdf5_serial.so\n";
 }
 
+/* Flips bits (mask) of byte `at` of the first chunk of dataset name. */
+static void flip_in_chunk(const char *path, const char *name, hsize_t at, unsigned char mask) {
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    hid_t sp = H5Dget_space(ds);
+    hsize_t offset[1] = {0}, size = 0;
+    unsigned mask_out = 0;
+    haddr_t addr = HADDR_UNDEF;
+    assert_true(H5Dget_chunk_info(ds, sp, 0, offset, &mask_out, &addr, &size) >= 0);
+    assert_true(at < size);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    H5Fclose(f);
+    FILE *fp = fopen(path, "r+b");
+    assert_non_null(fp);
+    assert_int_equal(fseek(fp, (long)(addr + at), SEEK_SET), 0);
+    int c = fgetc(fp);
+    assert_true(c != EOF);
+    assert_int_equal(fseek(fp, (long)(addr + at), SEEK_SET), 0);
+    fputc(c ^ mask, fp);
+    assert_int_equal(fclose(fp), 0);
+}
+
+/* One flipped bit in /increments/index or /series is a read error naming them, not a net
+ * displacement of 5.7e78 m or a time of 461 s in a 220 s run (issue 19, item 5): both are
+ * checksummed (Fletcher-32) like the element data. */
+static void test_format_index_and_series_checksummed(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "flip_index.h5");
+    write_small(path, 4, 1);
+    /* packed rows of 84 bytes: number 4, step 8, time 8, phase 4, net_displacement 8, ... */
+    flip_in_chunk(path, "increments/index", 3 * 84 + 24 + 7, 0x10);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) == CDEM_OK) {
+        cdem_increment_info info;
+        cdem_h5_reader_increment_info(r, 3, &info, &err);
+        cdem_h5_reader_close(r);
+        fail_msg("a flipped bit in /increments/index was read as net displacement %g m",
+                 info.net_displacement);
+    }
+    assert_int_equal(err.code, CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, "/increments/index"));
+    assert_non_null(strstr(err.msg, "damaged"));
+    assert_non_null(strstr(err.msg, "Fletcher32"));
+
+    write_small(path, 4, 1);
+    flip_in_chunk(path, "series/time", 5 * 8 + 6, 0x20);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_series_sample *smp = NULL;
+    size_t n = 0;
+    if (cdem_h5_reader_read_series(r, &smp, &n, &err) == CDEM_OK) {
+        double t = n > 5 ? smp[5].time : -1.0;
+        free(smp);
+        cdem_h5_reader_close(r);
+        fail_msg("a flipped bit in /series/time was read as a time of %g s", t);
+    }
+    assert_non_null(strstr(err.msg, "/series/time is damaged"));
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* Files written before the checksums rely on order checks: an index row whose time or step
+ * goes backwards, and a series sample whose step does, are refused naming them. */
+static void test_format_index_and_series_in_order(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "order.h5");
+    write_small(path, 4, 1);
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    hid_t ds = H5Dopen2(f, "increments/index", H5P_DEFAULT);
+    hid_t ft = H5Dget_type(ds);
+    hid_t mt = H5Tcreate(H5T_COMPOUND, sizeof(double));
+    H5Tinsert(mt, "time", 0, H5T_NATIVE_DOUBLE);
+    double times[4];
+    assert_true(H5Dread(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, times) >= 0);
+    times[2] = 461.0; /* later than increment 3 */
+    times[3] = 220.0;
+    assert_true(H5Dwrite(ds, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, times) >= 0);
+    H5Tclose(mt);
+    H5Tclose(ft);
+    H5Dclose(ds);
+    H5Fclose(f);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "/increments/index row 3 (increment 3)"));
+    assert_non_null(strstr(err.msg, "time"));
+    assert_non_null(strstr(err.msg, "220"));
+
+    write_small(path, 4, 1);
+    f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    ds = H5Dopen2(f, "series/step", H5P_DEFAULT);
+    int64_t steps[12];
+    assert_true(H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps) >= 0);
+    steps[7] = steps[2];
+    assert_true(H5Dwrite(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, steps) >= 0);
+    H5Dclose(ds);
+    H5Fclose(f);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_series_sample *smp = NULL;
+    size_t n = 0;
+    assert_int_equal(cdem_h5_reader_read_series(r, &smp, &n, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "/series sample 7"));
+    assert_non_null(strstr(err.msg, "out of order"));
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* Corrupt metadata is reported as damage, not as "not a cdem file" (issue 19, item 7). */
+static void test_format_corrupt_metadata_message(void **state) {
+    (void)state;
+    char path[1024];
+    tmp_file(path, sizeof path, "corrupt_root.h5");
+    write_small(path, 2, 1);
+    /* the root object header address is in the v3 superblock, bytes 36..43 */
+    uint64_t root = 0;
+    FILE *fp = fopen(path, "r+b");
+    unsigned char sb[48];
+    assert_int_equal(fread(sb, 1, sizeof sb, fp), sizeof sb);
+    for (int i = 7; i >= 0; i--)
+        root = (root << 8) | sb[36 + i];
+    fseek(fp, (long)(root + 100), SEEK_SET);
+    int c = fgetc(fp);
+    fseek(fp, (long)(root + 100), SEEK_SET);
+    fputc(c ^ 0xff, fp);
+    fclose(fp);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, "damaged file"));
+    assert_null(strstr(err.msg, "not a cdem file"));
+    remove_pair(path);
+}
+
+/* A sidecar that cannot be written: the message names the run file, the sidecar and how many
+ * increments the run file keeps (once it named only run.xmf.tmp). */
+static void test_format_sidecar_failure_message(void **state) {
+    (void)state;
+    char path[1024], side_tmp[1100];
+    tmp_file(path, sizeof path, "sidecar_fail.h5");
+    snprintf(side_tmp, sizeof side_tmp, "%.*s.xmf.tmp", (int)(strlen(path) - 3), path);
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_h5_writer *w = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    cdem_state s;
+    make_state(&s, 40, 3, 0);
+    for (int k = 0; k < 2; k++) {
+        cdem_increment_info info = make_info(k, 0);
+        assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+    }
+    assert_int_equal(mkdir(side_tmp, 0755), 0); /* the sidecar's temporary cannot be made */
+    cdem_increment_info info = make_info(2, 0);
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_ERR_IO);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, "keeps its 3 complete increments"));
+    assert_non_null(strstr(err.msg, "XDMF sidecar"));
+    assert_non_null(strstr(err.msg, "sidecar_fail.xmf"));
+    cdem_h5_writer_close(w, &err);
+    rmdir(side_tmp);
+    cdem_state_free(&s);
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 3);
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* The writer holds the path's lock: a second writer of the same path is refused naming the
+ * first, and the policies of cdem_h5_writer_create_checked keep existing files (issue 19,
+ * items 2 and 3). */
+static void test_format_one_writer_and_replace_policy(void **state) {
+    (void)state;
+    char path[1024], other[1100];
+    tmp_file(path, sizeof path, "one_writer.h5");
+    snprintf(other, sizeof other, "%s.txt", path);
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_h5_writer *w = NULL, *w2 = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w2, &err), CDEM_ERR_CONFLICT);
+    assert_null(w2);
+    assert_non_null(strstr(err.msg, "is being written by another process"));
+    assert_int_equal(cdem_h5_output_check(path, CDEM_H5_REPLACE_CDEM, &err), CDEM_ERR_CONFLICT);
+    /* the refused writer left the first one's file and temporary alone */
+    cdem_state s;
+    make_state(&s, 40, 3, 0);
+    cdem_increment_info info = make_info(0, 0);
+    assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    cdem_state_free(&s);
+    assert_int_equal(cdem_h5_writer_create_checked(path, &meta, CDEM_H5_REPLACE_NEVER, &w, &err),
+                     CDEM_ERR_CONFLICT);
+    assert_non_null(strstr(err.msg, "already exists"));
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 1);
+    cdem_h5_reader_close(r);
+    assert_int_equal(cdem_h5_writer_create_checked(path, &meta, CDEM_H5_REPLACE_CDEM, &w, &err),
+                     CDEM_OK);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    FILE *f = fopen(other, "w");
+    fputs("not a run\n", f);
+    fclose(f);
+    assert_int_equal(cdem_h5_writer_create_checked(other, &meta, CDEM_H5_REPLACE_CDEM, &w, &err),
+                     CDEM_ERR_CONFLICT);
+    assert_non_null(strstr(err.msg, "is not a cdem run file"));
+    f = fopen(other, "r");
+    char line[64] = "";
+    assert_non_null(fgets(line, sizeof line, f));
+    fclose(f);
+    assert_string_equal(line, "not a run\n");
+    remove(other);
+    remove_pair(path);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_format_roundtrip_all_fields),
@@ -1970,6 +2196,11 @@ int main(void) {
         cmocka_unit_test(test_format_swmr_live_refresh),
         cmocka_unit_test(test_format_write_failure_keeps_increments),
         cmocka_unit_test(test_format_free_space_check),
+        cmocka_unit_test(test_format_index_and_series_checksummed),
+        cmocka_unit_test(test_format_index_and_series_in_order),
+        cmocka_unit_test(test_format_corrupt_metadata_message),
+        cmocka_unit_test(test_format_sidecar_failure_message),
+        cmocka_unit_test(test_format_one_writer_and_replace_policy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -157,9 +157,11 @@ static void test_kill_survival_random_moments(void **state) {
     remove(xmf);
 }
 
-/* A full disk during the run (RLIMIT_FSIZE in the child, SIGXFSZ ignored: writes fail with
- * EFBIG): cdem-run stops with exit status 1 and a message naming the file, and the file
- * keeps every increment written before, with stop reason "write-failure". */
+/* A full disk during the run (RLIMIT_FSIZE in the child, as `ulimit -f` sets it): cdem-run
+ * stops with exit status 1 and a message naming the file, and the file keeps every increment
+ * written before, with stop reason "write-failure". The child leaves SIGXFSZ at its default
+ * (kill the process): cdem-run itself must ignore it so that the write fails with EFBIG
+ * instead (once it died silently; only this test, ignoring the signal, made it work). */
 static void test_kill_survival_file_size_limit(void **state) {
     (void)state;
     const char *tmp = getenv("CDEM_TEST_TMP");
@@ -170,7 +172,7 @@ static void test_kill_survival_file_size_limit(void **state) {
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        signal(SIGXFSZ, SIG_IGN);
+        signal(SIGXFSZ, SIG_DFL);
         struct rlimit rl = {400 * 1024, 400 * 1024};
         if (setrlimit(RLIMIT_FSIZE, &rl) != 0 || !freopen(errf, "w", stderr))
             _exit(126);
@@ -192,6 +194,9 @@ static void test_kill_survival_file_size_limit(void **state) {
     fclose(f);
     assert_non_null(strstr(msg, out));
     assert_non_null(strstr(msg, "disk full?"));
+    assert_non_null(strstr(msg, "File too large")); /* EFBIG, said plainly (issue 19, item 7) */
+    assert_null(strstr(msg, "18446744073709551615"));
+    assert_null(strstr(msg, ".creating"));
     char stop[64];
     size_t n = check_file(out, stop, sizeof stop);
     assert_string_equal(stop, "write-failure");

@@ -210,6 +210,18 @@ static void test_params_non_numeric_values(void **state) {
                      CDEM_ERR_RANGE);
     assert_int_equal(parse(&p, "[time]\nruntime = 1e3\n", &err), CDEM_OK);
     assert_true(p.runtime == 1000.0);
+    /* strtod reads hexadecimal: "0x10" was taken as 16 (issue 19, item 8) */
+    assert_int_equal(parse(&p, "[physics]\ngravity = 0x10\n", &err), CDEM_ERR_PARSE);
+    assert_msg_has(&err, "model.ini:2: gravity = 0x10: not a number");
+    assert_int_equal(parse(&p, "[time]\nruntime = 0x1p10\n", &err), CDEM_ERR_PARSE);
+    assert_int_equal(parse(&p, "[time]\nruntime = infinity\n", &err), CDEM_ERR_PARSE);
+    assert_int_equal(parse(&p, "[time]\nruntime = 1e\n", &err), CDEM_ERR_PARSE);
+    assert_int_equal(parse(&p, "[time]\nruntime = .5e3\n", &err), CDEM_OK);
+    assert_true(p.runtime == 500.0);
+    assert_int_equal(parse(&p, "[time]\nruntime = +2000.\n", &err), CDEM_OK);
+    assert_true(p.runtime == 2000.0);
+    assert_int_not_equal(cdem_params_override(&p, "physics.gravity=0x10", &err), CDEM_OK);
+    assert_msg_has(&err, "gravity = 0x10: not a number");
 }
 
 /* ---------- enums and booleans ---------- */
@@ -414,6 +426,9 @@ static void test_params_load_errors(void **state) {
     assert_int_equal(cdem_params_load(&p, "/nonexistent/dir/m.ini", &text, &err), CDEM_ERR_IO);
     assert_null(text);
     assert_msg_has(&err, "/nonexistent/dir/m.ini: cannot open parameter file");
+    /* a folder: said so, not a bare "read error" (issue 19, item 7) */
+    assert_int_equal(cdem_params_load(&p, data_dir(), &text, &err), CDEM_ERR_IO);
+    assert_msg_has(&err, "is a folder, not a parameter file");
     char path[1024];
     snprintf(path, sizeof path, "%s/bad_key.ini", data_dir());
     assert_int_equal(cdem_params_load(&p, path, NULL, &err), CDEM_ERR_PARSE);

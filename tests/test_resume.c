@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -398,12 +399,75 @@ static void test_resume_refusals(void **state) {
     cdem_h5_reader_close(r);
 }
 
+/* A killed run's file cut short afterwards (a full disk, an interrupted copy): the resume is
+ * refused saying so, and the file is left as it was. Once the message asked "is its writer
+ * still running?" (issue 19, item 7); the writer's lock now tells that no writer runs. */
+static void test_resume_truncated_killed_file(void **state) {
+    const rs_ctx *c = *state;
+    int st = start_and_signal(c, "cut", SIGKILL);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    char p[1200];
+    path_of(c, "cut.h5", p, sizeof p);
+    struct stat sb;
+    assert_int_equal(stat(p, &sb), 0);
+    const off_t cut = sb.st_size * 9 / 10;
+    assert_int_equal(truncate(p, cut), 0);
+    assert_int_equal(run(c, NULL, "-q --resume cut.h5"), 1);
+    expect_err(c, "cut.h5: cannot be resumed: the file is truncated");
+    expect_err(c, "it was not changed");
+    char *e = slurp(c, "err.txt");
+    assert_null(strstr(e, "still running"));
+    free(e);
+    assert_int_equal(stat(p, &sb), 0);
+    assert_int_equal(sb.st_size, cut);
+}
+
+/* A resume of a run that is still being written is refused at once, naming the writer. */
+static void test_resume_refused_while_running(void **state) {
+    const rs_ctx *c = *state;
+    char log[1200], out[1200];
+    path_of(c, "live.log", log, sizeof log);
+    path_of(c, "live.h5", out, sizeof out);
+    fflush(NULL);
+    const pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        FILE *f = freopen(log, "wb", stderr);
+        if (!f || chdir(c->tmp) != 0)
+            _exit(99);
+        execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
+              "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",
+              "-s", "time.runtime=600", (char *)NULL);
+        _exit(98);
+    }
+    for (int i = 0; i < 60000 && !file_has(log, "end of equilibration"); i++) {
+        const struct timespec ts = {0, 5000000};
+        nanosleep(&ts, NULL);
+    }
+    int rc = run(c, NULL, "-q --resume live.h5");
+    int st = 0;
+    int ended = waitpid(pid, &st, WNOHANG) == pid;
+    if (!ended) {
+        kill(pid, SIGINT);
+        assert_int_equal(waitpid(pid, &st, 0), pid);
+    }
+    if (ended)
+        fail_msg("the run ended before its resume was tried; the test needs a longer run");
+    assert_int_equal(rc, 1);
+    char who[64];
+    snprintf(who, sizeof who, "pid %d", (int)pid);
+    expect_err(c, "live.h5 is being written by another process");
+    expect_err(c, who);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resume_determinism_threads_1_2_3),
         cmocka_unit_test(test_resume_after_sigkill_is_bit_identical),
         cmocka_unit_test(test_resume_after_max_steps_is_bit_identical),
         cmocka_unit_test(test_resume_refusals),
+        cmocka_unit_test(test_resume_truncated_killed_file),
+        cmocka_unit_test(test_resume_refused_while_running),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -213,8 +213,11 @@ static void test_run_refuses_bad_requests(void **st) {
     assert_int_not_equal(cdem_run(&p, &o, &err), CDEM_OK);
     assert_non_null(strstr(err.msg, "mode"));
     p = small_params();
+    /* a missing folder is named as such, not taken for a full disk (issue 19, item 7) */
     o.output_path = "/nonexistent-dir/x.h5";
-    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_IO);
+    assert_int_equal(cdem_run(&p, &o, &err), CDEM_ERR_NOTFOUND);
+    assert_non_null(strstr(err.msg, "folder /nonexistent-dir does not exist"));
+    assert_null(strstr(err.msg, "free some space"));
     assert_int_equal(cdem_run(&p, NULL, &err), CDEM_ERR_INVALID);
     long ni = 0, nw = 0;
     assert_int_equal(cdem_run_count_elements(&p, &ni, &nw, &err), CDEM_OK);

@@ -32,6 +32,8 @@ mkdir -p "$OUT"
 
 # OpenMP threads = the CPUs Slurm gave this task; results do not depend on the count.
 export OMP_NUM_THREADS=${SLURM_CPUS_PER_TASK:-1}
+# --force: a task submitted again replaces its earlier result (two tasks writing the same
+# name at once are still refused: the second names the first).
 # shellcheck disable=SC2086  # the overrides are meant to split into words
-"$CDEM_RUN" -q "$MODEL" $overrides -o "$OUT/$name.h5" > "$OUT/$name.log" 2>&1
+"$CDEM_RUN" -q --force "$MODEL" $overrides -o "$OUT/$name.h5" > "$OUT/$name.log" 2>&1
 echo "task $SLURM_ARRAY_TASK_ID: $name done: $("${CDEM_STRAIN:-build/cdem-strain}" info "$OUT/$name.h5" | grep '^stop reason')"

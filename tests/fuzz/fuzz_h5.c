@@ -1,9 +1,12 @@
 /* fuzz_h5: the HDF5 element-state reader (common/h5format.c, reader API only). The input is
- * written to a temporary file, which is opened and read the way cdem-strain does: every
- * increment's info, find_increment for each spec form, every increment loaded, the time
- * series, the parameter record and the stored texts. Invariants checked: loaded states hold
- * the element count their info announces; failures carry a message. HDF5 itself is not
- * instrumented, so coverage guidance comes from our reader only. */
+ * written to a temporary file, which is opened and read the way cdem-strain and cdem-run
+ * --resume do: every increment's info, find_increment for each spec form, every increment
+ * loaded, the time series, the parameter record, the newest checkpoint, a refresh and the
+ * stored texts. Invariants checked: loaded states hold the element count their info
+ * announces; failures carry a message. Nobody holds the file's lock, so a file marked as
+ * being written is read as a complete one, like a killed run's (no SWMR retries: a damaged
+ * one once hung the reader). HDF5 itself is not instrumented, so coverage guidance comes
+ * from our reader only. */
 #include "h5format.h"
 
 #include "fuzz_util.h"
@@ -74,6 +77,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     free(samples);
     cdem_params p;
     if (cdem_h5_reader_params(r, &p, &err) != CDEM_OK)
+        FUZZ_CHECK(err.msg[0] != '\0');
+    cdem_snapshot *snap = NULL;
+    int32_t ckpt_inc = 0;
+    if (cdem_snapshot_alloc(&snap, &err) == CDEM_OK &&
+        cdem_h5_reader_read_checkpoint(r, snap, &ckpt_inc, &err) != CDEM_OK)
+        FUZZ_CHECK(err.msg[0] != '\0');
+    cdem_snapshot_free(snap);
+    int changed = 0;
+    if (cdem_h5_reader_refresh(r, &changed, &err) != CDEM_OK)
         FUZZ_CHECK(err.msg[0] != '\0');
     size_t total = strlen(cdem_h5_reader_summary(r)) + strlen(cdem_h5_reader_params_text(r)) +
                    strlen(cdem_h5_reader_stop_reason(r)) +
