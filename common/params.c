@@ -31,7 +31,7 @@
 
 static const char *const material_words[] = {"granular", "bonded", NULL};
 static const char *const law_words[] = {"normal-cohesion", "coulomb", "spring-cohesion", NULL};
-static const char *const cohesive_words[] = {"equilibrated", "formed", NULL};
+static const char *const cohesive_words[] = {"equilibrated", "formed", "initial", NULL};
 /* A real parameter whose row has choices accepts its one word instead of a number, stored as
  * NaN: "take the value of another parameter" (the base takes the lateral walls' values). */
 static const char *const as_wall_words[] = {"wall", NULL};
@@ -95,7 +95,7 @@ static const cdem_param_def param_table[] = {
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
      "granular: shear strength mu (Fn + C0) (normal-cohesion), mu Fn + C0 (coulomb), or Fs = Ks Xs + C0 capped at mu Fn (spring-cohesion)"},
     {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "equilibrated", 0, 0, 0, 0, cohesive_words,
-     "granular: C0 on the contacts of the end of equilibration (equilibrated), or also on every contact formed later (formed)"},
+     "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)"},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
      "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on"},
     {"material", "element_friction", CDEM_PTYPE_DOUBLE, P_OFF(element.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,

@@ -34,6 +34,7 @@ typedef enum {
 typedef enum {
     CDEM_COHESIVE_EQUILIBRATED = 0, /* contacts touching at the end of equilibration */
     CDEM_COHESIVE_FORMED = 1,       /* those, and every contact formed after it */
+    CDEM_COHESIVE_INITIAL = 2,      /* contacts of the built assembly still touching then */
 } cdem_cohesive_contacts;
 
 typedef enum {
@@ -85,11 +86,11 @@ typedef struct {
                                 0.1-1000 */
 
     /* [physics] */
-    double gravity;       /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
-    double density;       /* kg/m^3, 1500-3500 */
-    int keep_constants;   /* 0/1: use the 1000 m constants whatever the unit scaling */
+    double gravity;             /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
+    double density;             /* kg/m^3, 1500-3500 */
+    int keep_constants;         /* 0/1: use the 1000 m constants whatever the unit scaling */
     double deformation_damping; /* multiplier of the damping on deformation steps, 0-1 */
-    int calculate_stress; /* 0/1: store per-element stress in every increment */
+    int calculate_stress;       /* 0/1: store per-element stress in every increment */
 
     /* [material] */
     cdem_material_model material;   /* granular (frictional-cohesive) or bonded */

@@ -245,6 +245,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, "cohesive contacts", "%s",
              p->cohesive_contacts == CDEM_COHESIVE_FORMED
                  ? "those of the end of equilibration and every contact formed later"
+             : p->cohesive_contacts == CDEM_COHESIVE_INITIAL
+                 ? "the contacts of the built assembly that never separated, at the end of "
+                   "equilibration"
                  : "those of the end of equilibration");
         line(f, "cohesion lost", "%s",
              p->first_slip ? "at the first slip (first slip on)"

@@ -70,10 +70,11 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
                          "coulomb or spring-cohesion",
                          (int)p->granular_law);
     if (p->cohesive_contacts != CDEM_COHESIVE_EQUILIBRATED &&
-        p->cohesive_contacts != CDEM_COHESIVE_FORMED)
+        p->cohesive_contacts != CDEM_COHESIVE_FORMED &&
+        p->cohesive_contacts != CDEM_COHESIVE_INITIAL)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "contact law: material.cohesive_contacts = %d: must be equilibrated or "
-                         "formed",
+                         "contact law: material.cohesive_contacts = %d: must be equilibrated, "
+                         "formed or initial",
                          (int)p->cohesive_contacts);
     if (!(p->settling_friction >= 0.0 && p->settling_friction <= 1.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,

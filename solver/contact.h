@@ -7,7 +7,10 @@
  * for every law:
  *   - cohesion/bond created: at the end of equilibration for every touching pair
  *     (cdem_integrator_make_cohesive); with cohesive_contacts = formed also for every
- *     contact that forms afterwards (cdem_contact_law_phase sets cohesive_new);
+ *     contact that forms afterwards (cdem_contact_law_phase sets cohesive_new); with
+ *     cohesive_contacts = initial only for the touching pairs that were contacts of the
+ *     built assembly and never separated (CDEM_PAIR_INITIAL, set by
+ *     cdem_integrator_mark_initial before the first step);
  *   - lost: at the first slip (first_slip on) or when the pair separates;
  *   - the packing phase: while equilibrating, friction x settling_friction
  *     (cdem_contact_law_phase; the run loop says which phase a step is in).
@@ -60,6 +63,8 @@ enum {
     CDEM_PAIR_TOUCH = 1u << 0,    /* r < R at the last evaluation (a contact) */
     CDEM_PAIR_COHESIVE = 1u << 1, /* granular: the Coulomb limit includes the cohesion C0 */
     CDEM_PAIR_BONDED = 1u << 2,   /* bonded model: the bond is intact (tension allowed) */
+    CDEM_PAIR_INITIAL = 1u << 3,  /* a contact of the built assembly that has not separated
+                                     (cohesive_contacts = initial; until equilibration ends) */
 };
 
 typedef struct {
@@ -136,6 +141,20 @@ static inline void cdem_contact_law_phase(const cdem_contact_law *law, int equil
     if (equilibrating && law->settling_friction != 1.0)
         for (int c = 0; c < CDEM_CLASS_TOTAL; c++)
             out->friction[c] = law->friction[c] * law->settling_friction;
+}
+
+/* Relative reach of an initial contact (CDEM_PAIR_INITIAL): the built assembly's contacts are
+ * exact tangencies up to round-off, so a pair of them counts as not separated while
+ * r < R (1 + 1e-9), squared here. */
+#define CDEM_INITIAL_REACH2 (1.0 + 2e-9)
+
+/* The history a separated pair keeps (r >= R): nothing, except the mark of an initial
+ * contact that is still within CDEM_INITIAL_REACH2 (an exact tangency of the built
+ * assembly). */
+static CDEM_INLINE uint8_t cdem_contact_separated(uint8_t h, double r2, double R) {
+    return (uint8_t)((h & CDEM_PAIR_INITIAL) && r2 > 0.0 && r2 < R * R * CDEM_INITIAL_REACH2
+                         ? CDEM_PAIR_INITIAL
+                         : 0);
 }
 
 /* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
@@ -217,7 +236,7 @@ static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, doubl
         *fx = 0.0;
         *fy = 0.0;
         *xs = 0.0;
-        *hist = 0; /* a broken bond never comes back */
+        *hist = cdem_contact_separated(h, r2, R); /* a broken bond never comes back */
         return;
     }
     cdem_contact_touching(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, fx, fy);

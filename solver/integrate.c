@@ -430,7 +430,7 @@ static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p,
             pfx[p] = 0.0;
             pfy[p] = 0.0;
             if (h) {
-                hist[p] = 0;
+                hist[p] = cdem_contact_separated(h, r2, R);
                 xs[p] = 0.0;
             }
             return;
@@ -1000,10 +1000,36 @@ long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s) {
     (void)s;
     const uint8_t flag =
         it->law.model == CDEM_MATERIAL_BONDED ? CDEM_PAIR_BONDED : CDEM_PAIR_COHESIVE;
+    /* cohesive_contacts = initial: only the contacts of the built assembly that never
+     * separated; the marks have served and are cleared */
+    const uint8_t need =
+        it->law.model == CDEM_MATERIAL_GRANULAR && it->law.cohesive_rule == CDEM_COHESIVE_INITIAL
+            ? (uint8_t)(CDEM_PAIR_TOUCH | CDEM_PAIR_INITIAL)
+            : (uint8_t)CDEM_PAIR_TOUCH;
     long count = 0;
     for (size_t p = 0; p < it->nb.np; p++) {
-        if ((it->nb.hist[p] & CDEM_PAIR_TOUCH) && it->nb.cls[p] != CDEM_CLASS_SLIP) {
-            it->nb.hist[p] |= flag;
+        uint8_t h = it->nb.hist[p];
+        if ((h & need) == need && it->nb.cls[p] != CDEM_CLASS_SLIP) {
+            h |= flag;
+            count++;
+        }
+        it->nb.hist[p] = (uint8_t)(h & ~CDEM_PAIR_INITIAL);
+    }
+    return count;
+}
+
+long cdem_integrator_mark_initial(cdem_integrator *it, const cdem_state *s) {
+    if (it->law.model != CDEM_MATERIAL_GRANULAR || it->law.cohesive_rule != CDEM_COHESIVE_INITIAL ||
+        it->nb.n != s->n)
+        return 0;
+    const cdem_neighbour *nb = &it->nb;
+    long count = 0;
+    for (size_t p = 0; p < nb->np; p++) {
+        const int32_t i = nb->pi[p], j = nb->pj[p];
+        const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i], R = nb->R[p];
+        const double r2 = dx * dx + dy * dy;
+        if (r2 > 0.0 && r2 < R * R * CDEM_INITIAL_REACH2) {
+            it->nb.hist[p] |= CDEM_PAIR_INITIAL;
             count++;
         }
     }

@@ -201,10 +201,18 @@ cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double yma
 cdem_status cdem_integrator_begin_deformation(cdem_integrator *it, cdem_state *s, cdem_bc *bc,
                                               size_t *n_removed, cdem_error *err);
 
-/* End of equilibration (and of each settling): every touching pair becomes cohesive
- * (granular) or bonded (bonded model), except flexural-slip pairs (CDEM_CLASS_SLIP). Returns the
- * number of pairs so marked. */
+/* End of equilibration: every touching pair becomes cohesive (granular) or bonded (bonded
+ * model), except flexural-slip pairs (CDEM_CLASS_SLIP); with cohesive_contacts = initial only
+ * the touching pairs still marked initial (cdem_integrator_mark_initial). Returns the number of
+ * pairs so marked. */
 long cdem_integrator_make_cohesive(cdem_integrator *it, const cdem_state *s);
+
+/* cohesive_contacts = initial (granular), before the first step of a fresh run: marks every
+ * pair of the built assembly in contact (r < R (1 + 1e-9): its exact tangencies count) as an
+ * initial contact (CDEM_PAIR_INITIAL); the mark is lost when the pair separates, and at the
+ * end of equilibration only the marked touching pairs become cohesive. Returns the pairs
+ * marked (0 for the other rules). Needs the pair list of s (after prime). */
+long cdem_integrator_mark_initial(cdem_integrator *it, const cdem_state *s);
 
 /* Counts touching pairs and intact bonds / cohesive contacts. */
 void cdem_integrator_count(const cdem_integrator *it, long *contacts, long *bonds);

@@ -436,6 +436,7 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
     r->step = 0;
     r->next_inc = 0;
     CDEM_TRY(cdem_integrator_prime(&r->it, &r->s, err));
+    cdem_integrator_mark_initial(&r->it, &r->s);
     log_removed(r);
     CDEM_TRY(write_increment(r, err));
     CDEM_TRY(write_sample(r, err));

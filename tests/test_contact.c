@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include "contact.h"
+#include "integrate.h"
 #include "state.h"
 
 #include <math.h>
@@ -306,6 +307,86 @@ static void test_contact_phases_settling_friction_and_formed_contacts(void **st)
     assert_false(h & CDEM_PAIR_BONDED);
 }
 
+/* cohesive_contacts = initial: a contact of the built assembly keeps its mark while it touches
+ * or stays within round-off of a tangency, loses it when the pair separates, and at the end of
+ * equilibration only the still-marked touching pairs become cohesive. */
+static void test_contact_initial_contacts(void **st) {
+    (void)st;
+    cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 1);
+    const double R = 200.0;
+    double xs = 0.0, fx, fy;
+    uint8_t h = CDEM_PAIR_INITIAL;
+    /* an exact tangency up to round-off: no force, the mark kept */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * (1.0 + 1e-12), 0, R, 0, 0, 0.01, &xs, &h, &fx,
+                      &fy);
+    assert_int_equal(h, CDEM_PAIR_INITIAL);
+    assert_true(fx == 0.0 && fy == 0.0);
+    /* touching: the mark rides along with the touch flag */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 0.5, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    assert_int_equal(h, CDEM_PAIR_INITIAL | CDEM_PAIR_TOUCH);
+    /* separated (1 mm beyond the tangency): the mark is gone for good */
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1e-3, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    assert_int_equal(h, 0);
+    assert_int_equal(cdem_contact_separated(CDEM_PAIR_INITIAL | CDEM_PAIR_COHESIVE, R * R, R),
+                     CDEM_PAIR_INITIAL);
+    assert_int_equal(cdem_contact_separated(CDEM_PAIR_COHESIVE, R * R, R), 0);
+
+    /* through the integrator: three elements in a row, a-b tangent (built contact), b-c
+     * overlapping by 1 m but marked after the build is moved apart */
+    cdem_params p = base_params(CDEM_MATERIAL_GRANULAR);
+    p.granular_law = CDEM_LAW_NORMAL_COHESION;
+    p.cohesive_contacts = CDEM_COHESIVE_INITIAL;
+    cdem_model m;
+    memset(&m, 0, sizeof m);
+    const double r[4] = {50.0, 75.0, 100.0, 125.0};
+    for (int k = 0; k < 4; k++) {
+        m.radius[k] = r[k];
+        m.mass[k] = 2500.0 * M_PI * r[k] * r[k];
+    }
+    m.min_mass = m.mass[0];
+    m.max_radius = 125.0;
+    m.kn = KN;
+    m.ks = KS;
+    m.dt = 0.01;
+    cdem_error err;
+    cdem_state s;
+    cdem_integrator it;
+    assert_int_equal(cdem_state_init(&s, 4, 0, &err), CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 0.0, 0.0, 100.0, m.mass[2], 1, 0u, 0, NULL, &err),
+                     CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 200.0, 0.0, 100.0, m.mass[2], 1, 0u, 0, NULL, &err),
+                     CDEM_OK);
+    assert_int_equal(cdem_state_append(&s, -1, 399.0, 0.0, 100.0, m.mass[2], 1, 0u, 0, NULL, &err),
+                     CDEM_OK);
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_mark_initial(&it, &s), 2);
+    /* c moves away from b (beyond reach), then back into contact */
+    s.x[2] = 402.0;
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    s.x[2] = 399.0;
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    /* a and b: pushed into contact; only that pair becomes cohesive */
+    s.x[1] = 199.5;
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_make_cohesive(&it, &s), 1);
+    long contacts = 0, cohesive = 0;
+    cdem_integrator_count(&it, &contacts, &cohesive);
+    assert_int_equal(contacts, 2);
+    assert_int_equal(cohesive, 1);
+    for (size_t k = 0; k < it.nb.np; k++) /* the marks have served */
+        assert_false(it.nb.hist[k] & CDEM_PAIR_INITIAL);
+    /* the other rules mark nothing */
+    cdem_integrator_free(&it);
+    p.cohesive_contacts = CDEM_COHESIVE_EQUILIBRATED;
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_mark_initial(&it, &s), 0);
+    assert_int_equal(cdem_integrator_make_cohesive(&it, &s), 2);
+    cdem_integrator_free(&it);
+    cdem_state_free(&s);
+}
+
 static void test_contact_wall_and_fault_materials(void **st) {
     (void)st;
     cdem_contact_law law = make_law(CDEM_MATERIAL_GRANULAR, 0);
@@ -395,6 +476,7 @@ int main(void) {
         cmocka_unit_test(test_contact_normal_cohesion_limit_first_slip),
         cmocka_unit_test(test_contact_spring_cohesion),
         cmocka_unit_test(test_contact_phases_settling_friction_and_formed_contacts),
+        cmocka_unit_test(test_contact_initial_contacts),
         cmocka_unit_test(test_contact_wall_and_fault_materials),
         cmocka_unit_test(test_contact_base_material),
         cmocka_unit_test(test_contact_law_rejects_bad_values),
