@@ -94,7 +94,7 @@ static const cdem_param_def param_table[] = {
      "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
      "granular: shear strength mu (Fn + C0) (normal-cohesion), mu Fn + C0 (coulomb), or Fs = Ks Xs + C0 capped at mu Fn (spring-cohesion)"},
-    {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "equilibrated", 0, 0, 0, 0, cohesive_words,
+    {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "initial", 0, 0, 0, 0, cohesive_words,
      "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)"},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
      "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on"},

@@ -1,14 +1,14 @@
-/* Regression tests of the material at reduced size (docs/solver.md, "Which law"): with the
- * default contact law an extensional run opens no void and a collapse leaves no standing
- * cliff; the Mohr-Coulomb contact law (granular_law = coulomb, the law of versions before
- * 0.2) does both, which shows that the measures can fail.
+/* Regression tests of the material at reduced size (docs/solver.md, section 1): with the
+ * default material an extensional run opens no void and a collapse leaves no standing cliff;
+ * the material of version 0.1 (granular_law = coulomb, cohesive_contacts = equilibrated,
+ * settling_friction = 1) does both, which shows that the measures can fail.
  *   - extension: the paper's Fig. 7A set-up (30 degree planar normal fault, first slip off)
  *     on a 10 x 2.5 km assembly at default radii, 400 s of equilibration and 600 s (about
  *     420 m) of slip: no void (analysis/voids.h) and no surface steeper than 40 degrees over
- *     1 km (a graben's flanks); coulomb: a cavity or a chasm.
+ *     1 km (a graben's flanks); version 0.1's material: a cavity or a chasm.
  *   - collapse: the repose test (right wall removed) on the default 10 x 5 km assembly,
  *     2000 s after the wall goes: a slope of 20-40 degrees is fitted (analysis/repose.h) and
- *     nothing is steeper than 60 degrees over 1 km; coulomb: a standing cliff. */
+ *     nothing is steeper than 60 degrees over 1 km; version 0.1's material: a standing cliff. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -59,6 +59,14 @@ static void run_last(const cdem_params *p, const char *name, cdem_state *s) {
     }
 }
 
+/* The material of version 0.1: a Mohr-Coulomb contact with C0 on every contact of the
+ * equilibrated assembly, settled with friction. */
+static void old_material(cdem_params *p) {
+    p->granular_law = CDEM_LAW_COULOMB;
+    p->cohesive_contacts = CDEM_COHESIVE_EQUILIBRATED;
+    p->settling_friction = 1.0;
+}
+
 static cdem_params small_params(cdem_mode mode) {
     cdem_params p;
     cdem_params_defaults(&p);
@@ -79,15 +87,17 @@ static void test_material_extension_opens_no_void(void **st) {
     cdem_error err;
     run_last(&p, "test_material_extension.h5", &s);
     assert_int_equal(cdem_voids_measure(&s, 1000.0, &v, &err), CDEM_OK);
-    print_message("default law: %zu voids, steepest slope %.1f deg\n", v.n_voids, v.steepest_deg);
+    print_message("default material: %zu voids, steepest slope %.1f deg\n", v.n_voids,
+                  v.steepest_deg);
     assert_int_equal(v.n_voids, 0);
     assert_true(v.steepest_deg < 40.0);
     cdem_state_free(&s);
 
-    p.granular_law = CDEM_LAW_COULOMB;
-    run_last(&p, "test_material_extension_coulomb.h5", &s);
+    old_material(&p);
+    run_last(&p, "test_material_extension_old.h5", &s);
     assert_int_equal(cdem_voids_measure(&s, 1000.0, &v, &err), CDEM_OK);
-    print_message("coulomb law: %zu voids, steepest slope %.1f deg\n", v.n_voids, v.steepest_deg);
+    print_message("version 0.1's material: %zu voids, steepest slope %.1f deg\n", v.n_voids,
+                  v.steepest_deg);
     assert_true(v.n_voids > 0 || v.steepest_deg > 45.0);
     cdem_state_free(&s);
 }
@@ -105,18 +115,18 @@ static void test_material_collapse_leaves_no_cliff(void **st) {
     run_last(&p, "test_material_collapse.h5", &s);
     assert_int_equal(cdem_voids_measure(&s, 1000.0, &v, &err), CDEM_OK);
     assert_int_equal(cdem_repose_measure(&s, &rep, &err), CDEM_OK);
-    print_message("default law: repose %.1f deg, steepest slope %.1f deg\n", rep.angle_deg,
+    print_message("default material: repose %.1f deg, steepest slope %.1f deg\n", rep.angle_deg,
                   v.steepest_deg);
     assert_true(rep.angle_deg > 20.0 && rep.angle_deg < 40.0);
     assert_true(v.steepest_deg < 60.0);
     assert_int_equal(v.n_voids, 0);
     cdem_state_free(&s);
 
-    p.granular_law = CDEM_LAW_COULOMB;
-    run_last(&p, "test_material_collapse_coulomb.h5", &s);
+    old_material(&p);
+    run_last(&p, "test_material_collapse_old.h5", &s);
     assert_int_equal(cdem_voids_measure(&s, 1000.0, &v, &err), CDEM_OK);
     const cdem_status st_rep = cdem_repose_measure(&s, &rep, &err);
-    print_message("coulomb law: repose %s %.1f deg, steepest slope %.1f deg\n",
+    print_message("version 0.1's material: repose %s %.1f deg, steepest slope %.1f deg\n",
                   st_rep == CDEM_OK ? "fitted" : "not fitted", rep.angle_deg, v.steepest_deg);
     assert_true(v.steepest_deg > 60.0);
     cdem_state_free(&s);
