@@ -554,6 +554,14 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
     return st == CDEM_OK ? 0 : fail(a.cmd, &err);
 }
 
+/* Loads the increment `which` (K, last, equil, first; NULL = last) of an open run into s. */
+static cdem_status load_increment(cdem_h5_reader *r, const char *which, cdem_state *s,
+                                  cdem_increment_info *info, cdem_error *err) {
+    size_t idx;
+    CDEM_TRY(cdem_h5_reader_find_increment(r, which ? which : "last", &idx, err));
+    return cdem_h5_reader_load_increment(r, idx, s, info, err);
+}
+
 /* ---------------------------------------------------------------- repose */
 static const char repose_synopsis[] =
     "RUN.h5 [--increment K|last|equil|first] [-o OUT.png|.pdf|.svg] [--width N] [--height N]";
@@ -624,16 +632,12 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
     if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
         return fail(a.cmd, &err);
     cdem_h5_reader *r;
-    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
-        return fail(a.cmd, &err);
     cdem_state s = {0};
     cdem_increment_info info;
-    size_t idx;
     cdem_repose_result res;
-    cdem_status st =
-        cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &idx, &err);
-    if (st == CDEM_OK)
-        st = cdem_h5_reader_load_increment(r, idx, &s, &info, &err);
+    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
+        return fail(a.cmd, &err);
+    cdem_status st = load_increment(r, a.increment, &s, &info, &err);
     cdem_params prm;
     if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &err) == CDEM_OK &&
         prm.mode != CDEM_MODE_REPOSE)
@@ -687,16 +691,12 @@ int cdem_cmd_plot_voids(int argc, char **argv) {
         return usage(a.cmd, "prints numbers only (no -o)", voids_synopsis);
     cdem_error err;
     cdem_h5_reader *r;
-    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
-        return fail(a.cmd, &err);
     cdem_state s = {0};
     cdem_increment_info info;
-    size_t idx;
     cdem_voids_result res;
-    cdem_status st =
-        cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &idx, &err);
-    if (st == CDEM_OK)
-        st = cdem_h5_reader_load_increment(r, idx, &s, &info, &err);
+    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
+        return fail(a.cmd, &err);
+    cdem_status st = load_increment(r, a.increment, &s, &info, &err);
     if (st == CDEM_OK)
         st = cdem_voids_measure(&s, a.window > 0.0 ? a.window : 1000.0, &res, &err);
     if (st == CDEM_OK) {

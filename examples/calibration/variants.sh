@@ -4,7 +4,8 @@
 # Each variant: the five biaxial tests of the default assembly (biaxial.ini, 0-20 MPa), the
 # repose test of the same assembly, and the Fig. 7A set-up at reduced size (10 x 2.5 km,
 # default radii, 400 / 1000 s, first slip off). Variants: granular_law x cohesive_contacts x
-# settling_friction, then the default material in the biaxial test with frictional platens
+# settling_friction (the default: normal-cohesion/initial/sf0), then the default material
+# in the biaxial test with frictional platens
 # (the default wall material instead of biaxial.ini's lubricated ones) and/or without damping
 # during deformation (which part of the strength the test set-up makes). Existing runs in
 # OUTDIR are reused.
@@ -19,9 +20,13 @@ mkdir -p "$OUT"
 # name | overrides (material, biaxial-only)
 variants() {
     for law in normal-cohesion coulomb spring-cohesion; do
-        sfs="1 0"
-        [ "$law" = normal-cohesion ] && sfs="1 0.5 0.25 0"
-        for coh in equilibrated formed; do
+        rules="initial equilibrated"
+        sfs="0 1"
+        if [ "$law" = normal-cohesion ]; then
+            rules="initial equilibrated formed"
+            sfs="0 0.25 0.5 1"
+        fi
+        for coh in $rules; do
             for sf in $sfs; do
                 echo "$law/$coh/sf$sf|-s material.granular_law=$law -s material.cohesive_contacts=$coh -s material.settling_friction=$sf|"
             done
@@ -32,17 +37,19 @@ variants() {
     echo "default, frictional platens, no damping|-s material.granular_law=normal-cohesion|-s material.wall_friction=0.25 -s material.wall_cohesion=5e9 -s physics.deformation_damping=0"
 }
 slug() { echo "$1" | tr -c 'A-Za-z0-9.\n' '_'; }
+# 1 when run file $1 exists and completed (a killed run is made again)
+done_run() { [ -f "$1" ] && "$STRAIN" info "$1" 2>/dev/null | grep -q "stop reason: completed"; }
 
 # the commands of every run not yet made, one per line, run JOBS at a time
 variants | while IFS='|' read -r name mat biax; do
     d="$OUT/$(slug "$name")"
     mkdir -p "$d"
     for p in 0 5 10 15 20; do
-        [ -f "$d/b$p.h5" ] || echo "$RUN biaxial.ini $mat $biax -s boundary.confining_pressure=${p}e6 -o $d/b$p.h5 > $d/b$p.log 2>&1"
+        done_run "$d/b$p.h5" || echo "$RUN --force biaxial.ini $mat $biax -s boundary.confining_pressure=${p}e6 -o $d/b$p.h5 > $d/b$p.log 2>&1"
     done
     [ -n "$biax" ] && continue # the biaxial set-up variants: no repose or Fig. 7A
-    [ -f "$d/repose.h5" ] || echo "$RUN -q repose.ini $mat -o $d/repose.h5 > $d/repose.log 2>&1"
-    [ -f "$d/fig7a.h5" ] || echo "$RUN -q ../planar/fig7a-normal30.ini $mat -s assembly.half_radii=off -s assembly.height=2.5 -s time.equilibration=400 -s time.runtime=1000 -s time.display_interval=100 -o $d/fig7a.h5 > $d/fig7a.log 2>&1"
+    done_run "$d/repose.h5" || echo "$RUN --force -q repose.ini $mat -o $d/repose.h5 > $d/repose.log 2>&1"
+    done_run "$d/fig7a.h5" || echo "$RUN --force -q ../planar/fig7a-normal30.ini $mat -s assembly.half_radii=off -s assembly.height=2.5 -s time.equilibration=400 -s time.runtime=1000 -s time.display_interval=100 -o $d/fig7a.h5 > $d/fig7a.log 2>&1"
 done > "$OUT/commands.txt"
 OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive xargs -P "$JOBS" -I{} sh -c "nice -n $NICE {}" < "$OUT/commands.txt"
 
