@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include "cmd_basic.h"
+#include "cmd_faults.h"
 #include "cmd_plot.h"
 #include "cmd_render.h"
 #include "cmd_wedge.h"
@@ -39,6 +40,8 @@ static const cdem_command table[] = {
     {"repose", cdem_cmd_plot_repose, &cdem_cmd_repose_help, "angle of repose of the free surface"},
     {"voids", cdem_cmd_plot_voids, &cdem_cmd_voids_help,
      "steepest surface slope, voids and open fissures (cliffs, chasms, cavities)"},
+    {"faults", cdem_cmd_faults, &cdem_cmd_faults_help,
+     "fault zones from a strain field: position, dip and dip direction"},
     {"wedge", cdem_cmd_wedge, &cdem_cmd_wedge_help,
      "accretionary-wedge height, length, taper, area, forces"},
     {"plot-csv", cdem_cmd_plot_csv, &cdem_cmd_plot_csv_help,

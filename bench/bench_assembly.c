@@ -41,6 +41,7 @@ int main(int argc, char **argv) {
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cdem_params p;
         memset(&p, 0, sizeof p);
+        p.base_spacing = 2.0;
         p.width = cases[i].w;
         p.height = cases[i].h;
         p.unit_scaling = cases[i].scaling;

@@ -77,6 +77,7 @@ typedef struct {
     double unit_scaling;        /* metres per model unit, 100-1000 */
     int half_radii;             /* 0/1: radii 0.025..0.0625 units instead of 0.05..0.125 */
     int wall_height_multiplier; /* lateral wall height = multiplier * assembly height, 1-4 */
+    double base_spacing;        /* centre spacing of the base discs in wall radii, 1-2 */
     long seed;                  /* random seed of the packing (and all other randomness), >= 0 */
 
     /* [time] */

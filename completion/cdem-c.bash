@@ -21,7 +21,7 @@ complete -o filenames -F _cdem_run cdem-run
 _cdem_strain() {
     local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"
     if [ "$COMP_CWORD" -eq 1 ]; then
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
         [ ${#COMPREPLY[@]} -eq 0 ] && COMPREPLY=($(compgen -f -- "$cur"))
         return
     fi
@@ -108,6 +108,16 @@ _cdem_strain() {
             --window) return ;;
         esac
         opts="--increment --window -h --help" ;;
+    faults)
+        case "$prev" in
+            --increment) COMPREPLY=($(compgen -W "last equil first" -- "$cur")); return ;;
+            --quantity) COMPREPLY=($(compgen -W "incr-disp-x incr-disp-y incr-disp-mag total-disp-x total-disp-y total-disp-mag uplift incr-e1 incr-e3 incr-max-shear incr-dilation incr-rotation incr-s1-direction total-e1 total-e3 total-max-shear total-dilation total-s1-direction cum-e1 cum-e3 cum-max-shear cum-dilation sxx syy sxy sigma1 sigma3 max-shear-stress sigma1-direction" -- "$cur")); return ;;
+            --threshold) return ;;
+            --bin) return ;;
+            --min-rows) return ;;
+            -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+        esac
+        opts="--increment --quantity --threshold --bin --min-rows -o --output -h --help" ;;
     wedge)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
@@ -151,7 +161,7 @@ _cdem_strain() {
     quantities)
         opts="-h --help" ;;
     help)
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
         return ;;
     esac
     if [[ "$cur" == -* ]]; then

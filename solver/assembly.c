@@ -393,6 +393,11 @@ static cdem_status check_inputs(const cdem_params *p, const cdem_model *m, const
     if (!(isfinite(p->height) && p->height > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "assembly.height = %g units: must be finite and > 0 (2.5-7.5)", p->height);
+    if (!(p->base_spacing >= 1.0 && p->base_spacing <= 2.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "assembly.base_spacing = %g wall radii: must be 1-2 (1 overlapping, "
+                         "2 touching)",
+                         p->base_spacing);
     if (p->wall_height_multiplier < 1 || p->wall_height_multiplier > 4)
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "assembly.wall_height_multiplier = %d: must be 1-4",
                          p->wall_height_multiplier);
@@ -482,11 +487,18 @@ static void pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails) 
     }
 }
 
-/* Appends the walls: base (y = -rw, x from -rw to w + rw), left (x = -rw) and right
- * (x = w + rw) walls from just above the base corner up to wall height hw. */
+/* Number of base discs: from x = -rw to w + rw with centres at most spacing * rw apart. */
+static long base_disc_count(double w, double rw, double spacing) {
+    return (long)ceil((w + 2.0 * rw) / (spacing * rw)) + 1;
+}
+
+/* Appends the walls: base (y = -rw, x from -rw to w + rw, centres at most base_spacing * rw
+ * apart), left (x = -rw) and right (x = w + rw) walls from just above the base corner up to
+ * wall height hw, centres at most rw apart. The base's spacing sets its roughness: the
+ * base has no other way to resist sliding when its friction is zero (Fig. 12). */
 static cdem_status append_walls(cdem_state *s, double w, double hw, double rw, double mw,
-                                long *n_wall, cdem_error *err) {
-    long nb = (long)ceil((w + 2.0 * rw) / rw) + 1;
+                                double base_spacing, long *n_wall, cdem_error *err) {
+    long nb = base_disc_count(w, rw, base_spacing);
     double sb = (w + 2.0 * rw) / (double)(nb - 1);
     long nl = (long)ceil((hw + rw) / rw);
     double sl = (hw + rw) / (double)nl;
@@ -529,8 +541,8 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
     CDEM_TRY(st);
     long n_wall = 0;
     double rw = m->radius[0];
-    CDEM_TRY(
-        append_walls(s, pk->w, p->wall_height_multiplier * pk->h, rw, m->mass[0], &n_wall, err));
+    CDEM_TRY(append_walls(s, pk->w, p->wall_height_multiplier * pk->h, rw, m->mass[0],
+                          p->base_spacing, &n_wall, err));
     if (info) {
         memset(info, 0, sizeof *info);
         info->n_internal = pk->n;
@@ -538,6 +550,8 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
         info->n_guard_discards = pk->n_guard;
         info->wall_radius = rw;
         info->wall_spacing = rw;
+        info->base_spacing =
+            (pk->w + 2.0 * rw) / (double)(base_disc_count(pk->w, rw, p->base_spacing) - 1);
         info->area_fraction = area / (pk->w * pk->h);
         /* top profile per grid column */
         double sum = 0.0, top_max = 0.0;

@@ -28,7 +28,8 @@ typedef struct {
     double top_max;        /* m, highest point of any internal disc (max of y + r) */
     double area_fraction;  /* sum of internal disc areas / (width x height), 0..~0.9 */
     double wall_radius;    /* m, radius of every wall element (smallest element radius) */
-    double wall_spacing;   /* m, centre-to-centre spacing of wall elements (= wall_radius) */
+    double wall_spacing;   /* m, centre spacing of the lateral walls' elements (= wall_radius) */
+    double base_spacing;   /* m, centre spacing of the base's elements (assembly.base_spacing) */
     long n_guard_discards; /* drops discarded by a numerical guard (a disc wedged without
                               support, a final overlap, too many moves); 0 in practice */
 } cdem_assembly_info;

@@ -37,6 +37,7 @@ static void fill_params(cdem_params *p, double w, double h, double scaling, int 
     p->unit_scaling = scaling;
     p->half_radii = half;
     p->wall_height_multiplier = 1;
+    p->base_spacing = 2.0;
     p->seed = seed;
 }
 
@@ -493,14 +494,15 @@ static int cmp_double(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-static void check_wall_line(const double *pos, size_t n, double from, double to, double rw) {
+static void check_wall_line(const double *pos, size_t n, double from, double to, double rw,
+                            double spacing) {
     assert_true(n >= 2);
     assert_true(pos[0] <= from + 1e-9 * fabs(to));
     assert_true(pos[n - 1] >= to - 1e-9 * fabs(to));
     for (size_t i = 1; i < n; i++) {
-        /* centres at most one wall radius apart: neighbours overlap, no gap at all */
-        assert_true(pos[i] - pos[i - 1] <= rw * (1.0 + 1e-9));
-        assert_true(pos[i] - pos[i - 1] > 0.5 * rw);
+        /* centres at most spacing wall radii apart (1: overlapping; 2: touching, no gap) */
+        assert_true(pos[i] - pos[i - 1] <= spacing * rw * (1.0 + 1e-9));
+        assert_true(pos[i] - pos[i - 1] > 0.5 * spacing * rw);
     }
 }
 
@@ -511,12 +513,15 @@ static void test_assembly_walls_complete(void **unused) {
         cdem_model m;
         fill_params(&p, 10, 5, 1000, 0, 1);
         p.wall_height_multiplier = mult;
+        p.base_spacing = mult == 1 ? 2.0 : 1.0; /* the rough (default) and the smooth base */
         fill_model(&m, 1000, 0);
         cdem_state s;
         cdem_assembly_info info;
         build(&p, &m, &s, &info);
         double w = p.width * p.unit_scaling, h = p.height * p.unit_scaling, rw = m.radius[0];
         assert_true(info.wall_radius == rw && info.wall_spacing == rw);
+        assert_true(info.base_spacing <= p.base_spacing * rw * (1.0 + 1e-12) &&
+                    info.base_spacing > 0.9 * p.base_spacing * rw);
         double *base = malloc(s.n * sizeof *base), *left = malloc(s.n * sizeof *left),
                *right = malloc(s.n * sizeof *right);
         size_t nb = 0, nl = 0, nr = 0;
@@ -548,9 +553,9 @@ static void test_assembly_walls_complete(void **unused) {
         qsort(left, nl, sizeof *left, cmp_double);
         qsort(right, nr, sizeof *right, cmp_double);
         /* the base runs under both lateral walls; lateral walls from the base corner up */
-        check_wall_line(base, nb, -rw, w + rw, rw);
-        check_wall_line(left, nl, 0.0, mult * h, rw);
-        check_wall_line(right, nr, 0.0, mult * h, rw);
+        check_wall_line(base, nb, -rw, w + rw, rw, p.base_spacing);
+        check_wall_line(left, nl, 0.0, mult * h, rw, 1.0);
+        check_wall_line(right, nr, 0.0, mult * h, rw, 1.0);
         assert_true(left[0] - (-rw) <= rw * (1.0 + 1e-9)); /* joined to the corner element */
         assert_true(left[nl - 1] <= mult * h + rw);
         /* a wall gap (spacing - 2 rw) never exceeds the smallest internal diameter */

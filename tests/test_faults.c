@@ -1,0 +1,142 @@
+/* Tests of faults.[ch] (fault zones picked from a strain field) on a random packing with
+ * strain bands of known position, dip and dip direction. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "analysis_fixtures.h"
+#include "faults.h"
+
+#define W 12000.0
+#define H 4000.0
+
+/* Distance of (x, y) to the line through (x0, H) dipping `dip` degrees toward +x (right = 1)
+ * or -x. */
+static double band_distance(double x, double y, double x0, double dip, int right) {
+    const double t = dip * M_PI / 180.0;
+    /* direction down the dip: (cos t, -sin t) to the right, (-cos t, -sin t) to the left */
+    const double dx = right ? cos(t) : -cos(t), dy = -sin(t);
+    const double px = x - x0, py = y - H;
+    return fabs(px * dy - py * dx);
+}
+
+/* Values: 2 inside each band (half-width 250 m: about four elements across), 0.1 elsewhere, NaN on
+ * boundary elements. */
+static double *band_values(const cdem_state *s, int nb, const double *x0, const double *dip,
+                           const int *right) {
+    double *v = malloc(s->n * sizeof *v);
+    assert_non_null(v);
+    for (size_t i = 0; i < s->n; i++) {
+        v[i] = (s->flags[i] & CDEM_FLAGS_BOUNDARY) ? NAN : 0.1;
+        for (int b = 0; b < nb && !(s->flags[i] & CDEM_FLAGS_BOUNDARY); b++)
+            if (band_distance(s->x[i], s->y[i], x0[b], dip[b], right[b]) < 250.0)
+                v[i] = 2.0;
+    }
+    return v;
+}
+
+static void test_faults_two_bands(void **unused) {
+    (void)unused;
+    cdem_state s;
+    make_packing(&s, 6000, W, H, 3);
+    /* a graben: a 60-degree fault dipping right from x = 3 km and a 45-degree one dipping left
+     * from x = 10 km; they do not meet above the base */
+    const double x0[2] = {3000.0, 10000.0}, dip[2] = {60.0, 45.0};
+    const int right[2] = {1, 0};
+    double *v = band_values(&s, 2, x0, dip, right);
+    cdem_faults_options o;
+    cdem_faults_default_options(&o);
+    cdem_faults_result r;
+    cdem_error err;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 2);
+    assert_true(r.bin == 250.0); /* 2 x the largest radius of the fixture, 125 m */
+    for (int b = 0; b < 2; b++) {
+        const cdem_fault_zone *z = &r.zone[b];
+        printf("    zone %d: top (%.0f, %.0f) bottom (%.0f, %.0f) dip %.1f %s rows %d\n", b,
+               z->x_top, z->y_top, z->x_bottom, z->y_bottom, z->dip_deg,
+               z->dips_right ? "right" : "left", z->rows);
+        assert_int_equal(z->dips_right, right[b]);
+        assert_true(fabs(z->dip_deg - dip[b]) < 4.0);
+        assert_true(fabs(z->x_top - x0[b]) < 400.0);
+        assert_true(z->rows >= 12);
+        assert_true(z->mean_value > 1.0 && z->max_value <= 2.0 + 1e-12);
+    }
+    cdem_faults_free(&r);
+    free(v);
+    cdem_state_free(&s);
+}
+
+static void test_faults_vertical_and_quiet(void **unused) {
+    (void)unused;
+    cdem_state s;
+    make_packing(&s, 6000, W, H, 5);
+    const double x0[1] = {6000.0}, dip[1] = {90.0};
+    const int right[1] = {1};
+    double *v = band_values(&s, 1, x0, dip, right);
+    cdem_faults_options o;
+    cdem_faults_default_options(&o);
+    cdem_faults_result r;
+    cdem_error err;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 1);
+    assert_true(r.zone[0].dip_deg > 85.0);
+    assert_true(fabs(r.zone[0].x_top - 6000.0) < 250.0);
+    cdem_faults_free(&r);
+    /* a threshold above every value finds nothing */
+    o.threshold = 3.0;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 0);
+    cdem_faults_free(&r);
+    /* short zones do not count */
+    o.threshold = 1.0;
+    o.min_rows = 40;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 0);
+    cdem_faults_free(&r);
+    free(v);
+    cdem_state_free(&s);
+}
+
+static void test_faults_errors(void **unused) {
+    (void)unused;
+    cdem_state s;
+    make_packing(&s, 500, 3000.0, 2000.0, 7);
+    double *v = malloc(s.n * sizeof *v);
+    assert_non_null(v);
+    for (size_t i = 0; i < s.n; i++)
+        v[i] = NAN;
+    cdem_faults_options o;
+    cdem_faults_default_options(&o);
+    cdem_faults_result r;
+    cdem_error err;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "no free element has a value"));
+    for (size_t i = 0; i < s.n; i++)
+        v[i] = 0.0;
+    o.threshold = 0.0;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "threshold 0 must be > 0"));
+    o.threshold = 1.0;
+    o.min_rows = 1;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "min_rows 1"));
+    assert_int_equal(r.n, 0);
+    free(v);
+    cdem_state_free(&s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_faults_two_bands),
+        cmocka_unit_test(test_faults_vertical_and_quiet),
+        cmocka_unit_test(test_faults_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
