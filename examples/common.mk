@@ -81,3 +81,16 @@ $(OUT)/%-shear.png: $(OUT)/%.h5
 	$(RENDER) $< --increment last --color total-max-shear $(R_$*) -o $@
 $(OUT)/%-info.txt: $(OUT)/%.h5
 	$(CDEM_STRAIN) info $< > $@
+#   $(OUT)/NAME-measures.md  what cdem-strain measures in the last increment (measure.py:
+#                            counts, surface, voids, fault zones; extra options $(M_NAME))
+$(OUT)/%-measures.md: $(OUT)/%.h5 $(EXAMPLES_DIR)/measure.py
+	$(PYTHON) $(EXAMPLES_DIR)/measure.py $(CDEM_STRAIN) $< $(M_$*) > $@
+
+# $(OUT)/measures.md: the measures of every run the folder lists in MEASURED, in that order.
+# (second expansion: the folder sets MEASURED after including this file)
+.PHONY: measures
+measures: $(OUT)/measures.md
+.SECONDEXPANSION:
+$(OUT)/measures.md: $$(foreach r,$$(MEASURED),$(OUT)/$$(r)-measures.md)
+	{ echo "# Measures ($(if $(filter 1,$(QUICK)),quick,paper) size)"; echo; \
+	  cat $^; } > $@

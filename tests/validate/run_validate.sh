@@ -20,7 +20,9 @@
 #     every time step and array, compares them with the HDF5 files and renders a picture
 #     (tests/validate/check_paraview.py); skipped, saying so, when ParaView is not installed.
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
-#     analyses and pictures; a few minutes on 2 cores).
+#     analyses and pictures; a few minutes on 2 cores), and the paper's measurable features
+#     on those runs (tests/validate/check_examples.py: the 7A graben, no void, the 7C
+#     faults, more than one thrust and an undeformed foreland in 12A).
 # 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
 #     (tests/docs/run_doc_blocks.py --all; make test runs the quick ones);
 # 11. docs/measured.md equals a fresh measurement of the default model (make measured).
@@ -126,6 +128,7 @@ fi
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
 check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
+check examples-features $PY tests/validate/check_examples.py "$STRAIN" "$TMP/examples"
 
 check doc-blocks /usr/bin/python3 tests/docs/run_doc_blocks.py --all "$BUILD"
 check docs-measured sh -c "/usr/bin/python3 scripts/measure_docs.py '$BUILD' > '$TMP/measured.md' &&
