@@ -43,6 +43,7 @@ static const char *const kin_words[] = {"ch", "cd", NULL};
 static const char *const vert_words[] = {"caldera", "piston", NULL};
 static const char *const walls_words[] = {"right", "both", NULL};
 static const char *const weak_words[] = {"off", "lower", "upper", NULL};
+static const char *const flex_words[] = {"layer-contacts", "weak-layers", NULL};
 static const char *const sea_words[] = {"null", "low", "mid", "high", "very-high", NULL};
 
 /* Boolean spellings: bool_true_words[i] and bool_false_words[i] are a pair. */
@@ -127,6 +128,8 @@ static const cdem_param_def param_table[] = {
 
     {"heterogeneity", "flexural_slip", CDEM_PTYPE_BOOL, P_OFF(flexural_slip), 0, "", "off", 0, 1, 0, 0, NULL,
      "contacts between different pre-growth layers have no friction/cohesion (or no bond)"},
+    {"heterogeneity", "flexural_slip_style", CDEM_PTYPE_ENUM, P_OFF(flexural_slip_style), 0, "", "layer-contacts", 0, 0, 0, 0, flex_words,
+     "which contacts flexural slip makes strengthless: every contact between two different pre-growth layers (layer-contacts, the manual's and the paper's), or every contact of an element of layers 4, 8, 12, 16 and 20 (weak-layers, the original's versions 4.1-4.2)"},
     {"heterogeneity", "weak_interval", CDEM_PTYPE_ENUM, P_OFF(weak_interval), 0, "", "off", 0, 0, 0, 0, weak_words,
      "weak and/or light interval at the bottom (lower) or top (upper) of the assembly"},
     {"heterogeneity", "weak_thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_thickness_percent), 0, "%", "50", 0, 100, 0, 0, NULL,

@@ -55,6 +55,11 @@ typedef enum {
 typedef enum { CDEM_VERT_CALDERA = 0, CDEM_VERT_PISTON = 1 } cdem_vertical_sense;
 typedef enum { CDEM_WALLS_RIGHT = 0, CDEM_WALLS_BOTH = 1 } cdem_walls_choice;
 typedef enum { CDEM_WEAK_OFF = 0, CDEM_WEAK_LOWER = 1, CDEM_WEAK_UPPER = 2 } cdem_weak_interval;
+/* Which contacts flexural slip makes strengthless. */
+typedef enum {
+    CDEM_FLEX_LAYER_CONTACTS = 0, /* every contact between two different pre-growth layers */
+    CDEM_FLEX_WEAK_LAYERS = 1,    /* every contact of an element of layer 4, 8, 12, 16 or 20 */
+} cdem_flexural_style;
 typedef enum {
     CDEM_SEA_NULL = 0, /* factor 0.0 */
     CDEM_SEA_LOW,      /* factor 0.25 */
@@ -106,10 +111,11 @@ typedef struct {
 
     /* [heterogeneity] */
     int flexural_slip; /* 0/1: contacts between different pre-growth layers have no strength */
-    cdem_weak_interval weak_interval; /* off, lower or upper interval */
-    double weak_thickness_percent;    /* % of assembly height in the interval, 0-100 */
-    double weak_strength_percent;     /* % of material strength kept in the interval, 0-100 */
-    double weak_density_percent;      /* % of density in the interval, 50-100 */
+    cdem_flexural_style flexural_slip_style; /* which contacts (layer contacts, weak layers) */
+    cdem_weak_interval weak_interval;        /* off, lower or upper interval */
+    double weak_thickness_percent;           /* % of assembly height in the interval, 0-100 */
+    double weak_strength_percent;  /* % of material strength kept in the interval, 0-100 */
+    double weak_density_percent;   /* % of density in the interval, 50-100 */
     int layered_friction;          /* 0/1: layers 5-8, 13-16, 21-24 take layered_friction_value */
     double layered_friction_value; /* friction coefficient of those layers, >= 0 */
 

@@ -274,9 +274,11 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
 
     heading(f, "Heterogeneity");
     line(f, "flexural slip", "%s",
-         p->flexural_slip ? "on (no strength between pre-growth layers, from the end of "
-                            "equilibration)"
-                          : "off");
+         !p->flexural_slip ? "off"
+         : p->flexural_slip_style == CDEM_FLEX_WEAK_LAYERS
+             ? "on, weak layers (no strength on contacts of layers 4, 8, 12, 16 and 20, from "
+               "the end of equilibration)"
+             : "on (no strength between pre-growth layers, from the end of equilibration)");
     if (p->weak_interval == CDEM_WEAK_OFF) {
         line(f, "weak/light interval", "off");
     } else {

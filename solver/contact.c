@@ -87,7 +87,9 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
     law->kn = kn;
     law->ks = ks;
     law->max_breaking_strain = 0.0;
-    law->flexural_slip = p->flexural_slip ? 1 : 0;
+    law->flexural_slip = !p->flexural_slip                                 ? 0
+                         : p->flexural_slip_style == CDEM_FLEX_WEAK_LAYERS ? 2
+                                                                           : 1;
     law->layered_friction = p->layered_friction ? 1 : 0;
     if (p->material != CDEM_MATERIAL_GRANULAR && p->material != CDEM_MATERIAL_BONDED)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
@@ -134,12 +136,19 @@ int cdem_contact_layered_layer(int32_t layer) {
     return layer >= 1 && layer <= CDEM_PREGROWTH_LAYERS && ((layer - 1) / 4) % 2 == 1;
 }
 
+int cdem_contact_weak_layer(int32_t layer) {
+    return layer >= 4 && layer <= 20 && layer % 4 == 0;
+}
+
 int cdem_contact_refine(const cdem_contact_law *law, int cls, int32_t layer_i, uint32_t flags_i,
                         int32_t layer_j, uint32_t flags_j) {
     if (cls != CDEM_CLASS_ELEMENT)
         return cls;
-    if (law->flexural_slip && layer_i != layer_j && layer_i >= 1 &&
-        layer_i <= CDEM_PREGROWTH_LAYERS && layer_j >= 1 && layer_j <= CDEM_PREGROWTH_LAYERS)
+    if (law->flexural_slip && layer_i >= 1 && layer_i <= CDEM_PREGROWTH_LAYERS && layer_j >= 1 &&
+        layer_j <= CDEM_PREGROWTH_LAYERS &&
+        (law->flexural_slip == 1
+             ? layer_i != layer_j
+             : cdem_contact_weak_layer(layer_i) || cdem_contact_weak_layer(layer_j)))
         return CDEM_CLASS_SLIP;
     const int weak = ((flags_i | flags_j) & CDEM_FLAG_WEAK) != 0;
     const int layered = law->layered_friction && (cdem_contact_layered_layer(layer_i) ||

@@ -81,7 +81,9 @@ typedef struct {
     double cohesion[CDEM_CLASS_TOTAL]; /* C0 per class, N, >= 0 */
     double breaking_strain[CDEM_CLASS_TOTAL]; /* r0 per class (bonded), > 0 (0 for SLIP) */
     double max_breaking_strain; /* largest r0 of the classes when bonded, else 0 (cut-off) */
-    int flexural_slip;          /* 0/1: pairs of different pre-growth layers use CDEM_CLASS_SLIP */
+    int flexural_slip;          /* 0 off; 1: pairs of different pre-growth layers use
+                                   CDEM_CLASS_SLIP; 2: pairs with an element of a weak layer
+                                   (cdem_contact_weak_layer) do */
     int layered_friction;       /* 0/1: layers 5-8, 13-16, 21-24 use CDEM_CLASS_LAYERED */
 } cdem_contact_law;
 
@@ -100,15 +102,20 @@ int cdem_contact_class(uint32_t flags_i, uint32_t flags_j);
 
 /* Refines a base class (cdem_contact_class) of a pair from its elements' layers and flags.
  * Only CDEM_CLASS_ELEMENT is refined (walls and faults keep their own materials). Rules,
- * in order: flexural slip on and both layers in 1..24 and different -> SLIP (no strength,
- * no bond); else weak = either element has CDEM_FLAG_WEAK, layered = layered friction on
- * and either layer in 5-8, 13-16 or 21-24 -> ELEMENT, WEAK, LAYERED or LAYERED_WEAK. */
+ * in order: flexural slip on, both layers in 1..24 and, by style, different (layer
+ * contacts) or one of them a weak layer (weak layers) -> SLIP (no strength, no bond); else weak =
+ * either element has CDEM_FLAG_WEAK, layered = layered friction on and either layer in 5-8, 13-16
+ * or 21-24 -> ELEMENT, WEAK, LAYERED or LAYERED_WEAK. */
 int cdem_contact_refine(const cdem_contact_law *law, int cls, int32_t layer_i, uint32_t flags_i,
                         int32_t layer_j, uint32_t flags_j);
 
 /* 1 when pre-growth layer L (1..24) is one of the layered-friction layers 5-8, 13-16,
  * 21-24; 0 otherwise (growth layers 25.. and walls 0 never are). */
 int cdem_contact_layered_layer(int32_t layer);
+
+/* 1 when pre-growth layer L is one of flexural slip's weak layers 4, 8, 12, 16, 20 (style
+ * weak-layers, the original program's versions 4.1-4.2); 0 otherwise. */
+int cdem_contact_weak_layer(int32_t layer);
 
 /* Weak/light interval at assembly time (before equilibration, so the equilibrated state
  * carries the density): among free elements, those whose centre lies in the lowest

@@ -97,6 +97,29 @@ static void test_heterogeneity_flexural_slip(void **st) {
                      CDEM_CLASS_ELEMENT);
 }
 
+/* Style weak-layers (the original's versions 4.1-4.2): every contact of an element of layer
+ * 4, 8, 12, 16 or 20 has no strength, whatever the other layer; other layer contacts keep
+ * theirs. */
+static void test_heterogeneity_flexural_slip_weak_layers(void **st) {
+    (void)st;
+    cdem_params p = het_params(CDEM_MATERIAL_GRANULAR);
+    p.flexural_slip = 1;
+    p.flexural_slip_style = CDEM_FLEX_WEAK_LAYERS;
+    cdem_contact_law law = law_of(&p);
+    for (int a = 1; a <= 24; a++)
+        for (int b = 1; b <= 24; b++) {
+            const int weak = (a % 4 == 0 && a <= 20) || (b % 4 == 0 && b <= 20);
+            assert_int_equal(cdem_contact_refine(&law, CDEM_CLASS_ELEMENT, a, 0u, b, 0u),
+                             weak ? CDEM_CLASS_SLIP : CDEM_CLASS_ELEMENT);
+        }
+    assert_true(cdem_contact_weak_layer(20) && !cdem_contact_weak_layer(24) &&
+                !cdem_contact_weak_layer(0) && !cdem_contact_weak_layer(28));
+    /* growth layers and the wall/fault classes are never refined */
+    assert_int_equal(cdem_contact_refine(&law, CDEM_CLASS_ELEMENT, 4, 0u, 25, 0u),
+                     CDEM_CLASS_ELEMENT);
+    assert_int_equal(cdem_contact_refine(&law, CDEM_CLASS_WALL, 4, 0u, 4, 0u), CDEM_CLASS_WALL);
+}
+
 /* Two touching elements through the integrator: at the end of equilibration a bond is
  * created between same-layer elements only. */
 static long bonds_made(int layer_a, int layer_b) {
@@ -467,6 +490,7 @@ static void test_heterogeneity_run_end_to_end(void **st) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_heterogeneity_flexural_slip),
+        cmocka_unit_test(test_heterogeneity_flexural_slip_weak_layers),
         cmocka_unit_test(test_heterogeneity_flexural_slip_no_bond),
         cmocka_unit_test(test_heterogeneity_weak_strength),
         cmocka_unit_test(test_heterogeneity_weak_mass),
