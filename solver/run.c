@@ -67,12 +67,19 @@ struct cdem_run_ctx {
     double erosion_y;           /* m, erosion level (INFINITY until the end of equilibration) */
     double t_start, t_last_log; /* s, monotonic clock (progress display only) */
     long last_log_step;         /* step of the last progress output */
-    int tty_line_open;          /* 1 when a progress line is drawn without newline */
-    cdem_sediment sed;          /* syn-tectonic sedimentation (disabled when off) */
-    long k_def;                 /* deformation steps applied by the mode (settling excluded) */
-    int finished;               /* 1 once the stop reason is recorded (completed/stopped-early) */
-    const char *stop_kind;      /* "completed", "stopped-early", "interrupted" once recorded */
-    int ckpt_off;               /* 1 when the file layer cannot store checkpoints */
+    /* measured speed of each phase (progress display only): equilibration and deformation
+     * (with settling) run at different speeds, so the time left adds up each phase's own */
+    double phase_time[2];  /* s spent in [0] equilibration, [1] deformation and settling */
+    long phase_steps[2];   /* steps taken in each */
+    double t_mark;         /* s, clock at the last accounting */
+    long mark_step;        /* step at the last accounting */
+    double element_steps;  /* sum over the steps taken by this process of the element count */
+    int tty_line_open;     /* 1 when a progress line is drawn without newline */
+    cdem_sediment sed;     /* syn-tectonic sedimentation (disabled when off) */
+    long k_def;            /* deformation steps applied by the mode (settling excluded) */
+    int finished;          /* 1 once the stop reason is recorded (completed/stopped-early) */
+    const char *stop_kind; /* "completed", "stopped-early", "interrupted" once recorded */
+    int ckpt_off;          /* 1 when the file layer cannot store checkpoints */
 };
 typedef struct cdem_run_ctx run_ctx;
 
@@ -105,16 +112,48 @@ static int phase_of(const run_ctx *r, long step) {
     return cdem_sediment_settling(&r->sed, step) ? CDEM_PHASE_SETTLING : CDEM_PHASE_DEFORMATION;
 }
 
+/* Books the steps and time since the last call to the phase the run is in now (called every
+ * 64 steps, so a phase change is attributed to within 64 steps). */
+static void account_phase(run_ctx *r, double t) {
+    const int k = phase_of(r, r->step) == CDEM_PHASE_EQUILIBRATION ? 0 : 1;
+    r->phase_time[k] += t - r->t_mark;
+    r->phase_steps[k] += r->step - r->mark_step;
+    r->t_mark = t;
+    r->mark_step = r->step;
+}
+
+/* Steps per second of phase k (0 equilibration, 1 deformation), or `fallback` before that
+ * phase has run for a second. */
+static double phase_rate(const run_ctx *r, int k, double fallback) {
+    return r->phase_time[k] >= 1.0 ? (double)r->phase_steps[k] / r->phase_time[k] : fallback;
+}
+
+/* Seconds left: the equilibration steps left at equilibration's measured speed, the rest at
+ * deformation's (equilibration's until deformation has been measured). */
+static double time_left(const run_ctx *r, double overall) {
+    const long eq_end = r->m.equil_steps, total = r->m.total_steps;
+    const double eq_rate = phase_rate(r, 0, overall);
+    const double def_rate = phase_rate(r, 1, eq_rate);
+    const long eq_left = r->step < eq_end ? eq_end - r->step : 0;
+    const long def_left = total - (r->step > eq_end ? r->step : eq_end);
+    return (eq_rate > 0.0 ? (double)eq_left / eq_rate : 0.0) +
+           (def_rate > 0.0 && def_left > 0 ? (double)def_left / def_rate : 0.0);
+}
+
 /* The progress line; ending NULL: "N s left", else the text that replaces it on the last
- * line ("completed", "stopped early", "interrupted"), so a run never ends on a time left. */
+ * line ("completed", "stopped early", "interrupted"), so a run never ends on a time left.
+ * The speed shown is the current phase's. */
 static void progress_line(run_ctx *r, int force, const char *ending) {
     if (!logging(r))
         return;
     const double t = now_s();
+    account_phase(r, t);
     const long total = r->m.total_steps;
     const double elapsed = t - r->t_start;
-    const double rate = elapsed > 0.0 ? (double)(r->step - r->step0) / elapsed : 0.0;
-    const double left = rate > 0.0 ? (double)(total - r->step) / rate : 0.0;
+    const double overall = elapsed > 0.0 ? (double)(r->step - r->step0) / elapsed : 0.0;
+    const int k = phase_of(r, r->step) == CDEM_PHASE_EQUILIBRATION ? 0 : 1;
+    const double rate = phase_rate(r, k, overall);
+    const double left = time_left(r, overall);
     const double net = cdem_bc_net_displacement(&r->bc);
     const int inc_done = r->next_inc - 1;
     char tail[64];
@@ -383,7 +422,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the parameter text");
     cdem_params_write(p, f);
     fclose(f);
-    r->t_start = r->t_last_log = now_s();
+    r->t_start = r->t_last_log = r->t_mark = now_s();
     r->last_written_step = -1;
     return CDEM_OK;
 }
@@ -507,7 +546,7 @@ static cdem_status restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *er
                          (long long)step, r->it.step);
     CDEM_TRY(cdem_bc_snapshot_get(&r->bc, snap, err));
     CDEM_TRY(cdem_sediment_snapshot_get(&r->sed, snap, err));
-    r->step = r->step0 = (long)step;
+    r->step = r->step0 = r->mark_step = (long)step;
     r->next_inc = (int)next_inc;
     r->next_inc_step = (long)next_inc_step;
     r->last_written_step = (long)lws;
@@ -631,6 +670,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         if (r->w && !r->ckpt_off && p->checkpoint_interval > 0 && r->last_written_step == step &&
             step < total && r->next_inc - 1 - r->last_ckpt_inc >= p->checkpoint_interval)
             CDEM_TRY(write_checkpoint(r, 1, err));
+        r->element_steps += (double)r->s.n;
         if (step % 64 == 0)
             progress(r, 0);
         /* a stop (signal, max_steps) first checkpoints the state of this step, before the
@@ -763,10 +803,12 @@ static void log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
     char hint[CDEM_PATH_MAX + 160] = "";
     if (st == CDEM_OK && r->stop_kind && !strcmp(r->stop_kind, "stopped-early"))
         resume_hint(r, hint, sizeof hint);
+    const double wall = now_s() - r->t_start;
     fprintf(r->opt->log,
             "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "
-            "stop reason: %s%s)\n",
-            r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, how, hint);
+            "%ld steps in %.1f s wall time, %.3g element-steps/s; stop reason: %s%s)\n",
+            r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, r->step - r->step0, wall,
+            wall > 0.0 ? r->element_steps / wall : 0.0, how, hint);
 }
 
 cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {

@@ -170,6 +170,11 @@ static void test_run_stops_early_and_on_signal(void **st) {
     snprintf(want, sizeof want, "cdem-run: wrote %s (", path);
     assert_non_null(strstr(last, want));
     assert_non_null(strstr(last, " MB; "));
+    /* with the steps this process took, its wall time and speed */
+    snprintf(want, sizeof want, "; %ld steps in ", m.equil_steps + 40);
+    assert_non_null(strstr(last, want));
+    assert_non_null(strstr(last, " s wall time, "));
+    assert_non_null(strstr(last, " element-steps/s; stop reason: "));
     snprintf(want, sizeof want,
              "stop reason: stopped-early; continue it with: cdem-run --resume %s)\n", path);
     assert_non_null(strstr(last, want));
