@@ -8,6 +8,7 @@
  * stdout (or -o FILE) so they can be redirected. */
 #include "cmd_basic.h"
 #include "commands.h"
+#include "threads.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -20,6 +21,7 @@
 enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2 };
 
 int main(int argc, char **argv) {
+    cdem_threads_settle_wait_policy(argv); /* idle threads spin briefly, then sleep */
     if (argc < 2) {
         cdem_cli_usage_print(stderr, &cdem_strain_help, "missing command");
         return EXIT_USAGE;

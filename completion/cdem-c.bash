@@ -8,10 +8,11 @@ _cdem_run() {
         -s) return ;;
         --max-steps) return ;;
         --resume) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+        --threads) return ;;
         --par-min) return ;;
     esac
     if [[ "$cur" == -* ]]; then
-        COMPREPLY=($(compgen -W "-o --force -s -q --quiet --summary --dry-run --print-defaults --params-markdown --max-steps --resume --par-min --ignore-free-space --no-fsync -V --version -h --help -" -- "$cur"))
+        COMPREPLY=($(compgen -W "-o --force -s -q --quiet --summary --dry-run --print-defaults --params-markdown --max-steps --resume --threads --par-min --ignore-free-space --no-fsync -V --version -h --help -" -- "$cur"))
     else
         COMPREPLY=($(compgen -f -- "$cur"))
     fi

@@ -15,6 +15,7 @@
 #include "runlock.h"
 #include "summary.h"
 #include "cli_help.h"
+#include "threads.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -24,6 +25,10 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #ifndef CDEM_VERSION
 #define CDEM_VERSION "0.0.0"
@@ -46,9 +51,9 @@ static void on_signal(int sig) {
  * every option in it appears in the synopsis and is accepted by parse_args. */
 static const char *const run_forms[] = {
     "[MODEL.ini|-] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
-    "[--print-defaults] [--params-markdown] [--max-steps N] [--par-min N] [--force] "
+    "[--print-defaults] [--params-markdown] [--max-steps N] [--threads N] [--par-min N] [--force] "
     "[--ignore-free-space] [--no-fsync]",
-    "--resume RUN.h5 [-q] [--max-steps N] [--par-min N] [--no-fsync]",
+    "--resume RUN.h5 [-q] [--max-steps N] [--threads N] [--par-min N] [--no-fsync]",
     "-V|--version | -h|--help", NULL};
 
 static const cdem_cli_option run_options[] = {
@@ -74,6 +79,10 @@ static const cdem_cli_option run_options[] = {
      "continue a stopped or killed run from its newest checkpoint "
      "(output.checkpoint_interval); the parameters come from the file, so MODEL.ini, -s and "
      "-o are refused; the result is bit-identical to an uninterrupted run"},
+    {"--threads", "N",
+     "run on N threads (default: OMP_NUM_THREADS, else one per core); results are identical "
+     "for any N. Idle threads spin briefly, then sleep, so threads do not slow a run on a busy "
+     "machine (OMP_WAIT_POLICY or GOMP_SPINCOUNT, when set, decide instead)"},
     {"--par-min", "N",
      "run loops of N or more items on several threads (default 16384; results are "
      "identical for any N and thread count)"},
@@ -134,6 +143,7 @@ typedef struct {
     long max_steps;          /* --max-steps, 0 = no limit */
     const char *resume_path; /* --resume RUN.h5, or NULL */
     long par_min;            /* --par-min, 0 = default */
+    int threads;             /* --threads, 0 = OMP_NUM_THREADS or all cores */
     int ignore_free_space;   /* --ignore-free-space */
     int force;               /* --force */
     int no_fsync;            /* --no-fsync */
@@ -200,6 +210,11 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs the run file to continue", arg);
             a->resume_path = argv[++i];
+        } else if (strcmp(arg, "--threads") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("option %s needs a number of threads", arg);
+            if (cdem_threads_parse(argv[++i], &a->threads) != 0)
+                return usage_error("--threads %s: expected a whole number from 1 to 1024", argv[i]);
         } else if (strcmp(arg, "--par-min") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a number of items", arg);
@@ -381,6 +396,7 @@ static int resume(const cli_args *a, cdem_error *err) {
 }
 
 int main(int argc, char **argv) {
+    cdem_threads_settle_wait_policy(argv);
     cli_args a;
     memset(&a, 0, sizeof a);
     a.overrides = calloc((size_t)argc + 1, sizeof *a.overrides);
@@ -393,6 +409,10 @@ int main(int argc, char **argv) {
         free(a.overrides);
         return rc;
     }
+#ifdef _OPENMP
+    if (a.threads > 0)
+        omp_set_num_threads(a.threads);
+#endif
     if (a.help) {
         cdem_cli_help_print(stdout, &run_help);
         free(a.overrides);

@@ -1,0 +1,62 @@
+#!/bin/sh
+# Threads on a busy machine (make bench, part "contended"; docs/performance.md, "Threads on a
+# busy machine"): cdem-run's wall time on 1 and 2 threads with the machine idle and with one
+# CPU-bound competitor process (a shell busy loop, started and stopped here), in one run.
+# The figure of merit is busy 2t / busy 1t: threads must not make a run slower when another
+# process holds a core (goal <= 1.15), while idle 1t / idle 2t keeps the speed-up.
+# Usage: sh bench/contended.sh [BUILD]
+# Environment:
+#   WAITS="cdem"   wait settings to compare, each run in the same way:
+#                  cdem      the environment as it comes (cdem-run chooses: threads.h)
+#                  libgomp   GOMP_SPINCOUNT=300000, libgomp's own default
+#                  passive   OMP_WAIT_POLICY=passive
+#                  spin:N    GOMP_SPINCOUNT=N
+#   MODEL="-s assembly.width=20 -s assembly.half_radii=on"  (16,700 elements)
+#   STEPS=1500  REPS=3 (medians)  WORK=/tmp/cdem_bench
+BUILD=${1:-build}
+WAITS=${WAITS:-cdem}
+MODEL=${MODEL:-"-s assembly.width=20 -s assembly.half_radii=on"}
+STEPS=${STEPS:-1500}
+REPS=${REPS:-3}
+WORK=${WORK:-/tmp/cdem_bench}
+mkdir -p "$WORK"
+median() { sort -g | awk '{a[NR]=$1} END {if (NR % 2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
+
+# one timed run: wall seconds of cdem-run with the wait setting $1 on $2 threads
+timed() {
+    t=$2
+    case $1 in
+    cdem) set -- env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT ;;
+    libgomp) set -- env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=300000 ;;
+    passive) set -- env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=passive ;;
+    spin:*) set -- env -u OMP_WAIT_POLICY GOMP_SPINCOUNT="${1#spin:}" ;;
+    *) echo "contended.sh: unknown wait setting $1" >&2; return 1 ;;
+    esac
+    s=$(date +%s.%N)
+    "$@" "$BUILD/cdem-run" -q --force --no-fsync --threads "$t" --max-steps "$STEPS" $MODEL \
+        -o "$WORK/contended.h5" || return 1
+    e=$(date +%s.%N)
+    awk -v a="$s" -v b="$e" 'BEGIN {printf "%.3f\n", b - a}'
+}
+
+measure() { # wait, threads: median wall time of REPS runs
+    for r in $(seq "$REPS"); do timed "$1" "$2"; done | median
+}
+
+# the competitor: a CPU-bound shell loop, one core's worth
+start_competitor() { sh -c 'while :; do :; done' & COMP=$!; }
+stop_competitor() { kill "$COMP" 2>/dev/null; wait "$COMP" 2>/dev/null; }
+trap 'stop_competitor' EXIT INT TERM
+
+echo "   model: $MODEL, $STEPS steps ($("$BUILD/cdem-run" --summary $MODEL | awk '/free elements:/ {print $3}') free elements); median of $REPS runs; load before $(cut -d' ' -f1-3 /proc/loadavg)"
+printf '   %-14s | %8s %8s %8s | %8s %8s %8s\n' wait "idle 1t" "idle 2t" "speed-up" "busy 1t" "busy 2t" "2t / 1t"
+for w in $WAITS; do
+    i1=$(measure "$w" 1); i2=$(measure "$w" 2)
+    start_competitor
+    b1=$(measure "$w" 1); b2=$(measure "$w" 2)
+    stop_competitor
+    printf '   %-14s | %7.2fs %7.2fs %7.2fx | %7.2fs %7.2fs %7.2fx\n' "$w" "$i1" "$i2" \
+        "$(awk -v a="$i1" -v b="$i2" 'BEGIN {print a / b}')" "$b1" "$b2" \
+        "$(awk -v a="$b1" -v b="$b2" 'BEGIN {print b / a}')"
+done
+echo "   idle speed-up = idle 1t / idle 2t; busy 2t / 1t = the slowdown threads cause with one core busy (goal <= 1.15)"
