@@ -4,6 +4,8 @@
 #   make test       build and run every cmocka test (tests/test_*.c)
 #   make asan       the same tests under address + undefined sanitizers (build-asan/)
 #   make validate   longer physics validations (not part of make test)
+#   make check-slurm   examples/slurm/sweep.sh under a single-node Slurm from Debian's
+#                   packages (installed if missing; as root; make validate runs it too)
 #   make bench      benchmarks (bench/)
 #   make deps       install missing Debian packages (apt-get)
 #   make demo       the main job: simulate the default model, analyse, render a picture
@@ -84,6 +86,10 @@ asan:
 
 validate: all $(BUILD)/tests/test_kill_survival
 	@sh tests/validate/run_validate.sh $(BUILD)
+
+.PHONY: check-slurm
+check-slurm: all
+	@sh tests/validate/check_slurm.sh $(BUILD)
 
 bench: all
 	@sh bench/run_bench.sh $(BUILD)

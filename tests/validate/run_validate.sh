@@ -19,6 +19,10 @@
 #     run, of the stress run, of a compute --format h5 file and an --xdmf2 sidecar, reads
 #     every time step and array, compares them with the HDF5 files and renders a picture
 #     (tests/validate/check_paraview.py); skipped, saying so, when ParaView is not installed.
+#  8c. Slurm: examples/slurm/sweep.sh submitted as its job array to a single-node Slurm
+#     started from Debian's packages (installed if missing), every task's file checked
+#     (tests/validate/check_slurm.sh, also make check-slurm); skipped, saying why, where
+#     Slurm cannot be installed or started (not root, no Debian mirror, daemons fail).
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
 #     analyses and pictures; a few minutes on 2 cores), and the paper's measurable features
 #     on those runs (tests/validate/check_examples.py: the 7A graben, no void, the 7C
@@ -121,6 +125,17 @@ if command -v pvpython >/dev/null 2>&1 && command -v xvfb-run >/dev/null 2>&1; t
 else
     echo "validate: paraview-sidecars: SKIPPED (pvpython or xvfb-run is not installed;" \
         "apt-get install paraview xvfb to run it)"
+fi
+
+# 8c. The Slurm sweep example under a real (single-node, private) Slurm.
+if sh tests/validate/check_slurm.sh "$BUILD" >"$TMP/slurm-sweep.log" 2>&1; then
+    if grep -q '^check-slurm: SKIPPED' "$TMP/slurm-sweep.log"; then
+        echo "validate: slurm-sweep: SKIPPED ($(sed -n 's/^check-slurm: SKIPPED: //p' "$TMP/slurm-sweep.log"))"
+    else
+        passed=$((passed + 1)); echo "validate: slurm-sweep: OK $(tail -n 1 "$TMP/slurm-sweep.log")"
+    fi
+else
+    failed=$((failed + 1)); echo "validate: slurm-sweep: FAILED"; tail -n 30 "$TMP/slurm-sweep.log"
 fi
 
 # 8. kill survival: 200 SIGKILLs of a short cdem-run at seeded random moments; every file
