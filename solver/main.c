@@ -15,6 +15,7 @@
 #include "runlock.h"
 #include "summary.h"
 #include "cli_help.h"
+#include "parallel.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -75,7 +76,7 @@ static const cdem_cli_option run_options[] = {
      "(output.checkpoint_interval); the parameters come from the file, so MODEL.ini, -s and "
      "-o are refused; the result is bit-identical to an uninterrupted run"},
     {"--par-min", "N",
-     "run loops of N or more items on several threads (default 16384; results are "
+     "run loops of N or more items on several threads (default " CDEM_PAR_MIN_STR "; results are "
      "identical for any N and thread count)"},
     {"--ignore-free-space", NULL,
      "run even when the output directory has less free space than the estimated file size"},

@@ -1,8 +1,8 @@
 /* test_numeric_failure: the NaN/Inf protection of cdem_run (issue 10). The issue's scenario
  * is a time step made too large through keep_constants at a small unit scaling. In cdem-c
- * the time step always follows the smallest mass (dt = 0.25 sqrt(m_min / Kn), SPEC), so
- * keep_constants at 100 m stays stable: the first test checks exactly that. The second makes
- * the time step 10x too large through the run's fault-injection option (dt_factor, standing
+ * the time step always follows the smallest mass (dt = 0.25 sqrt(m_min / Kn), as in the original
+ * program), so keep_constants at 100 m stays stable: the first test checks exactly that. The second
+ * makes the time step 10x too large through the run's fault-injection option (dt_factor, standing
  * in for the original program's 1000 m time step with 100x lighter elements) on the same
  * model. Such a run does not reach NaN: elements fly out and are removed as escaping, and
  * before the instability guard of run.c it went on writing garbage. The test checks the run
