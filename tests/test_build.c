@@ -45,6 +45,15 @@ static const char *line_with(const char *out, const char *what, char *line, size
     return line;
 }
 
+/* LINE = the command make would run for TARGET (with EXTRA make arguments) that mentions
+ * WHAT. */
+static void command_for(const char *target, const char *extra, const char *what, char *line,
+                        size_t cap) {
+    static char out[1 << 17];
+    dry_run(target, extra, out, sizeof out);
+    line_with(out, what, line, cap);
+}
+
 static int has_word(const char *line, const char *word) {
     size_t n = strlen(word);
     for (const char *p = strstr(line, word); p; p = strstr(p + 1, word))
@@ -55,10 +64,8 @@ static int has_word(const char *line, const char *word) {
 
 static void test_build_user_cflags_are_appended(void **state) {
     (void)state;
-    static char out[1 << 16];
     char line[4096];
-    dry_run("common/state.o", "CFLAGS=-O1", out, sizeof out);
-    line_with(out, "common/state.c", line, sizeof line);
+    command_for("common/state.o", "CFLAGS=-O1", "common/state.c", line, sizeof line);
     const char *kept[] = {"-std=c17", "-Werror", "-fopenmp", "-O1", "-Icommon"};
     for (size_t i = 0; i < sizeof kept / sizeof kept[0]; i++)
         if (!has_word(line, kept[i]))
@@ -77,11 +84,9 @@ static void test_build_layer_include_paths(void **state) {
         {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis", NULL}},
         {"analysis/render.o", "analysis/render.c", {"-Icommon", "-Ianalysis"}, {"-Isolver", NULL}},
     };
-    static char out[1 << 16];
     char line[4096];
     for (size_t i = 0; i < sizeof layers / sizeof layers[0]; i++) {
-        dry_run(layers[i].object, "", out, sizeof out);
-        line_with(out, layers[i].source, line, sizeof line);
+        command_for(layers[i].object, "", layers[i].source, line, sizeof line);
         for (size_t k = 0; k < 2; k++) {
             if (layers[i].allowed[k] && !has_word(line, layers[i].allowed[k]))
                 fail_msg("%s compiles without %s: %s", layers[i].source, layers[i].allowed[k],
@@ -94,10 +99,8 @@ static void test_build_layer_include_paths(void **state) {
 
 static void test_build_strain_links_no_solver(void **state) {
     (void)state;
-    static char out[1 << 17];
     char line[8192];
-    dry_run("cdem-strain", "", out, sizeof out);
-    line_with(out, "-o dryrun-build/cdem-strain", line, sizeof line);
+    command_for("cdem-strain", "", "-o dryrun-build/cdem-strain", line, sizeof line);
     assert_non_null(strstr(line, "libcdemanalysis.a"));
     assert_non_null(strstr(line, "libcdem.a"));
     if (strstr(line, "libcdemsolver.a"))
