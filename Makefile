@@ -20,16 +20,34 @@ BUILD   ?= build
 CC      ?= gcc
 PKGS    := hdf5 gsl cairo
 OPT     ?= -O2
-CFLAGS  ?= $(OPT) -g
+# The project's flags live in CDEM_CFLAGS; a user's CFLAGS (and CPPFLAGS, LDFLAGS) come
+# after them, so `make CFLAGS=-O1` changes the optimisation (the last -O wins) but never
+# drops -std, -Werror, OpenMP or the include paths. OPT is what `make asan` and
+# `make fuzz` swap.
+CFLAGS  ?=
 # -fno-math-errno: sqrt inlines without the errno branch (the results are the same IEEE values)
-CFLAGS  += -fno-math-errno
-CFLAGS  += -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
-           -Icommon -Isolver -Ianalysis -MMD -MP
-CFLAGS  += $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+CDEM_CFLAGS := $(OPT) -g -fno-math-errno
+CDEM_CFLAGS += -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
+               -MMD -MP
+# (after the layer's include paths: a library's header never shadows one of ours)
+PKG_CFLAGS  := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lgif -lm -fopenmp
 TEST_LDLIBS := $(shell pkg-config --libs cmocka 2>/dev/null)
 VERSION := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
-CFLAGS  += -DCDEM_VERSION='"$(VERSION)"'
+CDEM_CFLAGS += -DCDEM_VERSION='"$(VERSION)"'
+
+# Include paths per layer: they are the allowed dependencies. common sees only itself;
+# the solver and the analysis each see common and themselves, never each other (the
+# analysis needs nothing of the solver: it reads the solver's results through the file
+# format in common/). Tests and fuzz harnesses see every layer. A file's layer is the first
+# folder of its path. (A header in the same folder as its includer is found without -I,
+# which is the same rule: a layer always sees itself.)
+INC_common   := -Icommon
+INC_solver   := -Icommon -Isolver
+INC_analysis := -Icommon -Ianalysis
+INC_tests    := -Icommon -Isolver -Ianalysis
+layer_inc = $(INC_$(firstword $(subst /, ,$(1))))
+compile_flags = $(CDEM_CFLAGS) $(1) $(PKG_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 
 COMMON_SRC   := $(wildcard common/*.c)
 SOLVER_SRC   := $(filter-out solver/main.c,$(wildcard solver/*.c))
@@ -55,7 +73,7 @@ deps:
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c $< -o $@
+	$(CC) $(call compile_flags,$(call layer_inc,$<)) -c $< -o $@
 
 $(LIBCOMMON): $(COMMON_OBJ)
 	@mkdir -p $(dir $@)
@@ -67,14 +85,15 @@ $(LIBANALYSIS): $(ANALYSIS_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
+# cdem-strain links no solver code: the analysis reads runs through common/'s file format
 $(BUILD)/cdem-run: $(BUILD)/solver/main.o $(LIBSOLVER) $(LIBCOMMON)
-	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
-$(BUILD)/cdem-strain: $(BUILD)/analysis/main.o $(LIBANALYSIS) $(LIBSOLVER) $(LIBCOMMON)
-	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) $(call compile_flags,) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+$(BUILD)/cdem-strain: $(BUILD)/analysis/main.o $(LIBANALYSIS) $(LIBCOMMON)
+	$(CC) $(call compile_flags,) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/tests/%: tests/%.c $(LIBS)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -o $@ $< $(LIBS) $(LDLIBS) $(TEST_LDLIBS)
+	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -o $@ $< $(LIBS) $(LDLIBS) $(TEST_LDLIBS)
 
 tests-build: all $(TEST_BIN)
 
@@ -111,7 +130,7 @@ fuzz-build:
 fuzz-bins: $(FUZZ_HARNESSES:%=$(BUILD)/fuzz/fuzz_%)
 $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
+	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
 
 format:
 	clang-format -i common/*.[ch] solver/*.[ch] analysis/*.[ch] tests/*.[ch] 2>/dev/null || true

@@ -1,5 +1,6 @@
 /* colorlimits (module "limits"; not named limits.h so it never shadows <limits.h>): colour-bar
- * limits (SPEC section 5) and the percentile they are built from.
+ * limits (as the original program chooses them; docs/analysis.md) and the percentile they are built
+ * from.
  *
  * Percentile definition (the one of gsl_stats_quantile_from_sorted_data, used directly): for
  * n finite values sorted ascending, the f-quantile is v[i] + (v[i+1] - v[i]) (h - i) with

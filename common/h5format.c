@@ -191,53 +191,54 @@ static const series_column series_columns[] = {
 #undef SCOL
 #define N_SERIES (sizeof series_columns / sizeof series_columns[0])
 
-/* Per-element datasets of an increment. */
-typedef enum { EL_I32, EL_U32, EL_F64 } el_type;
+/* Per-element datasets of an increment: the rows of CDEM_STATE_FIELDS (state.h) marked
+ * in_increments, in table order (velocities, forces and masses live only in checkpoints).
+ * The list is built by the preprocessor so that its length is a compile-time constant. */
 typedef struct {
-    const char *name; /* dataset name in the increment group */
-    el_type type;     /* stored and memory type */
-    int optional;     /* 1: stress, present only with has_stress */
-    const char *xdmf; /* XDMF NumberType */
+    const char *name;     /* dataset name in the increment group */
+    const char *path;     /* "/increments/<name>" */
+    cdem_field_type type; /* stored and memory type */
+    int optional;         /* 1: stress, present only with has_stress */
+    size_t offset;        /* of the array pointer in cdem_state */
 } element_field;
 
-static const element_field element_fields[] = {
-    {"id", EL_I32, 0, "Int"},       {"x", EL_F64, 0, "Float"},   {"y", EL_F64, 0, "Float"},
-    {"radius", EL_F64, 0, "Float"}, {"layer", EL_I32, 0, "Int"}, {"flags", EL_U32, 0, "UInt"},
-    {"born", EL_I32, 0, "Int"},     {"sxx", EL_F64, 1, "Float"}, {"syy", EL_F64, 1, "Float"},
-    {"sxy", EL_F64, 1, "Float"},
-};
+#define IF_IN_INCREMENTS_0(...)
+#define IF_IN_INCREMENTS_1(...) __VA_ARGS__
+#define INCREMENT_FIELD(name, ctype, ftype, in_increments, stress)                                 \
+    IF_IN_INCREMENTS_##in_increments(                                                              \
+        {#name, "/increments/" #name, ftype, stress, offsetof(cdem_state, name)}, )
+static const element_field element_fields[] = {CDEM_STATE_FIELDS(INCREMENT_FIELD)};
+#undef INCREMENT_FIELD
 #define N_ELEMENT_FIELDS (sizeof element_fields / sizeof element_fields[0])
 
+/* The array of element field k in s. */
 static void *element_array(const cdem_state *s, size_t k) {
-    switch (k) {
-    case 0:
-        return s->id;
-    case 1:
-        return s->x;
-    case 2:
-        return s->y;
-    case 3:
-        return s->radius;
-    case 4:
-        return s->layer;
-    case 5:
-        return s->flags;
-    case 6:
-        return s->born;
-    case 7:
-        return s->sxx;
-    case 8:
-        return s->syy;
-    default:
-        return s->sxy;
-    }
+    void *p;
+    memcpy(&p, (const char *)s + element_fields[k].offset, sizeof p);
+    return p;
 }
 
-static hid_t el_file_type(el_type t) {
-    return t == EL_I32 ? H5T_STD_I32LE : t == EL_U32 ? H5T_STD_U32LE : H5T_IEEE_F64LE;
+/* Index of the first stress field (the stress datasets share one extent). */
+static size_t first_stress_field(void) {
+    size_t k = 0;
+    while (k < N_ELEMENT_FIELDS && !element_fields[k].optional)
+        k++;
+    return k;
 }
-static hid_t el_mem_type(el_type t) {
-    return t == EL_I32 ? H5T_NATIVE_INT32 : t == EL_U32 ? H5T_NATIVE_UINT32 : H5T_NATIVE_DOUBLE;
+
+static const char *xdmf_number_type(cdem_field_type t) {
+    return t == CDEM_FIELD_I32 ? "Int" : t == CDEM_FIELD_U32 ? "UInt" : "Float";
+}
+
+static hid_t el_file_type(cdem_field_type t) {
+    return t == CDEM_FIELD_I32   ? H5T_STD_I32LE
+           : t == CDEM_FIELD_U32 ? H5T_STD_U32LE
+                                 : H5T_IEEE_F64LE;
+}
+static hid_t el_mem_type(cdem_field_type t) {
+    return t == CDEM_FIELD_I32   ? H5T_NATIVE_INT32
+           : t == CDEM_FIELD_U32 ? H5T_NATIVE_UINT32
+                                 : H5T_NATIVE_DOUBLE;
 }
 
 /* ------------------------------------------------------------------ attribute helpers */
@@ -721,8 +722,16 @@ static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
 }
 
 /* ------------------------------------------------------------------ XDMF sidecar */
-/* The attributes of a grid, in sidecar order (indices into element_fields). */
-static const size_t xmf_attributes[] = {3, 4, 0, 5, 6, 7, 8, 9};
+/* The attributes of a grid, in sidecar order (names of element_fields). */
+static const char *const xmf_attributes[] = {"radius", "layer", "id",  "flags",
+                                             "born",   "sxx",   "syy", "sxy"};
+
+static const element_field *element_field_named(const char *name) {
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        if (!strcmp(element_fields[k].name, name))
+            return &element_fields[k];
+    return NULL;
+}
 
 /* One increment of a version-2 file as an XDMF grid (xdmf.h): rows offset .. of the ragged
  * datasets, whose extents were data_ext and stress_ext when the sidecar was written. */
@@ -736,18 +745,14 @@ static void xmf_grid(cdem_xdmf_grid *g, const xmf_entry *e, hsize_t data_ext, hs
     g->y.dataset = "/increments/y";
     g->xy.dataset = "/increments/xy";
     for (size_t a = 0; a < sizeof xmf_attributes / sizeof xmf_attributes[0]; a++) {
-        const element_field *fd = &element_fields[xmf_attributes[a]];
-        if (fd->optional && !e->has_stress)
+        const element_field *fd = element_field_named(xmf_attributes[a]);
+        if (!fd || (fd->optional && !e->has_stress))
             continue;
-        static const char *const paths[N_ELEMENT_FIELDS] = {
-            "/increments/id",    "/increments/x",     "/increments/y",    "/increments/radius",
-            "/increments/layer", "/increments/flags", "/increments/born", "/increments/sxx",
-            "/increments/syy",   "/increments/sxy"};
         g->attribute_names[g->n_attributes] = fd->name;
         g->attributes[g->n_attributes++] =
-            (cdem_xdmf_data){paths[xmf_attributes[a]], fd->optional ? e->stress_offset : e->offset,
-                             (long long)(fd->optional ? stress_ext : data_ext), fd->xdmf,
-                             fd->type == EL_F64 ? 8 : 4};
+            (cdem_xdmf_data){fd->path, fd->optional ? e->stress_offset : e->offset,
+                             (long long)(fd->optional ? stress_ext : data_ext),
+                             xdmf_number_type(fd->type), (int)cdem_field_type_size(fd->type)};
     }
 }
 
@@ -1198,8 +1203,10 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
     if (info->number < 0)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: increment number %d is negative", w->path,
                          (int)info->number);
-    if (s->n > 0 && (!s->id || !s->x || !s->y || !s->radius || !s->layer || !s->flags || !s->born ||
-                     (s->has_stress && (!s->sxx || !s->syy || !s->sxy))))
+    int missing = 0;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        missing |= (!element_fields[k].optional || s->has_stress) && !element_array(s, k);
+    if (s->n > 0 && missing)
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "%s: increment %d: the state has %zu elements but missing arrays", w->path,
                          (int)info->number, s->n);
@@ -1714,7 +1721,7 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
                 H5Tclose(t);
             if (sp >= 0)
                 H5Sclose(sp);
-            H5T_class_t want = fd->type == EL_F64 ? H5T_FLOAT : H5T_INTEGER;
+            H5T_class_t want = fd->type == CDEM_FIELD_F64 ? H5T_FLOAT : H5T_INTEGER;
             if (cls != want || rank != 1)
                 return CDEM_FAIL(err, CDEM_ERR_FORMAT,
                                  "%s: dataset /%s has type class %d and rank %d (expected a 1-D "
@@ -2040,7 +2047,7 @@ static cdem_status read_element_dataset(cdem_h5_reader *r, hid_t g, const char *
     cdem_status st = CDEM_OK;
     hid_t t = H5Dget_type(ds), sp = H5Dget_space(ds);
     H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
-    H5T_class_t want = fd->type == EL_F64 ? H5T_FLOAT : H5T_INTEGER;
+    H5T_class_t want = fd->type == CDEM_FIELD_F64 ? H5T_FLOAT : H5T_INTEGER;
     hsize_t dims[2] = {0, 0};
     int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
     if (rank >= 0 && rank <= 2)
@@ -2818,7 +2825,7 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
 
     /* Increments to keep: the valid prefix of the index up to keep_inc. */
     hsize_t rows = extent_of(w->index), data_ext = extent_of(w->data[0]),
-            stress_ext = extent_of(w->data[7]);
+            stress_ext = extent_of(w->data[first_stress_field()]);
     for (size_t k = 1; k < N_ELEMENT_FIELDS; k++) {
         hsize_t e = extent_of(w->data[k]);
         if (element_fields[k].optional)

@@ -1,4 +1,4 @@
-/* model: derived constants and the increment schedule (see model.h, SPEC section 2).
+/* model: derived constants and the increment schedule (see model.h).
  *
  * Every number that the solver, the summary and the analysis must agree on is computed
  * here once. The boundary speed v = 25 m/s^2 x dt is not stated by the original documents;

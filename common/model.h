@@ -1,4 +1,4 @@
-/* model: the quantities derived from the parameters (SPEC section 2): element radii and
+/* model: the quantities derived from the parameters (as in the original program): element radii and
  * masses, spring and damping constants, time step, boundary speed, step counts and the
  * display-increment schedule. Pure functions of cdem_params; the solver, the summary and
  * the tests all use these, so a constant is computed in exactly one place.
@@ -19,7 +19,7 @@
 #define CDEM_NUM_RADII 4
 #define CDEM_PREGROWTH_LAYERS 24
 
-/* Boundary speed relation (SPEC 2): v = CDEM_BOUNDARY_ACCEL * dt, in m/s. */
+/* Boundary speed of the original program: v = CDEM_BOUNDARY_ACCEL * dt, in m/s. */
 #define CDEM_BOUNDARY_ACCEL 25.0
 
 typedef struct {

@@ -5,21 +5,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define STATE_ARRAYS(X)                                                                            \
-    X(id, int32_t)                                                                                 \
-    X(x, double)                                                                                   \
-    X(y, double)                                                                                   \
-    X(vx, double)                                                                                  \
-    X(vy, double)                                                                                  \
-    X(fx, double)                                                                                  \
-    X(fy, double)                                                                                  \
-    X(radius, double)                                                                              \
-    X(mass, double)                                                                                \
-    X(layer, int32_t)                                                                              \
-    X(flags, uint32_t)                                                                             \
-    X(born, int32_t)
+#define FIELD_ROW(name, ctype, ftype, in_increments, stress)                                       \
+    {#name, ftype, offsetof(cdem_state, name), in_increments, stress},
+const cdem_state_field cdem_state_fields[] = {CDEM_STATE_FIELDS(FIELD_ROW)};
+#undef FIELD_ROW
+const size_t cdem_state_field_count = sizeof cdem_state_fields / sizeof cdem_state_fields[0];
 
-#define STRESS_ARRAYS(X) X(sxx, double) X(syy, double) X(sxy, double)
+void *cdem_state_field_array(const cdem_state *s, const cdem_state_field *f) {
+    void *p;
+    memcpy(&p, (const char *)s + f->offset, sizeof p);
+    return p;
+}
+
+size_t cdem_field_type_size(cdem_field_type t) {
+    return t == CDEM_FIELD_F64 ? sizeof(double) : sizeof(int32_t);
+}
 
 static int grow_array(void **p, size_t elem_size, size_t old_cap, size_t new_cap) {
     void *q = realloc(*p, new_cap * elem_size);
@@ -42,9 +42,8 @@ cdem_status cdem_state_init(cdem_state *s, size_t capacity, int with_stress, cde
 void cdem_state_free(cdem_state *s) {
     if (!s)
         return;
-#define FREE_ONE(name, type) free(s->name);
-    STATE_ARRAYS(FREE_ONE)
-    STRESS_ARRAYS(FREE_ONE)
+#define FREE_ONE(name, ctype, ftype, in_increments, stress) free(s->name);
+    CDEM_STATE_FIELDS(FREE_ONE)
 #undef FREE_ONE
     memset(s, 0, sizeof *s);
 }
@@ -59,14 +58,12 @@ cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) 
     size_t new_cap = s->capacity ? s->capacity : 16;
     while (new_cap < capacity)
         new_cap += new_cap / 2 + 1;
-#define GROW_ONE(name, type)                                                                       \
-    if (!grow_array((void **)&s->name, sizeof(type), s->capacity, new_cap))                        \
+#define GROW_ONE(name, ctype, ftype, in_increments, stress)                                        \
+    if ((!(stress) || s->has_stress) &&                                                            \
+        !grow_array((void **)&s->name, sizeof(ctype), s->capacity, new_cap))                       \
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory growing element arrays to %zu",       \
                          new_cap);
-    STATE_ARRAYS(GROW_ONE)
-    if (s->has_stress) {
-        STRESS_ARRAYS(GROW_ONE)
-    }
+    CDEM_STATE_FIELDS(GROW_ONE)
 #undef GROW_ONE
     s->capacity = new_cap;
     return CDEM_OK;
@@ -75,15 +72,20 @@ cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err) 
 cdem_status cdem_state_enable_stress(cdem_state *s, cdem_error *err) {
     if (s->has_stress)
         return CDEM_OK;
-#define ALLOC_ONE(name, type) s->name = calloc(s->capacity ? s->capacity : 1, sizeof(type));
-    /* All three or none: a partial failure frees what it got (a retry must not leak). */
-    STRESS_ARRAYS(ALLOC_ONE)
+    int missing = 0;
+#define ALLOC_ONE(name, ctype, ftype, in_increments, stress)                                       \
+    if (stress)                                                                                    \
+        missing |= !(s->name = calloc(s->capacity ? s->capacity : 1, sizeof(ctype)));
+    /* All or none: a partial failure frees what it got (a retry must not leak). */
+    CDEM_STATE_FIELDS(ALLOC_ONE)
 #undef ALLOC_ONE
-    if (!s->sxx || !s->syy || !s->sxy) {
-#define DROP_ONE(name, type)                                                                       \
-    free(s->name);                                                                                 \
-    s->name = NULL;
-        STRESS_ARRAYS(DROP_ONE)
+    if (missing) {
+#define DROP_ONE(name, ctype, ftype, in_increments, stress)                                        \
+    if (stress) {                                                                                  \
+        free(s->name);                                                                             \
+        s->name = NULL;                                                                            \
+    }
+        CDEM_STATE_FIELDS(DROP_ONE)
 #undef DROP_ONE
         return CDEM_FAIL(err, CDEM_ERR_NOMEM,
                          "out of memory allocating stress arrays for %zu elements", s->capacity);
@@ -105,18 +107,20 @@ cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, dou
     size_t i = s->n++;
     if (id >= s->next_id)
         s->next_id = id + 1;
+        /* every field zero (a slot freed by compaction keeps old values), then the given ones */
+#define ZERO_ONE(name, ctype, ftype, in_increments, stress)                                        \
+    if (!(stress) || s->has_stress)                                                                \
+        s->name[i] = 0;
+    CDEM_STATE_FIELDS(ZERO_ONE)
+#undef ZERO_ONE
     s->id[i] = id;
     s->x[i] = x;
     s->y[i] = y;
-    s->vx[i] = s->vy[i] = 0.0;
-    s->fx[i] = s->fy[i] = 0.0;
     s->radius[i] = radius;
     s->mass[i] = mass;
     s->layer[i] = layer;
     s->flags[i] = flags;
     s->born[i] = born;
-    if (s->has_stress)
-        s->sxx[i] = s->syy[i] = s->sxy[i] = 0.0;
     if (index)
         *index = i;
     return CDEM_OK;
@@ -133,11 +137,10 @@ void cdem_state_compact(cdem_state *s, const unsigned char *keep, size_t *new_in
         if (new_index_out)
             new_index_out[i] = j;
         if (j != i) {
-#define MOVE_ONE(name, type) s->name[j] = s->name[i];
-            STATE_ARRAYS(MOVE_ONE)
-            if (s->has_stress) {
-                STRESS_ARRAYS(MOVE_ONE)
-            }
+#define MOVE_ONE(name, ctype, ftype, in_increments, stress)                                        \
+    if (!(stress) || s->has_stress)                                                                \
+        s->name[j] = s->name[i];
+            CDEM_STATE_FIELDS(MOVE_ONE)
 #undef MOVE_ONE
         }
         j++;
@@ -154,11 +157,10 @@ cdem_status cdem_state_copy(cdem_state *dst, const cdem_state *src, cdem_error *
         cdem_state_free(dst); /* arrays the failed init did allocate */
         return st;
     }
-#define COPY_ONE(name, type) memcpy(dst->name, src->name, src->n * sizeof(type));
-    STATE_ARRAYS(COPY_ONE)
-    if (src->has_stress) {
-        STRESS_ARRAYS(COPY_ONE)
-    }
+#define COPY_ONE(name, ctype, ftype, in_increments, stress)                                        \
+    if (!(stress) || src->has_stress)                                                              \
+        memcpy(dst->name, src->name, src->n * sizeof(ctype));
+    CDEM_STATE_FIELDS(COPY_ONE)
 #undef COPY_ONE
     dst->n = src->n;
     dst->next_id = src->next_id;

@@ -34,23 +34,69 @@ enum {
 #define CDEM_FLAGS_BOUNDARY                                                                        \
     (CDEM_FLAG_WALL | CDEM_FLAG_FAULT | CDEM_FLAG_FOOTWALL | CDEM_FLAG_MYLAR)
 
+/* Element types of the per-element arrays, as stored in files. */
+typedef enum {
+    CDEM_FIELD_I32, /* int32_t */
+    CDEM_FIELD_U32, /* uint32_t */
+    CDEM_FIELD_F64, /* double */
+} cdem_field_type;
+
+/* The per-element arrays: the one list that declares them (cdem_state below), allocates,
+ * grows, frees, copies and compacts them (state.c), stores them in every increment of the
+ * run file (common/h5format.c) and in checkpoints (solver/checkpoint.c). Adding a field is
+ * one row here (plus, for an in_increments field, its line in docs/format.md and a thought
+ * about older files, which lack the dataset). The order is the order of the checkpoint blob
+ * and of the run file's datasets: append new rows, do not reorder. Columns:
+ *   X(name, C type, file type, in_increments, stress)
+ *   in_increments  1: a dataset /increments/<name> of the run file; 0: checkpoints only
+ *   stress         1: allocated only when has_stress (the three stress components) */
+#define CDEM_STATE_FIELDS(X)                                                                       \
+    X(id, int32_t, CDEM_FIELD_I32, 1, 0)     /* stable element id, unique within a run */          \
+    X(x, double, CDEM_FIELD_F64, 1, 0)       /* centre position, m */                              \
+    X(y, double, CDEM_FIELD_F64, 1, 0)       /* centre position, m */                              \
+    X(vx, double, CDEM_FIELD_F64, 0, 0)      /* velocity, m/s */                                   \
+    X(vy, double, CDEM_FIELD_F64, 0, 0)      /* velocity, m/s */                                   \
+    X(fx, double, CDEM_FIELD_F64, 0, 0)      /* total force of the current step, N */              \
+    X(fy, double, CDEM_FIELD_F64, 0, 0)      /* total force of the current step, N */              \
+    X(radius, double, CDEM_FIELD_F64, 1, 0)  /* m */                                               \
+    X(mass, double, CDEM_FIELD_F64, 0, 0)    /* kg per metre */                                    \
+    X(layer, int32_t, CDEM_FIELD_I32, 1, 0)  /* 1..24 pre-growth; 25.. growth; 0 = wall */         \
+    X(flags, uint32_t, CDEM_FIELD_U32, 1, 0) /* CDEM_FLAG_* bits */                                \
+    X(born, int32_t, CDEM_FIELD_I32, 1, 0)   /* increment that created it (0 = initial) */         \
+    X(sxx, double, CDEM_FIELD_F64, 1, 1)     /* stress, N/m, compression positive */               \
+    X(syy, double, CDEM_FIELD_F64, 1, 1)     /* NULL unless has_stress */                          \
+    X(sxy, double, CDEM_FIELD_F64, 1, 1)
+
 typedef struct {
     size_t n;        /* number of elements in use */
     size_t capacity; /* allocated length of every array */
     int has_stress;  /* 1: sxx, syy, sxy are allocated */
     int32_t next_id; /* id for the next added element */
-
-    int32_t *id;             /* stable element id, unique within a run */
-    double *x, *y;           /* centre position, m */
-    double *vx, *vy;         /* velocity, m/s */
-    double *fx, *fy;         /* total force of the current step, N */
-    double *radius;          /* m */
-    double *mass;            /* kg per metre */
-    int32_t *layer;          /* 1..24 pre-growth layers; 25.. growth layers; 0 = wall/unassigned */
-    uint32_t *flags;         /* CDEM_FLAG_* bits */
-    int32_t *born;           /* increment number at which the element was created (0 = initial) */
-    double *sxx, *syy, *sxy; /* stress, N/m, compression positive; NULL unless has_stress */
+    /* one array per row of CDEM_STATE_FIELDS (meaning and units there): id, x, y, vx, vy,
+     * fx, fy, radius, mass, layer, flags, born, sxx, syy, sxy */
+#define CDEM_STATE_MEMBER(name, ctype, ftype, in_increments, stress) ctype *name;
+    CDEM_STATE_FIELDS(CDEM_STATE_MEMBER)
+#undef CDEM_STATE_MEMBER
 } cdem_state;
+
+/* A row of CDEM_STATE_FIELDS as data, for code that loops over the fields at run time. */
+typedef struct {
+    const char *name;     /* member name, dataset name and checkpoint array name */
+    cdem_field_type type; /* element type */
+    size_t offset;        /* offset of the array pointer in cdem_state */
+    int in_increments;    /* 1: stored in every increment of the run file */
+    int stress;           /* 1: exists only when has_stress */
+} cdem_state_field;
+
+/* The rows of CDEM_STATE_FIELDS, in order; cdem_state_field_count of them. */
+extern const cdem_state_field cdem_state_fields[];
+extern const size_t cdem_state_field_count;
+
+/* The array of field f in s (NULL when not allocated). */
+void *cdem_state_field_array(const cdem_state *s, const cdem_state_field *f);
+
+/* Bytes of one element of type t. */
+size_t cdem_field_type_size(cdem_field_type t);
 
 /* Initialises an empty state with room for capacity elements. */
 cdem_status cdem_state_init(cdem_state *s, size_t capacity, int with_stress, cdem_error *err);

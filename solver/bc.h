@@ -22,11 +22,6 @@
 #include "snapshot.h"
 #include "state.h"
 
-/* The modes' loops over all elements run on one thread below this many elements (the
- * integrator threads its own passes from the same size, cdem_integrator.par_min's default):
- * with fewer, starting the threads costs more than the loop. Results do not depend on it. */
-#define CDEM_BC_PAR_MIN 8192
-
 #include <stdio.h>
 
 typedef struct {

@@ -10,6 +10,7 @@
  * choices, as version 2.6 of the original program reports it, so increments come every
  * display interval of total shortening as in every other mode. Units: m, s. */
 #include "bc.h"
+#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
@@ -66,7 +67,7 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             /* the right wall moves left, the left wall right: both inward */

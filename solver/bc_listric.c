@@ -27,6 +27,7 @@
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
  * right wall move du along the basal segment. */
 #include "bc.h"
+#include "parallel.h"
 #include "checkpoint.h"
 #include "fault_file.h"
 
@@ -253,7 +254,7 @@ static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, d
     c->sheet -= sgn * du;
     const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
     const long n = (long)s->n;
-#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
     for (long i = 0; i < n; i++) {
         const uint32_t f = s->flags[i];
         if (!(f & CDEM_FLAG_MOVING))
@@ -291,7 +292,7 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
             (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {

@@ -13,6 +13,7 @@
  * becomes the exposed fault face as the block rises. Ramps and walls never interact with
  * each other (boundary-boundary pairs are skipped). */
 #include "bc.h"
+#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
@@ -128,7 +129,7 @@ static cdem_status planar_apply(void *vctx, cdem_state *s, long k, double du, do
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             x[i] += ux;

@@ -12,6 +12,7 @@
  * fixed for caldera (the pit's side walls), moving with the block for piston (the block's
  * faces as it rises). Net displacement = the block's displacement along its sense (>= 0). */
 #include "bc.h"
+#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
@@ -95,7 +96,7 @@ static cdem_status vert_apply(void *vctx, cdem_state *s, long k, double du, doub
     const long n = (long)s->n;
     double *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_BC_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             y[i] += uy;

@@ -113,29 +113,11 @@ cdem_status cdem_ckpt_check_f64(const cdem_snapshot *s, const char *prefix, cons
 
 /* ---------------------------------------------------------------- element state */
 
-typedef struct {
-    const char *name;        /* array name under "state." */
-    cdem_snapshot_type type; /* element type */
-    size_t offset;           /* offset of the array pointer in cdem_state */
-    int stress;              /* 1: only when has_stress */
-} state_field;
-
-#define SF(field, type, stress)                                                                    \
-    { #field, type, offsetof(cdem_state, field), stress }
-static const state_field state_fields[] = {
-    SF(id, CDEM_SNAP_I32, 0),    SF(x, CDEM_SNAP_F64, 0),      SF(y, CDEM_SNAP_F64, 0),
-    SF(vx, CDEM_SNAP_F64, 0),    SF(vy, CDEM_SNAP_F64, 0),     SF(fx, CDEM_SNAP_F64, 0),
-    SF(fy, CDEM_SNAP_F64, 0),    SF(radius, CDEM_SNAP_F64, 0), SF(mass, CDEM_SNAP_F64, 0),
-    SF(layer, CDEM_SNAP_I32, 0), SF(flags, CDEM_SNAP_U32, 0),  SF(born, CDEM_SNAP_I32, 0),
-    SF(sxx, CDEM_SNAP_F64, 1),   SF(syy, CDEM_SNAP_F64, 1),    SF(sxy, CDEM_SNAP_F64, 1),
-};
-#undef SF
-#define N_STATE_FIELDS (sizeof state_fields / sizeof state_fields[0])
-
-static void *field_ptr(const cdem_state *st, const state_field *f) {
-    void *p;
-    memcpy(&p, (const char *)st + f->offset, sizeof p);
-    return p;
+/* The snapshot type of a state field's element type. */
+static cdem_snapshot_type snap_type(cdem_field_type t) {
+    return t == CDEM_FIELD_I32   ? CDEM_SNAP_I32
+           : t == CDEM_FIELD_U32 ? CDEM_SNAP_U32
+                                 : CDEM_SNAP_F64;
 }
 
 /* fx or fy with the boundary elements' values replaced by 0 (malloc'd; NULL: no memory). */
@@ -153,11 +135,12 @@ cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "n", (int64_t)st->n, err));
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "next_id", st->next_id, err));
     CDEM_TRY(cdem_ckpt_put_i64(s, "state", "has_stress", st->has_stress, err));
-    for (size_t k = 0; k < N_STATE_FIELDS; k++) {
-        const state_field *f = &state_fields[k];
+    /* every field of the state (checkpoints resume the run exactly), in table order */
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
         if (f->stress && !st->has_stress)
             continue;
-        const void *data = field_ptr(st, f);
+        const void *data = cdem_state_field_array(st, f);
         double *copy = NULL;
         if (!boundary_forces && (data == st->fx || data == st->fy)) {
             copy = free_forces_only(st, data);
@@ -166,7 +149,8 @@ cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_
                                  "checkpoint: out of memory copying %zu forces", st->n);
             data = copy;
         }
-        cdem_status rc = cdem_ckpt_put_array(s, "state", f->name, f->type, st->n, data, err);
+        cdem_status rc =
+            cdem_ckpt_put_array(s, "state", f->name, snap_type(f->type), st->n, data, err);
         free(copy);
         CDEM_TRY(rc);
     }
@@ -179,24 +163,25 @@ cdem_status cdem_ckpt_state_get(cdem_state *st, const cdem_snapshot *s, cdem_err
     CDEM_TRY(cdem_ckpt_get_range(s, "state", "next_id", 0, INT32_MAX, &next_id, err));
     CDEM_TRY(cdem_ckpt_get_range(s, "state", "has_stress", 0, 1, &has_stress, err));
     /* check every array before touching st */
-    for (size_t k = 0; k < N_STATE_FIELDS; k++) {
-        const state_field *f = &state_fields[k];
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
         if (f->stress && !has_stress)
             continue;
         const cdem_snapshot_array *a = NULL;
-        CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, f->type, (size_t)n, &a, err));
+        CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, snap_type(f->type), (size_t)n, &a, err));
     }
     CDEM_TRY(cdem_state_reserve(st, (size_t)n, err));
     if (has_stress)
         CDEM_TRY(cdem_state_enable_stress(st, err));
-    for (size_t k = 0; k < N_STATE_FIELDS; k++) {
-        const state_field *f = &state_fields[k];
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
         if (f->stress && !has_stress)
             continue;
         const cdem_snapshot_array *a = NULL;
-        CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, f->type, (size_t)n, &a, err));
+        CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, snap_type(f->type), (size_t)n, &a, err));
         if (n > 0)
-            memcpy(field_ptr(st, f), a->data, (size_t)n * cdem_snapshot_type_size(f->type));
+            memcpy(cdem_state_field_array(st, f), a->data,
+                   (size_t)n * cdem_field_type_size(f->type));
     }
     st->n = (size_t)n;
     st->next_id = (int32_t)next_id;

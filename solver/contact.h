@@ -1,4 +1,4 @@
-/* contact: the pair force laws of SPEC section 4 (bonded and frictional-cohesive), evaluated
+/* contact: the pair force laws of the manual and paper (bonded and frictional-cohesive), evaluated
  * for one pair with its history, in one kernel (cdem_contact_touching / cdem_contact_eval)
  * that the integrator's force loop, the tests and everything else call. The granular laws
  * differ only in how the cohesion C0 enters the shear strength; each is one inline function

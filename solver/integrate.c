@@ -14,6 +14,7 @@
 #include "integrate.h"
 
 #include "checkpoint.h"
+#include "parallel.h"
 
 #include <math.h>
 #include <omp.h>
@@ -24,11 +25,6 @@
 
 /* Rebuilds between re-sorts of the state into cell order. */
 #define RESORT_EVERY 20
-/* Default of cdem_integrator.par_min: loops shorter than this run on one thread. A step of
- * the default model (~2500 elements, ~5000 pairs) takes ~0.1 ms, comparable to the cost of
- * waking a sleeping thread (OMP_WAIT_POLICY=passive) on a shared machine, so small models
- * stay serial; from ~8,000 elements (half radii) the force pass and the build are threaded. */
-#define PAR_MIN_DEFAULT 8192
 
 cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, const cdem_model *m,
                                  cdem_error *err) {
@@ -45,7 +41,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "integrator: smallest radius = %g m: must be > 0 (skin is 0.25 of it)",
                          m->radius[0]);
-    it->par_min = PAR_MIN_DEFAULT;
+    it->par_min = CDEM_PAR_MIN; /* parallel.h says why */
     it->damping_factor = 1.0;
     it->unstable_index = -1;
     it->boundary_forces = 1;

@@ -15,6 +15,7 @@
 #include "runlock.h"
 #include "summary.h"
 #include "cli_help.h"
+#include "parallel.h"
 #include "threads.h"
 
 #include <errno.h>
@@ -84,7 +85,7 @@ static const cdem_cli_option run_options[] = {
      "for any N. Idle threads spin briefly, then sleep, so threads do not slow a run on a busy "
      "machine (OMP_WAIT_POLICY or GOMP_SPINCOUNT, when set, decide instead)"},
     {"--par-min", "N",
-     "run loops of N or more items on several threads (default 16384; results are "
+     "run loops of N or more items on several threads (default " CDEM_PAR_MIN_STR "; results are "
      "identical for any N and thread count)"},
     {"--ignore-free-space", NULL,
      "run even when the output directory has less free space than the estimated file size"},

@@ -10,6 +10,7 @@
 
 #include "checkpoint.h"
 #include "contact.h"
+#include "parallel.h"
 
 #include <math.h>
 #include <omp.h>
@@ -44,7 +45,7 @@ cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_fa
     nb->skin = skin;
     nb->reach_factor = reach_factor;
     nb->resort_every = resort_every > 0 ? resort_every : 1;
-    nb->par_min = 8192;
+    nb->par_min = CDEM_PAR_MIN;
     return CDEM_OK;
 }
 

@@ -1,4 +1,4 @@
-/* sediment: syn-tectonic sedimentation (SPEC 3, manual item 15 and Theory "Syn-sedimentation").
+/* sediment: syn-tectonic sedimentation (manual item 15, paper's Theory "Syn-sedimentation").
  * Every sediment_steps run steps after equilibration a deposit of new free elements fills the
  * space between the current surface and sea level = ymax + (step - equil_steps) x du x factor
  * (ymax: highest free-element top at the end of equilibration). Deposition is geometric: discs

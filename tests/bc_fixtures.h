@@ -10,6 +10,7 @@
 #include "h5format.h"
 #include "integrate.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -174,9 +175,9 @@ __attribute__((unused)) static char *fx_view(const cdem_bc *bc) {
  * the last increment written and the model. */
 __attribute__((unused)) static void fx_cdem_run(cdem_params p, const char *name, long def_steps,
                                                 cdem_increment_info *last, cdem_model *m) {
-    char path[1024];
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(path, sizeof path, "%s/%s.h5", dir && *dir ? dir : "/tmp", name);
+    char path[1024], file[256];
+    snprintf(file, sizeof file, "%s.h5", name);
+    scratch_path(path, sizeof path, file);
     p.width = 10.0;
     p.height = 2.5;
     p.equilibration = 60.0;

@@ -12,6 +12,7 @@
 #include "analysis_fixtures.h"
 #include "cdem2d.h"
 #include "cmd_render.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,11 +21,6 @@
 #include <unistd.h>
 
 #define NINC 9
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/anah5_%d_%s", d ? d : "/tmp", (int)getpid(), name);
-}
 
 static void remove_run(const char *h5) {
     char xmf[1200];
@@ -82,7 +78,7 @@ static void test_analysis_h5_matches_memory(void **state) {
     p.total_strain_max = 3.0;
     make_run(st, info);
     char path[1100];
-    tmp_path(path, sizeof path, "run.h5");
+    scratch_path(path, sizeof path, "run.h5");
     write_run(path, st, info, &p);
     cdem_analysis *af, *am;
     cdem_error err;
@@ -127,7 +123,7 @@ static void test_analysis_h5_open_errors(void **state) {
     assert_non_null(strstr(err.msg, "/nonexistent/run.h5"));
     assert_null(a);
     char path[1100];
-    tmp_path(path, sizeof path, "notcdem.h5");
+    scratch_path(path, sizeof path, "notcdem.h5");
     FILE *f = fopen(path, "w");
     fputs("not an hdf5 file\n", f);
     fclose(f);
@@ -147,7 +143,7 @@ static void test_analysis_h5_cdem2d_import(void **state) {
     char dir[1024], path[1100];
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(dir, sizeof dir, "%s/cdem2d_crlf", d ? d : "tests/data");
-    tmp_path(path, sizeof path, "imported.h5");
+    scratch_path(path, sizeof path, "imported.h5");
     cdem_error err;
     assert_int_equal(cdem_cdem2d_import_h5(dir, path, &err), CDEM_OK);
     cdem_state mem[4] = {{0}};

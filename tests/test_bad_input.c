@@ -10,6 +10,7 @@
 #include "fault_file.h"
 #include "h5format.h"
 #include "params.h"
+#include "scratch.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -61,8 +62,7 @@ static void test_bad_input_params_quote_inside_string_value(void **state) {
 }
 
 static void tmp_dir(char *buf, size_t n, const char *name) {
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/bad_input_%d_%s", t && *t ? t : "/tmp", (int)getpid(), name);
+    scratch_path(buf, n, name);
     mkdir(buf, 0777);
 }
 

@@ -18,6 +18,7 @@
 #include "integrate.h"
 #include "model.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,11 +26,6 @@
 #include <string.h>
 
 #define PRESSURE 1e7 /* N/m */
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%s", dir && *dir ? dir : "/tmp", name);
-}
 
 static cdem_params biaxial_params(void) {
     cdem_params p;
@@ -181,7 +177,7 @@ static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
 static void test_bc_biaxial_uniaxial_sample_stays_packed(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_bc_biaxial_uniaxial.h5");
+    scratch_path(path, sizeof path, "test_bc_biaxial_uniaxial.h5");
     cdem_params p = biaxial_params();
     p.confining_pressure = 0.0;
     p.runtime = 110.0;
@@ -215,7 +211,7 @@ static void test_bc_biaxial_uniaxial_sample_stays_packed(void **st) {
 static void test_bc_biaxial_refuses_bad_parameters(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_bc_biaxial_refused.h5");
+    scratch_path(path, sizeof path, "test_bc_biaxial_refused.h5");
     cdem_run_options o;
     memset(&o, 0, sizeof o);
     o.output_path = path;
@@ -256,7 +252,7 @@ static void platens(const cdem_state *s, double y_mid, double *top, double *bott
 static void test_bc_biaxial_end_to_end(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_bc_biaxial_run.h5");
+    scratch_path(path, sizeof path, "test_bc_biaxial_run.h5");
     cdem_params p = biaxial_params();
     cdem_model m;
     cdem_error err;

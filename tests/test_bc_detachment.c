@@ -12,6 +12,7 @@
 
 #include "bc_fixtures.h"
 #include "contact.h"
+#include "scratch.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,9 +127,9 @@ static void test_bc_detachment_cdem_run(void **st) {
         fx_cdem_run(p, name, 300, &last, &m);
         assert_int_equal(last.step, m.equil_steps + 300);
         assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
-        char path[1024];
-        const char *dir = getenv("CDEM_TEST_TMP");
-        snprintf(path, sizeof path, "%s/%s.h5", dir && *dir ? dir : "/tmp", name);
+        char path[1024], file[256];
+        snprintf(file, sizeof file, "%s.h5", name); /* the file fx_cdem_run wrote */
+        scratch_path(path, sizeof path, file);
         cdem_error err;
         cdem_h5_reader *r = NULL;
         assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);

@@ -12,6 +12,7 @@
 #include "bc_fixtures.h"
 #include "contact.h"
 #include "fault_file.h"
+#include "scratch.h"
 
 #include <unistd.h>
 
@@ -343,7 +344,6 @@ static void test_bc_listric_errors(void **st) {
     assert_non_null(strstr(err.msg, "fault_bad_first.txt, line 1: first point"));
     /* issue 19, item 8: a vertex far above the model (it once laid fault elements up to
      * y = 1e9 m: 5 GB), a 1e-7 m segment, a folder as the vertex file */
-    const char *t = getenv("CDEM_TEST_TMP");
     static const struct {
         const char *text; /* vertex file */
         const char *want; /* in the message */
@@ -354,8 +354,9 @@ static void test_bc_listric_errors(void **st) {
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
         p = listric_params(CDEM_MODE_IRREGULAR_FAULT);
-        snprintf(p.fault_file, sizeof p.fault_file, "%s/bad_fault_%d_%zu.txt", t && *t ? t : "/tmp",
-                 (int)getpid(), k);
+        char name[64];
+        snprintf(name, sizeof name, "bad_fault_%zu.txt", k);
+        scratch_path(p.fault_file, sizeof p.fault_file, name);
         FILE *f = fopen(p.fault_file, "w");
         assert_non_null(f);
         fputs(bad[k].text, f);
@@ -366,7 +367,7 @@ static void test_bc_listric_errors(void **st) {
         remove(p.fault_file);
     }
     p = listric_params(CDEM_MODE_IRREGULAR_FAULT);
-    snprintf(p.fault_file, sizeof p.fault_file, "%s", t && *t ? t : "/tmp");
+    snprintf(p.fault_file, sizeof p.fault_file, "%s", scratch_root());
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, "is a folder"));
     /* none of the refusals touched the state */

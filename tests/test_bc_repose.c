@@ -15,6 +15,7 @@
 #include "h5format.h"
 #include "model.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -217,8 +218,7 @@ static void test_bc_repose_display_interval_seconds(void **st) {
 static void test_bc_repose_run_removes_walls(void **st) {
     (void)st;
     char path[1024];
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(path, sizeof path, "%s/test_bc_repose_run.h5", dir && *dir ? dir : "/tmp");
+    scratch_path(path, sizeof path, "test_bc_repose_run.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     p.width = 10.0;

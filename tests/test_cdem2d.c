@@ -10,6 +10,7 @@
 #include "assert_near.h"
 
 #include "cdem2d.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -173,9 +174,8 @@ static void write_folder(const char *dir, const char *rows1) {
  * elements). Each is refused naming the file and line. */
 static void test_cdem2d_absurd_rows(void **st) {
     (void)st;
-    const char *t = getenv("CDEM_TEST_TMP");
     char dir[1024];
-    snprintf(dir, sizeof dir, "%s/cdem2d_absurd", t && *t ? t : "/tmp");
+    scratch_path(dir, sizeof dir, "cdem2d_absurd");
     static const struct {
         const char *rows; /* increment 1 */
         const char *want; /* in the message */

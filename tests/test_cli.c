@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "params.h"
+#include "scratch.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,8 +18,8 @@
 #include <unistd.h>
 
 typedef struct {
-    char bin[1024]; /* path of cdem-run */
-    char tmp[1024]; /* private scratch directory */
+    char bin[1024];      /* path of cdem-run */
+    scratch_dir scratch; /* private scratch directory */
 } cli_ctx;
 
 static int setup(void **state) {
@@ -27,9 +28,7 @@ static int setup(void **state) {
         return -1;
     const char *b = getenv("CDEM_BUILD");
     snprintf(c->bin, sizeof c->bin, "%s/cdem-run", b && b[0] ? b : "build");
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(c->tmp, sizeof c->tmp, "%s/test_cli_XXXXXX", t && t[0] ? t : "/tmp");
-    if (!mkdtemp(c->tmp)) {
+    if (scratch_dir_make(&c->scratch, "test_cli") != 0) {
         free(c);
         return -1;
     }
@@ -39,11 +38,9 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     cli_ctx *c = *state;
-    char cmd[2200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
-    int rc = system(cmd);
+    int rc = scratch_dir_remove(&c->scratch);
     free(c);
-    return rc == 0 ? 0 : -1;
+    return rc;
 }
 
 /* Runs cdem-run with args (shell syntax), stdout and stderr to files in tmp; returns the
@@ -54,7 +51,8 @@ static int run(const cli_ctx *c, const char *args) {
         fail();
     }
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "'%s' %s >'%s/out.txt' 2>'%s/err.txt'", c->bin, args, c->tmp, c->tmp);
+    snprintf(cmd, sizeof cmd, "'%s' %s >'%s/out.txt' 2>'%s/err.txt'", c->bin, args, c->scratch.dir,
+             c->scratch.dir);
     int st = system(cmd);
     assert_true(WIFEXITED(st));
     return WEXITSTATUS(st);
@@ -62,7 +60,7 @@ static int run(const cli_ctx *c, const char *args) {
 
 static char *slurp(const cli_ctx *c, const char *name) {
     char path[1100];
-    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    snprintf(path, sizeof path, "%s/%s", c->scratch.dir, name);
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     char *buf = calloc(1, 1 << 20);
@@ -75,7 +73,7 @@ static char *slurp(const cli_ctx *c, const char *name) {
 
 static void write_file(const cli_ctx *c, const char *name, const char *text) {
     char path[1100];
-    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    snprintf(path, sizeof path, "%s/%s", c->scratch.dir, name);
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
     fputs(text, f);
@@ -93,7 +91,7 @@ static void test_cli_print_defaults_round_trip(void **state) {
     cli_ctx *c = *state;
     assert_int_equal(run(c, "--print-defaults"), 0);
     char path[1100];
-    snprintf(path, sizeof path, "%s/out.txt", c->tmp);
+    snprintf(path, sizeof path, "%s/out.txt", c->scratch.dir);
     cdem_params p, d;
     cdem_error err;
     cdem_params_defaults(&d);
@@ -124,7 +122,7 @@ static void test_cli_override_visible_in_print_defaults(void **state) {
     /* overrides apply after the file */
     write_file(c, "m.ini", "[time]\nruntime = 3000\n[physics]\ngravity = 5\n");
     char args[1200];
-    snprintf(args, sizeof args, "'%s/m.ini' -s time.runtime=4000 --print-defaults", c->tmp);
+    snprintf(args, sizeof args, "'%s/m.ini' -s time.runtime=4000 --print-defaults", c->scratch.dir);
     assert_int_equal(run(c, args), 0);
     out = slurp(c, "out.txt");
     assert_has(out, "\nruntime = 4000\n");
@@ -136,7 +134,7 @@ static void test_cli_bad_key_in_file(void **state) {
     cli_ctx *c = *state;
     write_file(c, "bad.ini", "[assembly]\nwidth = 12\nwidht = 13\n");
     char args[1200];
-    snprintf(args, sizeof args, "'%s/bad.ini' --summary", c->tmp);
+    snprintf(args, sizeof args, "'%s/bad.ini' --summary", c->scratch.dir);
     assert_int_equal(run(c, args), 1);
     char *err = slurp(c, "err.txt");
     assert_has(err, "cdem-run: ");
@@ -209,13 +207,13 @@ static void test_cli_parameters_from_stdin(void **state) {
     cli_ctx *c = *state;
     write_file(c, "piped.ini", "[boundary]\nfault_dip = 45\n");
     char args[2400];
-    snprintf(args, sizeof args, "- --print-defaults < '%s/piped.ini'", c->tmp);
+    snprintf(args, sizeof args, "- --print-defaults < '%s/piped.ini'", c->scratch.dir);
     assert_int_equal(run(c, args), 0);
     char *out = slurp(c, "out.txt");
     assert_has(out, "fault_dip = 45");
     free(out);
     write_file(c, "bad.ini", "[physics]\ngravity = 40\n");
-    snprintf(args, sizeof args, "- --summary < '%s/bad.ini'", c->tmp);
+    snprintf(args, sizeof args, "- --summary < '%s/bad.ini'", c->scratch.dir);
     assert_int_equal(run(c, args), 1);
     char *err = slurp(c, "err.txt");
     assert_has(err, "cdem-run: standard input:2: gravity = 40");
@@ -243,7 +241,7 @@ static void test_cli_counts_agree(void **state) {
     snprintf(args, sizeof args,
              "-s assembly.height=2.5 -s time.equilibration=100 -s time.runtime=130 "
              "-s time.display_interval=10 -o '%s/counts.h5'",
-             c->tmp);
+             c->scratch.dir);
     assert_int_equal(run(c, args), 0);
     char *out = slurp(c, "out.txt"), *err = slurp(c, "err.txt");
     long elements = -1, free_el = -1, boundary = -1;
@@ -273,7 +271,7 @@ static void test_cli_counts_agree(void **state) {
     /* cdem-strain info on the file */
     char cmd[4400];
     snprintf(cmd, sizeof cmd, "'%.*scdem-strain' info '%s/counts.h5' > '%s/info.txt'",
-             (int)(strrchr(c->bin, '/') - c->bin + 1), c->bin, c->tmp, c->tmp);
+             (int)(strrchr(c->bin, '/') - c->bin + 1), c->bin, c->scratch.dir, c->scratch.dir);
     assert_int_equal(system(cmd), 0);
     char *info = slurp(c, "info.txt");
     snprintf(want, sizeof want,

@@ -1,4 +1,5 @@
-/* Tests of solver/contact: the pair laws of SPEC section 4 against their closed forms. */
+/* Tests of solver/contact: the pair laws (the original manual and paper) against their closed
+ * forms. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

@@ -16,6 +16,7 @@
 
 #include "h5format.h"
 #include "runlock.h"
+#include "scratch.h"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -68,8 +69,7 @@ static void copy_file(const char *from, const char *to) {
 }
 
 static void load_corpus(corpus *c) {
-    const char *tmp = getenv("CDEM_TEST_TMP");
-    snprintf(c->dir, sizeof c->dir, "%s/damaged_%d", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(c->dir, sizeof c->dir, "damaged");
     mkdir(c->dir, 0755);
     char src[1024];
     snprintf(src, sizeof src, "%s/damaged", data_dir());

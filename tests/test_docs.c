@@ -16,6 +16,7 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "scratch.h"
 
 /* Runs the block runner with args; its output into out; returns its exit status. */
 static int run_blocks(const char *args, char *out, size_t cap) {
@@ -52,9 +53,8 @@ static void test_docs_blocks_run(void **state) {
  * without a reason. */
 static void test_docs_runner_catches_the_old_example(void **state) {
     (void)state;
-    const char *t = getenv("CDEM_TEST_TMP");
     char page[1024], args[1200];
-    snprintf(page, sizeof page, "%s/test_docs_page_%d.md", t && t[0] ? t : "/tmp", (int)getpid());
+    scratch_path(page, sizeof page, "test_docs_page.md");
     FILE *f = fopen(page, "w");
     assert_non_null(f);
     fputs("# page\n\n<!-- doc-test\nsetup: cp \"$DOCTEST_RUN\" run.h5\n-->\n```python\n"

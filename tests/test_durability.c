@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "scratch.h"
 
 #include <fcntl.h>
 #include <stdio.h>
@@ -66,11 +67,6 @@ ssize_t pwrite(int fd, const void *buf, size_t n, off_t offset) {
     return (ssize_t)syscall(SYS_pwrite64, fd, buf, n, offset);
 }
 
-static void tmp_file(char *buf, size_t n, const char *name) {
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%d_%s", t && *t ? t : "/tmp", (int)getpid(), name);
-}
-
 static void make_state(cdem_state *s, size_t n) {
     memset(s, 0, sizeof *s);
     cdem_error err;
@@ -93,7 +89,7 @@ static cdem_increment_info info_of(int k) {
 static void test_durability_every_commit_reaches_the_disk(void **state) {
     (void)state;
     char path[1024], xmf[1100];
-    tmp_file(path, sizeof path, "durable.h5");
+    scratch_path(path, sizeof path, "durable.h5");
     snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(path) - 3), path);
     cdem_params p;
     cdem_params_defaults(&p);

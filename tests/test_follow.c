@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "scratch.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -25,9 +26,8 @@ static const char *build_dir(void) {
 
 static void test_follow_renders_new_increments(void **state) {
     (void)state;
-    const char *tmp = getenv("CDEM_TEST_TMP");
     char dir[1024], run[1100], live[1100], ref[1100], cmd[4096];
-    snprintf(dir, sizeof dir, "%s/follow_%d", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(dir, sizeof dir, "follow");
     snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
     assert_int_equal(system(cmd), 0);
     snprintf(run, sizeof run, "%s/run.h5", dir);
@@ -100,10 +100,9 @@ static void test_follow_renders_new_increments(void **state) {
  * reader must not wait for a writer that is gone). */
 static void test_follow_ends_when_the_writer_is_gone(void **state) {
     (void)state;
-    const char *tmp = getenv("CDEM_TEST_TMP");
     const char *data = getenv("CDEM_TEST_DATA");
     char dir[1024], run[1100], live[1100], cmd[4200];
-    snprintf(dir, sizeof dir, "%s/follow_dead_%d", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(dir, sizeof dir, "follow_dead");
     snprintf(run, sizeof run, "%s/killed.h5", dir);
     snprintf(live, sizeof live, "%s/live.png", dir);
     snprintf(cmd, sizeof cmd, "mkdir -p '%s' && cp '%s/damaged/killed.h5' '%s'", dir,

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "scratch.h"
 
 #include <hdf5.h>
 
@@ -23,11 +24,6 @@
 #include <unistd.h>
 
 /* ------------------------------------------------------------------ helpers */
-
-static void tmp_file(char *buf, size_t n, const char *name) {
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/fmt_%d_%s", dir && *dir ? dir : "/tmp", (int)getpid(), name);
-}
 
 static void remove_pair(const char *h5) {
     char xmf[1100];
@@ -194,7 +190,7 @@ static void copy_truncated(const char *src, const char *dst, long len) {
 static void test_format_roundtrip_all_fields(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "roundtrip.h5");
+    scratch_path(path, sizeof path, "roundtrip.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_error err;
@@ -335,7 +331,7 @@ static void test_format_roundtrip_all_fields(void **state) {
 static void test_format_variable_element_counts(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "variable.h5");
+    scratch_path(path, sizeof path, "variable.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_run_meta meta = {&p, NULL, NULL, NULL, NULL};
@@ -401,7 +397,7 @@ static void test_format_variable_element_counts(void **state) {
 static void test_format_missing_optional_stress(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "stress.h5");
+    scratch_path(path, sizeof path, "stress.h5");
     write_small(path, 3, 1);
     cdem_error err;
     cdem_h5_reader *r = NULL;
@@ -434,7 +430,7 @@ static void test_format_missing_optional_stress(void **state) {
 static void test_format_inconsistent_datasets(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "inconsistent.h5");
+    scratch_path(path, sizeof path, "inconsistent.h5");
     write_small(path, 2, 1);
     /* radius one row short: the index row of increment 1 points beyond it. */
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
@@ -476,7 +472,7 @@ static void test_format_inconsistent_datasets(void **state) {
 static void test_format_invalid_arguments(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "args.h5");
+    scratch_path(path, sizeof path, "args.h5");
     cdem_error err;
     cdem_params p;
     cdem_params_defaults(&p);
@@ -525,7 +521,7 @@ static void test_format_invalid_arguments(void **state) {
 static void test_format_read_while_writing(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "live.h5");
+    scratch_path(path, sizeof path, "live.h5");
     int up[2], down[2];
     assert_int_equal(pipe(up), 0);
     assert_int_equal(pipe(down), 0);
@@ -605,7 +601,7 @@ static void test_format_read_while_writing(void **state) {
 static void test_format_version_mismatch(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "version.h5");
+    scratch_path(path, sizeof path, "version.h5");
     write_small(path, 1, 1);
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
@@ -630,12 +626,12 @@ static void test_format_not_cdem_files(void **state) {
     cdem_error err;
     cdem_h5_reader *r = NULL;
     /* Missing file. */
-    tmp_file(path, sizeof path, "does_not_exist.h5");
+    scratch_path(path, sizeof path, "does_not_exist.h5");
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_NOTFOUND);
     assert_non_null(strstr(err.msg, path));
     assert_non_null(strstr(err.msg, "No such file"));
     /* A text file. */
-    tmp_file(path, sizeof path, "text.h5");
+    scratch_path(path, sizeof path, "text.h5");
     FILE *t = fopen(path, "w");
     fputs("[time]\nruntime = 1000\n", t);
     fclose(t);
@@ -649,7 +645,7 @@ static void test_format_not_cdem_files(void **state) {
     assert_non_null(strstr(err.msg, "not an HDF5 file"));
     remove(path);
     /* An HDF5 file without the format attribute, then with a wrong one. */
-    tmp_file(path, sizeof path, "foreign.h5");
+    scratch_path(path, sizeof path, "foreign.h5");
     hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     assert_true(f >= 0);
     H5Fclose(f);
@@ -670,8 +666,7 @@ static void test_format_not_cdem_files(void **state) {
     assert_non_null(strstr(err.msg, "'format' is \"netcdf4\" (expected \"cdem-c\")"));
     remove(path);
     /* A directory. */
-    const char *dir = getenv("CDEM_TEST_TMP");
-    assert_int_not_equal(cdem_h5_reader_open(dir && *dir ? dir : "/tmp", &r, &err), CDEM_OK);
+    assert_int_not_equal(cdem_h5_reader_open(scratch_root(), &r, &err), CDEM_OK);
     assert_null(r);
     /* The writer refuses an uncreatable path and names it. */
     cdem_params p;
@@ -690,7 +685,7 @@ static void test_format_not_cdem_files(void **state) {
 static void test_format_truncated_files(void **state) {
     (void)state;
     char path[1024], cut[1100];
-    tmp_file(path, sizeof path, "full.h5");
+    scratch_path(path, sizeof path, "full.h5");
     write_small(path, 6, 1);
     long size = file_size(path);
     assert_true(size > 4096);
@@ -717,7 +712,7 @@ static void test_format_truncated_files(void **state) {
 static void test_format_corrupt_bytes(void **state) {
     (void)state;
     char path[1024], bad[1100];
-    tmp_file(path, sizeof path, "clean.h5");
+    scratch_path(path, sizeof path, "clean.h5");
     snprintf(bad, sizeof bad, "%s.bad.h5", path);
     write_small(path, 4, 1);
     long size = file_size(path);
@@ -778,7 +773,7 @@ static void test_format_corrupt_bytes(void **state) {
 static void test_format_find_increment_specs(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "find.h5");
+    scratch_path(path, sizeof path, "find.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_run_meta meta = {&p, NULL, NULL, NULL, NULL};
@@ -866,7 +861,7 @@ static void test_format_find_increment_specs(void **state) {
 static void test_format_killed_writer_keeps_increments(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "killed.h5");
+    scratch_path(path, sizeof path, "killed.h5");
     enum { N = 5 };
     fflush(NULL);
     pid_t pid = fork();
@@ -932,7 +927,7 @@ static void test_format_killed_writer_keeps_increments(void **state) {
 static void test_format_writer_killed_mid_increment(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "midkill.h5");
+    scratch_path(path, sizeof path, "midkill.h5");
     /* CDEM_TEST_KILL_ROUNDS runs more rounds at seeded random moments (a long hunt). */
     const char *env = getenv("CDEM_TEST_KILL_ROUNDS");
     int rounds = env && atoi(env) > 0 ? atoi(env) : 3;
@@ -1104,7 +1099,7 @@ static long write_synthetic_run(const char *path, int with_stress) {
 static void test_format_size_of_default_run(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "size.h5");
+    scratch_path(path, sizeof path, "size.h5");
     long plain = write_synthetic_run(path, 0);
     /* Spot-check that the data are there at full precision. */
     cdem_error err;
@@ -1353,7 +1348,7 @@ static void check_xdmf2(const char *xmf, const char *path, int increments, int s
 static void test_format_xmf_sidecar(void **state) {
     (void)state;
     char path[1024], xmf[1100];
-    tmp_file(path, sizeof path, "side&car.h5"); /* '&' must be escaped in the XML */
+    scratch_path(path, sizeof path, "side&car.h5"); /* '&' must be escaped in the XML */
     snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(path) - 3), path);
     write_small(path, 3, 1); /* stress in increment 1 */
     check_xdmf3(xmf, path, 3, 1);
@@ -1460,7 +1455,7 @@ static void test_format_reads_version_1(void **state) {
     /* A version-1 file cannot be resumed. */
     cdem_h5_writer *w = NULL;
     char copy[1100];
-    tmp_file(copy, sizeof copy, "v1copy.h5");
+    scratch_path(copy, sizeof copy, "v1copy.h5");
     copy_truncated(path, copy, file_size(path));
     assert_int_equal(cdem_h5_writer_reopen(copy, 3, 10000, &w, &err), CDEM_ERR_UNSUPPORTED);
     assert_non_null(strstr(err.msg, "version 1 cannot be resumed"));
@@ -1546,7 +1541,7 @@ static void assert_checkpoint(const char *path, int expected_inc) {
 static void test_format_checkpoint_roundtrip(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "ckpt.h5");
+    scratch_path(path, sizeof path, "ckpt.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
@@ -1603,7 +1598,7 @@ static void scribble_slot(const char *path, int slot, hsize_t at, hsize_t n,
 static void test_format_checkpoint_torn(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "torn.h5");
+    scratch_path(path, sizeof path, "torn.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
@@ -1661,8 +1656,8 @@ static unsigned char *read_whole(hid_t f, const char *name, hid_t mtype, hsize_t
 static void test_format_reopen_truncate_append(void **state) {
     (void)state;
     char straight[1024], resumed[1024];
-    tmp_file(straight, sizeof straight, "straight.h5");
-    tmp_file(resumed, sizeof resumed, "resumed.h5");
+    scratch_path(straight, sizeof straight, "straight.h5");
+    scratch_path(resumed, sizeof resumed, "resumed.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
@@ -1737,7 +1732,7 @@ static void test_format_reopen_truncate_append(void **state) {
 static void test_format_swmr_live_refresh(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "swmr.h5");
+    scratch_path(path, sizeof path, "swmr.h5");
     int to_child[2], to_parent[2];
     assert_int_equal(pipe(to_child), 0);
     assert_int_equal(pipe(to_parent), 0);
@@ -1824,7 +1819,7 @@ static void test_format_swmr_live_refresh(void **state) {
 static void test_format_write_failure_keeps_increments(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "fsize.h5");
+    scratch_path(path, sizeof path, "fsize.h5");
     int fds[2];
     assert_int_equal(pipe(fds), 0);
     fflush(NULL);
@@ -1904,7 +1899,7 @@ static void test_format_write_failure_keeps_increments(void **state) {
 static void test_format_free_space_check(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "space.h5");
+    scratch_path(path, sizeof path, "space.h5");
     cdem_error err;
     assert_int_equal(cdem_h5_check_free_space(path, 1.0, &err), CDEM_OK);
     assert_int_equal(cdem_h5_check_free_space(path, 1e18, &err), CDEM_ERR_IO);
@@ -1922,8 +1917,8 @@ static void test_format_free_space_check(void **state) {
 static void test_format_deterministic_bytes(void **state) {
     (void)state;
     char a[1024], b[1024];
-    tmp_file(a, sizeof a, "det_a.h5");
-    tmp_file(b, sizeof b, "det_b.h5");
+    scratch_path(a, sizeof a, "det_a.h5");
+    scratch_path(b, sizeof b, "det_b.h5");
     write_small(a, 3, 1);
     write_small(b, 3, 1);
     long n = file_size(a);
@@ -1976,7 +1971,7 @@ static void flip_in_chunk(const char *path, const char *name, hsize_t at, unsign
 static void test_format_index_and_series_checksummed(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "flip_index.h5");
+    scratch_path(path, sizeof path, "flip_index.h5");
     write_small(path, 4, 1);
     /* packed rows of 84 bytes: number 4, step 8, time 8, phase 4, net_displacement 8, ... */
     flip_in_chunk(path, "increments/index", 3 * 84 + 24 + 7, 0x10);
@@ -2016,7 +2011,7 @@ static void test_format_index_and_series_checksummed(void **state) {
 static void test_format_index_and_series_in_order(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "order.h5");
+    scratch_path(path, sizeof path, "order.h5");
     write_small(path, 4, 1);
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     hid_t ds = H5Dopen2(f, "increments/index", H5P_DEFAULT);
@@ -2062,7 +2057,7 @@ static void test_format_index_and_series_in_order(void **state) {
 static void test_format_corrupt_metadata_message(void **state) {
     (void)state;
     char path[1024];
-    tmp_file(path, sizeof path, "corrupt_root.h5");
+    scratch_path(path, sizeof path, "corrupt_root.h5");
     write_small(path, 2, 1);
     /* the root object header address is in the v3 superblock, bytes 36..43 */
     uint64_t root = 0;
@@ -2090,7 +2085,7 @@ static void test_format_corrupt_metadata_message(void **state) {
 static void test_format_sidecar_failure_message(void **state) {
     (void)state;
     char path[1024], side_tmp[1100];
-    tmp_file(path, sizeof path, "sidecar_fail.h5");
+    scratch_path(path, sizeof path, "sidecar_fail.h5");
     snprintf(side_tmp, sizeof side_tmp, "%.*s.xmf.tmp", (int)(strlen(path) - 3), path);
     cdem_params p;
     cdem_params_defaults(&p);
@@ -2127,7 +2122,7 @@ static void test_format_sidecar_failure_message(void **state) {
 static void test_format_one_writer_and_replace_policy(void **state) {
     (void)state;
     char path[1024], other[1100];
-    tmp_file(path, sizeof path, "one_writer.h5");
+    scratch_path(path, sizeof path, "one_writer.h5");
     snprintf(other, sizeof other, "%s.txt", path);
     cdem_params p;
     cdem_params_defaults(&p);

@@ -15,15 +15,7 @@
 
 #include "gif.h"
 #include "render.h"
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
-
-static void tmp_path(char *buf, size_t cap, const char *name) {
-    snprintf(buf, cap, "%s/%s", tmp_dir(), name);
-}
+#include "scratch.h"
 
 static long file_size(const char *path) {
     struct stat st;
@@ -177,7 +169,7 @@ static void check_order(const char *path, const size_t *want, int n) {
 static void test_gif_order_read_back(void **state) {
     (void)state;
     char path[512];
-    tmp_path(path, sizeof path, "gif_order.gif");
+    scratch_path(path, sizeof path, "gif_order.gif");
     cdem_gif_options o;
     cdem_gif_options_default(&o);
     cdem_error err;
@@ -229,8 +221,8 @@ static void test_gif_order_read_back(void **state) {
 static void test_gif_optimised_frames_reconstruct(void **state) {
     (void)state;
     char path[512], path_full[512];
-    tmp_path(path, sizeof path, "gif_opt.gif");
-    tmp_path(path_full, sizeof path_full, "gif_full.gif");
+    scratch_path(path, sizeof path, "gif_opt.gif");
+    scratch_path(path_full, sizeof path_full, "gif_full.gif");
     const int w = 64, h = 32, n = 8;
     cdem_gif_options o;
     cdem_gif_options_default(&o);
@@ -266,7 +258,7 @@ static void test_gif_optimised_frames_reconstruct(void **state) {
 static void test_gif_scale_and_identical_frames(void **state) {
     (void)state;
     char path[512];
-    tmp_path(path, sizeof path, "gif_scale.gif");
+    scratch_path(path, sizeof path, "gif_scale.gif");
     const int w = 40, h = 20;
     uint8_t *rgba = malloc((size_t)w * h * 4);
     assert_non_null(rgba);
@@ -338,7 +330,7 @@ static void test_gif_rendered_frames(void **state) {
     ro.wall = (cdem_rgba){0.6, 0.4, 0.2, 1.0}; /* 153, 102, 51 in 8 bits */
     render_ctx ctx = {&s, &ro};
     char path[512];
-    tmp_path(path, sizeof path, "gif_render.gif");
+    scratch_path(path, sizeof path, "gif_render.gif");
     cdem_gif_options o;
     cdem_gif_options_default(&o);
     const int w = 200, h = 120;
@@ -390,7 +382,7 @@ static void test_gif_options_view(void **state) {
 static void test_gif_errors(void **state) {
     (void)state;
     char path[512];
-    tmp_path(path, sizeof path, "gif_err.gif");
+    scratch_path(path, sizeof path, "gif_err.gif");
     cdem_gif_options o;
     cdem_gif_options_default(&o);
     cdem_error err;

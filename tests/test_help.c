@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "scratch.h"
 
 #define OUT_MAX (1 << 18)
 
@@ -25,8 +26,8 @@
 #define FMT(buf, ...) assert_true(snprintf(buf, sizeof buf, __VA_ARGS__) < (int)sizeof buf)
 
 typedef struct {
-    char build[1024]; /* directory of cdem-run and cdem-strain */
-    char tmp[1024];   /* private scratch directory */
+    char build[1024];    /* directory of cdem-run and cdem-strain */
+    scratch_dir scratch; /* private scratch directory */
     char out[OUT_MAX], err[OUT_MAX];
 } help_ctx;
 
@@ -36,9 +37,7 @@ static int setup(void **state) {
         return -1;
     const char *b = getenv("CDEM_BUILD");
     snprintf(c->build, sizeof c->build, "%s", b && b[0] ? b : "build");
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(c->tmp, sizeof c->tmp, "%s/test_help_XXXXXX", t && t[0] ? t : "/tmp");
-    if (!mkdtemp(c->tmp)) {
+    if (scratch_dir_make(&c->scratch, "test_help") != 0) {
         free(c);
         return -1;
     }
@@ -48,11 +47,9 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     help_ctx *c = *state;
-    char cmd[2200];
-    FMT(cmd, "rm -rf '%s'", c->tmp);
-    int rc = system(cmd);
+    int rc = scratch_dir_remove(&c->scratch);
     free(c);
-    return rc == 0 ? 0 : -1;
+    return rc;
 }
 
 static void slurp(const char *path, char *buf) {
@@ -67,8 +64,8 @@ static void slurp(const char *path, char *buf) {
  * output; returns the exit status. */
 static int run(help_ctx *c, const char *program, const char *args) {
     char cmd[4096], o[1100], e[1100];
-    FMT(o, "%s/out.txt", c->tmp);
-    FMT(e, "%s/err.txt", c->tmp);
+    FMT(o, "%s/out.txt", c->scratch.dir);
+    FMT(e, "%s/err.txt", c->scratch.dir);
     char bin[1100];
     FMT(bin, "%s/%s", c->build, program);
     if (bin[0] != '/') {
@@ -78,7 +75,7 @@ static int run(help_ctx *c, const char *program, const char *args) {
     }
     if (access(bin, X_OK) != 0)
         fail_msg("%s is missing: build it first (make)", bin);
-    FMT(cmd, "cd '%s' && '%s' %s >'%s' 2>'%s' </dev/null", c->tmp, bin, args, o, e);
+    FMT(cmd, "cd '%s' && '%s' %s >'%s' 2>'%s' </dev/null", c->scratch.dir, bin, args, o, e);
     int st = system(cmd);
     assert_true(WIFEXITED(st));
     slurp(o, c->out);

@@ -13,6 +13,7 @@
 #include "h5format.h"
 #include "integrate.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -411,8 +412,7 @@ static void test_heterogeneity_erosion_removes_above(void **st) {
 static void test_heterogeneity_run_end_to_end(void **st) {
     (void)st;
     char path[1024];
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(path, sizeof path, "%s/test_heterogeneity_run.h5", dir && *dir ? dir : "/tmp");
+    scratch_path(path, sizeof path, "test_heterogeneity_run.h5");
     cdem_params p;
     cdem_params_defaults(&p);
     p.width = 10.0;

@@ -28,7 +28,7 @@ static double disc_mass(double r) {
     return RHO * M_PI * r * r;
 }
 
-/* The default model constants (SPEC 2) with dt, damping, gravity chosen by the test. */
+/* The default model constants (common/model.c) with dt, damping, gravity chosen by the test. */
 static cdem_model hand_model(double dt, double damping, double g) {
     cdem_model m;
     memset(&m, 0, sizeof m);

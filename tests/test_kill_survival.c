@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "scratch.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -101,9 +102,8 @@ static size_t check_file(const char *path, char *stop, size_t stop_len) {
 
 static void test_kill_survival_random_moments(void **state) {
     (void)state;
-    const char *tmp = getenv("CDEM_TEST_TMP");
     char out[1024];
-    snprintf(out, sizeof out, "%s/kill_%d.h5", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(out, sizeof out, "kill.h5");
     const char *ek = getenv("CDEM_KILLS"), *es = getenv("CDEM_KILL_SEED");
     int kills = ek && *ek ? atoi(ek) : 10;
     uint64_t seed = es && *es ? strtoull(es, NULL, 10) : 20261122u;
@@ -164,9 +164,8 @@ static void test_kill_survival_random_moments(void **state) {
  * instead (once it died silently; only this test, ignoring the signal, made it work). */
 static void test_kill_survival_file_size_limit(void **state) {
     (void)state;
-    const char *tmp = getenv("CDEM_TEST_TMP");
     char out[1024], errf[1100];
-    snprintf(out, sizeof out, "%s/limit_%d.h5", tmp && *tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(out, sizeof out, "limit.h5");
     snprintf(errf, sizeof errf, "%s.err", out);
     fflush(NULL);
     pid_t pid = fork();

@@ -14,10 +14,11 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "scratch.h"
 
 typedef struct {
-    char build[1024]; /* directory of cdem-run and cdem-strain */
-    char tmp[1024];   /* private scratch directory */
+    char build[1024];    /* directory of cdem-run and cdem-strain */
+    scratch_dir scratch; /* private scratch directory */
 } man_ctx;
 
 static int setup(void **state) {
@@ -26,9 +27,7 @@ static int setup(void **state) {
         return -1;
     const char *b = getenv("CDEM_BUILD");
     snprintf(c->build, sizeof c->build, "%s", b && b[0] ? b : "build");
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(c->tmp, sizeof c->tmp, "%s/test_man_XXXXXX", t && t[0] ? t : "/tmp");
-    if (!mkdtemp(c->tmp)) {
+    if (scratch_dir_make(&c->scratch, "test_man") != 0) {
         free(c);
         return -1;
     }
@@ -38,10 +37,8 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     man_ctx *c = *state;
-    char cmd[2200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
-    if (system(cmd) != 0)
-        fprintf(stderr, "test_man: could not remove %s\n", c->tmp);
+    if (scratch_dir_remove(&c->scratch) != 0)
+        fprintf(stderr, "test_man: could not remove %s\n", c->scratch.dir);
     free(c);
     return 0;
 }
@@ -104,12 +101,12 @@ static const char *compare_page(const char *committed, const char *generated, ch
 
 static void test_man_pages_match_help(void **state) {
     man_ctx *c = *state;
-    assert_int_equal(generate(c, c->tmp), 0);
+    assert_int_equal(generate(c, c->scratch.dir), 0);
     const char *pages[] = {"cdem-run.1", "cdem-strain.1"};
     for (size_t i = 0; i < 2; i++) {
         char committed[256], generated[2100], msg[2400];
         snprintf(committed, sizeof committed, "man/%s", pages[i]);
-        snprintf(generated, sizeof generated, "%s/%s", c->tmp, pages[i]);
+        snprintf(generated, sizeof generated, "%s/%s", c->scratch.dir, pages[i]);
         const char *err = compare_page(committed, generated, msg, sizeof msg);
         if (err)
             fail_msg("%s", err);
@@ -171,10 +168,10 @@ static void test_man_lists_every_option_and_command(void **state) {
 /* A page that differs from the generated one is reported as stale, naming it. */
 static void test_man_detects_a_stale_page(void **state) {
     man_ctx *c = *state;
-    assert_int_equal(generate(c, c->tmp), 0);
+    assert_int_equal(generate(c, c->scratch.dir), 0);
     char page[2100], copy[2100], cmd[4400], msg[2400];
-    snprintf(page, sizeof page, "%s/cdem-run.1", c->tmp);
-    snprintf(copy, sizeof copy, "%s/stale-cdem-run.1", c->tmp);
+    snprintf(page, sizeof page, "%s/cdem-run.1", c->scratch.dir);
+    snprintf(copy, sizeof copy, "%s/stale-cdem-run.1", c->scratch.dir);
     snprintf(cmd, sizeof cmd, "sed 's/print the version and exit/print the version/' '%s' > '%s'",
              page, copy);
     assert_int_equal(run(cmd), 0);
@@ -191,7 +188,7 @@ static void test_man_detects_a_stale_page(void **state) {
 static void test_man_completion_fresh_and_working(void **state) {
     man_ctx *c = *state;
     char cmd[4400], generated[2100], msg[2400];
-    snprintf(generated, sizeof generated, "%s/cdem-c.bash", c->tmp);
+    snprintf(generated, sizeof generated, "%s/cdem-c.bash", c->scratch.dir);
     snprintf(cmd, sizeof cmd, "/usr/bin/python3 scripts/help2completion.py '%s' '%s' 2>&1",
              c->build, generated);
     assert_int_equal(run(cmd), 0);
@@ -214,7 +211,7 @@ static void test_man_completion_fresh_and_working(void **state) {
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char out[2048];
-        snprintf(out, sizeof out, "%s/reply.txt", c->tmp);
+        snprintf(out, sizeof out, "%s/reply.txt", c->scratch.dir);
         snprintf(cmd, sizeof cmd,
                  "bash -c 'source completion/cdem-c.bash; COMP_WORDS=(%s); "
                  "COMP_CWORD=$((${#COMP_WORDS[@]} - 1)); "

@@ -24,16 +24,12 @@
 #include "repose.h"
 #include "run.h"
 #include "voids.h"
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%s", dir && *dir ? dir : "/tmp", name);
-}
+#include "scratch.h"
 
 /* Runs p into path and loads its last increment into s. */
 static void run_last(const cdem_params *p, const char *name, cdem_state *s) {
     char path[1024];
-    tmp_path(path, sizeof path, name);
+    scratch_path(path, sizeof path, name);
     remove(path);
     cdem_run_options o;
     memset(&o, 0, sizeof o);

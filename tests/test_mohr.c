@@ -19,16 +19,12 @@
 #include "h5format.h"
 #include "mohr.h"
 #include "params.h"
+#include "scratch.h"
 
 #include <fcntl.h>
 #include <unistd.h>
 
 static const double deg = 3.14159265358979323846 / 180.0;
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
 
 /* Peak differential stress of a test at confining pressure s3 on the envelope (C, phi). */
 static double peak_q(double s3, double C, double phi) {
@@ -112,9 +108,9 @@ static void test_mohr_bad_input_messages(void **state) {
 static void test_mohr_table_and_command(void **state) {
     (void)state;
     char path[512], png[512], bad[512];
-    snprintf(path, sizeof path, "%s/mohr_tests.txt", tmp_dir());
-    snprintf(png, sizeof png, "%s/mohr.png", tmp_dir());
-    snprintf(bad, sizeof bad, "%s/mohr_bad.txt", tmp_dir());
+    snprintf(path, sizeof path, "%s/mohr_tests.txt", scratch_root());
+    snprintf(png, sizeof png, "%s/mohr.png", scratch_root());
+    snprintf(bad, sizeof bad, "%s/mohr_bad.txt", scratch_root());
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f, "# sigma3 q (N/m)\n");
@@ -191,11 +187,11 @@ static void test_mohr_command_on_runs(void **state) {
     const double C = 4e6, phi = 34 * deg;
     char runs[3][512], png[512], out[512];
     for (int i = 0; i < 3; i++) {
-        snprintf(runs[i], sizeof runs[i], "%s/mohr_run%d.h5", tmp_dir(), i);
+        snprintf(runs[i], sizeof runs[i], "%s/mohr_run%d.h5", scratch_root(), i);
         write_biaxial_run(runs[i], 5e6 * i, peak_q(5e6 * i, C, phi), CDEM_MODE_BIAXIAL);
     }
-    snprintf(png, sizeof png, "%s/mohr_runs.png", tmp_dir());
-    snprintf(out, sizeof out, "%s/mohr_stdout.txt", tmp_dir());
+    snprintf(png, sizeof png, "%s/mohr_runs.png", scratch_root());
+    snprintf(out, sizeof out, "%s/mohr_stdout.txt", scratch_root());
     char *argv[] = {"mohr", runs[0], runs[1], runs[2], "-o", png};
     fflush(stdout);
     int saved = dup(1), fd = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);

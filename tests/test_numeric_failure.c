@@ -1,8 +1,8 @@
 /* test_numeric_failure: the NaN/Inf protection of cdem_run (issue 10). The issue's scenario
  * is a time step made too large through keep_constants at a small unit scaling. In cdem-c
- * the time step always follows the smallest mass (dt = 0.25 sqrt(m_min / Kn), SPEC), so
- * keep_constants at 100 m stays stable: the first test checks exactly that. The second makes
- * the time step 10x too large through the run's fault-injection option (dt_factor, standing
+ * the time step always follows the smallest mass (dt = 0.25 sqrt(m_min / Kn), as in the original
+ * program), so keep_constants at 100 m stays stable: the first test checks exactly that. The second
+ * makes the time step 10x too large through the run's fault-injection option (dt_factor, standing
  * in for the original program's 1000 m time step with 100x lighter elements) on the same
  * model. Such a run does not reach NaN: elements fly out and are removed as escaping, and
  * before the instability guard of run.c it went on writing garbage. The test checks the run
@@ -17,17 +17,13 @@
 #include "h5format.h"
 #include "params.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%d_%s", t && *t ? t : "/tmp", (int)getpid(), name);
-}
 
 /* 10 x 2.5 units at 100 m with keep_constants on: ~1400 elements. */
 static void small_keep_constants(cdem_params *p) {
@@ -66,7 +62,7 @@ static size_t check_file(const char *path, const char *want_reason) {
 static void test_numeric_failure_keep_constants_small_scaling_is_stable(void **state) {
     (void)state;
     char path[1024];
-    tmp_path(path, sizeof path, "keep_stable.h5");
+    scratch_path(path, sizeof path, "keep_stable.h5");
     cdem_params p;
     small_keep_constants(&p);
     cdem_run_options o;
@@ -86,7 +82,7 @@ static void test_numeric_failure_keep_constants_small_scaling_is_stable(void **s
 static void test_numeric_failure_time_step_too_large_stops_with_diagnosis(void **state) {
     (void)state;
     char path[1024];
-    tmp_path(path, sizeof path, "blowup.h5");
+    scratch_path(path, sizeof path, "blowup.h5");
     cdem_params p;
     small_keep_constants(&p);
     cdem_run_options o;

@@ -13,6 +13,7 @@
 #include "analysis_fixtures.h"
 #include "h5format.h"
 #include "outfile.h"
+#include "scratch.h"
 
 #include <hdf5.h>
 
@@ -28,11 +29,11 @@
 #define NINC 5
 
 typedef struct {
-    char tmp[1024];    /* private folder of this test binary */
-    char run[1100];    /* a valid run file */
-    char broken[1100]; /* the same run, last increment's x dataset deleted */
-    char exe[1024];    /* cdem-strain */
-    char out[8192];    /* output of the last command */
+    scratch_dir scratch; /* private folder of this test binary */
+    char run[1100];      /* a valid run file */
+    char broken[1100];   /* the same run, last increment's x dataset deleted */
+    char exe[1024];      /* cdem-strain */
+    char out[8192];      /* output of the last command */
 } fixture;
 
 static int exists(const char *path) {
@@ -148,14 +149,12 @@ static int setup(void **state) {
     if (!g)
         return -1;
     *state = g;
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(g->tmp, sizeof g->tmp, "%s/outputs_%d", t ? t : "/tmp", (int)getpid());
-    if (mkdir(g->tmp, 0777) != 0)
+    if (scratch_dir_make(&g->scratch, "outputs") != 0)
         return -1;
     const char *b = getenv("CDEM_BUILD");
     snprintf(g->exe, sizeof g->exe, "%s/cdem-strain", b ? b : "build");
-    snprintf(g->run, sizeof g->run, "%s/run.h5", g->tmp);
-    snprintf(g->broken, sizeof g->broken, "%s/broken.h5", g->tmp);
+    snprintf(g->run, sizeof g->run, "%s/run.h5", g->scratch.dir);
+    snprintf(g->broken, sizeof g->broken, "%s/broken.h5", g->scratch.dir);
     if (write_run(g->run) != 0 || write_run(g->broken) != 0)
         return -1;
     return break_last_increment(g->broken);
@@ -163,9 +162,7 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     fixture *g = *state;
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g->tmp);
-    int rc = system(cmd) == 0 ? 0 : -1;
+    int rc = scratch_dir_remove(&g->scratch);
     free(g);
     return rc;
 }
@@ -175,7 +172,7 @@ static int teardown(void **state) {
 static void test_outputs_outfile_commit(void **state) {
     fixture *g = *state;
     char path[1200];
-    snprintf(path, sizeof path, "%s/commit.txt", g->tmp);
+    snprintf(path, sizeof path, "%s/commit.txt", g->scratch.dir);
     cdem_outfile of;
     cdem_error err;
     cdem_error_clear(&err);
@@ -200,7 +197,7 @@ static void test_outputs_outfile_commit(void **state) {
 static void test_outputs_outfile_failure_removes_tmp(void **state) {
     fixture *g = *state;
     char path[1200];
-    snprintf(path, sizeof path, "%s/failed.txt", g->tmp);
+    snprintf(path, sizeof path, "%s/failed.txt", g->scratch.dir);
     cdem_outfile of;
     cdem_error err;
     cdem_error_clear(&err);
@@ -219,7 +216,7 @@ static void test_outputs_outfile_failure_removes_tmp(void **state) {
 static void test_outputs_outfile_stale_tmp_removed(void **state) {
     fixture *g = *state;
     char path[1200], tmp[1300];
-    snprintf(path, sizeof path, "%s/stale.txt", g->tmp);
+    snprintf(path, sizeof path, "%s/stale.txt", g->scratch.dir);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "w");
     assert_non_null(f);
@@ -239,17 +236,17 @@ static void test_outputs_outfile_bad_destination(void **state) {
     cdem_error err;
     char path[1200];
     /* missing folder */
-    snprintf(path, sizeof path, "%s/no-such-folder/out.csv", g->tmp);
+    snprintf(path, sizeof path, "%s/no-such-folder/out.csv", g->scratch.dir);
     cdem_error_clear(&err);
     assert_int_equal(cdem_outfile_begin(&of, path, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, path));
     assert_non_null(strstr(err.msg, "No such file"));
     /* a regular file where the folder should be */
-    snprintf(path, sizeof path, "%s/run.h5/out.csv", g->tmp);
+    snprintf(path, sizeof path, "%s/run.h5/out.csv", g->scratch.dir);
     assert_int_equal(cdem_outfile_begin(&of, path, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, path));
     /* the output itself is a folder */
-    assert_int_equal(cdem_outfile_begin(&of, g->tmp, &err), CDEM_ERR_IO);
+    assert_int_equal(cdem_outfile_begin(&of, g->scratch.dir, &err), CDEM_ERR_IO);
     assert_non_null(strstr(err.msg, "is a folder"));
     /* empty and overlong paths */
     assert_int_equal(cdem_outfile_begin(&of, "", &err), CDEM_ERR_INVALID);
@@ -278,7 +275,7 @@ static void expect_failed_clean(const fixture *g, int rc, const char *needle, co
 static void test_outputs_compute_csv_fails_midway(void **state) {
     fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/values.csv", g->tmp);
+    snprintf(out, sizeof out, "%s/values.csv", g->scratch.dir);
     /* the valid run: the file appears, no .tmp left */
     snprintf(cmd, sizeof cmd,
              "'%s' compute '%s' --increment all --quantity total-max-shear -o '%s'", g->exe, g->run,
@@ -297,7 +294,7 @@ static void test_outputs_compute_csv_fails_midway(void **state) {
 static void test_outputs_compute_h5_fails_midway(void **state) {
     fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/values.h5", g->tmp);
+    snprintf(out, sizeof out, "%s/values.h5", g->scratch.dir);
     snprintf(cmd, sizeof cmd,
              "'%s' compute '%s' --increment all --quantity total-max-shear --format h5 -o '%s'",
              g->exe, g->broken, out);
@@ -307,25 +304,25 @@ static void test_outputs_compute_h5_fails_midway(void **state) {
 static void test_outputs_unwritable_destinations(void **state) {
     fixture *g = *state;
     char out[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/missing/values.csv", g->tmp);
+    snprintf(out, sizeof out, "%s/missing/values.csv", g->scratch.dir);
     snprintf(cmd, sizeof cmd,
              "'%s' compute '%s' --increment last --quantity total-max-shear -o '%s'", g->exe,
              g->run, out);
     expect_failed_clean(g, run(g, cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/picture.png", g->tmp);
+    snprintf(out, sizeof out, "%s/missing/picture.png", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment last -o '%s'", g->exe, g->run, out);
     expect_failed_clean(g, run(g, cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/movie.gif", g->tmp);
+    snprintf(out, sizeof out, "%s/missing/movie.gif", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --gif '%s'", g->exe, g->run, out);
     expect_failed_clean(g, run(g, cmd), out, out);
-    snprintf(out, sizeof out, "%s/missing/series.svg", g->tmp);
+    snprintf(out, sizeof out, "%s/missing/series.svg", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' plot-series '%s' --y kinetic_energy -o '%s'", g->exe, g->run,
              out);
     int rc = run(g, cmd);
     /* this run has no series samples: either reason is an error naming a file */
     assert_int_equal(rc, 1);
     assert_false(exists(out));
-    snprintf(out, sizeof out, "%s/missing/biaxial.txt", g->tmp);
+    snprintf(out, sizeof out, "%s/missing/biaxial.txt", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' export-biaxial '%s' -o '%s'", g->exe, g->run, out);
     rc = run(g, cmd);
     assert_int_equal(rc, 1); /* not a biaxial run: refused, naming the run file */
@@ -336,14 +333,14 @@ static void test_outputs_unwritable_destinations(void **state) {
 static void test_outputs_render_series_fails_midway(void **state) {
     fixture *g = *state;
     char dir[1200], gif[1200], cmd[4096];
-    snprintf(dir, sizeof dir, "%s/pictures", g->tmp);
+    snprintf(dir, sizeof dir, "%s/pictures", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment all --zoom -100,2100,-100,1300 -o '%s'",
              g->exe, g->broken, dir);
     int rc = run(g, cmd);
     if (rc != 1 || !strstr(g->out, g->broken))
         fail_msg("render: expected exit 1 naming %s; got %d: %s", g->broken, rc, g->out);
     assert_int_equal(count_entries(dir), 0); /* earlier pictures of this call removed */
-    snprintf(gif, sizeof gif, "%s/movie.gif", g->tmp);
+    snprintf(gif, sizeof gif, "%s/movie.gif", g->scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --zoom -100,2100,-100,1300 --gif '%s'", g->exe,
              g->broken, gif);
     expect_failed_clean(g, run(g, cmd), g->broken, gif);
@@ -352,7 +349,7 @@ static void test_outputs_render_series_fails_midway(void **state) {
 static void test_outputs_export_sspx_fails_midway(void **state) {
     fixture *g = *state;
     char dir[1200], cmd[4096];
-    snprintf(dir, sizeof dir, "%s/sspx", g->tmp);
+    snprintf(dir, sizeof dir, "%s/sspx", g->scratch.dir);
     assert_int_equal(mkdir(dir, 0777), 0);
     snprintf(cmd, sizeof cmd, "'%s' export-sspx '%s' --increments first-last '%s'", g->exe,
              g->broken, dir);
@@ -371,8 +368,8 @@ static void test_outputs_import_cdem2d_fails_midway(void **state) {
     fixture *g = *state;
     const char *d = getenv("CDEM_TEST_DATA");
     char out[1200], xmf[1200], cmd[4096];
-    snprintf(out, sizeof out, "%s/imported.h5", g->tmp);
-    snprintf(xmf, sizeof xmf, "%s/imported.xmf", g->tmp);
+    snprintf(out, sizeof out, "%s/imported.h5", g->scratch.dir);
+    snprintf(xmf, sizeof xmf, "%s/imported.xmf", g->scratch.dir);
     /* modelresults_0.txt is valid (written), modelresults_1.txt is malformed */
     snprintf(cmd, sizeof cmd, "'%s' import-cdem2d '%s/cdem2d_malformed' -o '%s'", g->exe,
              d && *d ? d : "tests/data", out);

@@ -17,11 +17,7 @@
 #include "h5format.h"
 #include "params.h"
 #include "plot.h"
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
+#include "scratch.h"
 
 static long file_size(const char *path) {
     struct stat sb;
@@ -93,7 +89,7 @@ static void test_plot_errors_name_the_problem(void **state) {
     assert_int_equal(cdem_plot_layout_compute(&p, 0, 0, 800, 500, &lay, &err), CDEM_ERR_INVALID);
     assert_non_null(strstr(err.msg, "'broken'"));
     char path[512];
-    snprintf(path, sizeof path, "%s/plot_bad.jpg", tmp_dir());
+    snprintf(path, sizeof path, "%s/plot_bad.jpg", scratch_root());
     p.n_series = 0;
     assert_int_not_equal(cdem_plot_to_file(path, &p, 1, 400, 300, &err), CDEM_OK);
     assert_non_null(strstr(err.msg, ".jpg"));
@@ -152,8 +148,8 @@ static void write_series_file(const char *path) {
 static void test_plot_series_command_draws_the_line(void **state) {
     (void)state;
     char h5[512], png[512];
-    snprintf(h5, sizeof h5, "%s/plot_series.h5", tmp_dir());
-    snprintf(png, sizeof png, "%s/plot_series.png", tmp_dir());
+    snprintf(h5, sizeof h5, "%s/plot_series.h5", scratch_root());
+    snprintf(png, sizeof png, "%s/plot_series.png", scratch_root());
     write_series_file(h5);
     char *argv[] = {"plot-series", h5,        "--y", "kinetic_energy", "--x", "time", "-o",
                     png,           "--width", "800", "--height",       "500"};
@@ -200,7 +196,7 @@ static void test_plot_series_command_draws_the_line(void **state) {
     assert_int_equal(cdem_cmd_plot_series(8, argv6), 2);
     /* several runs, vector output, unknown column */
     char pdf[512];
-    snprintf(pdf, sizeof pdf, "%s/plot_series.pdf", tmp_dir());
+    snprintf(pdf, sizeof pdf, "%s/plot_series.pdf", scratch_root());
     char *argv2[] = {"plot-series", h5, h5, "--y=contacts", "--x=step", "-o", pdf};
     assert_int_equal(cdem_cmd_plot_series(7, argv2), 0);
     assert_true(file_size(pdf) > 500);

@@ -6,6 +6,7 @@
 
 #include "assert_near.h"
 #include "qexport.h"
+#include "scratch.h"
 
 #include <hdf5.h>
 #include <math.h>
@@ -49,8 +50,7 @@ static void test_qexport_h5_round_trip(void **st) {
     cdem_error err;
     cdem_quantity_find("total-max-shear", &q, &err);
     char path[1024];
-    const char *tmp = getenv("CDEM_TEST_TMP");
-    snprintf(path, sizeof path, "%s/qexport_%d.h5", tmp ? tmp : "/tmp", (int)getpid());
+    scratch_path(path, sizeof path, "qexport.h5");
     cdem_qexport_h5 *h;
     assert_int_equal(cdem_qexport_h5_create(path, q, &h, &err), CDEM_OK);
     assert_int_equal(cdem_qexport_h5_write(h, 282, 1234.5, &s, v, &err), CDEM_OK);

@@ -14,11 +14,7 @@
 #include <string.h>
 
 #include "render.h"
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
+#include "scratch.h"
 
 /* Elements of the hand-made scene (index = element). View box x 0..10, y 0..5 m. */
 enum {
@@ -534,7 +530,7 @@ static void test_render_files_png_pdf_svg(void **state) {
     /* PNG, explicit size */
     o.width = 320;
     o.height = 200;
-    snprintf(path, sizeof path, "%s/render_test.png", tmp_dir());
+    snprintf(path, sizeof path, "%s/render_test.png", scratch_root());
     assert_int_equal(cdem_render_to_file(path, &sc, &o, &err), CDEM_OK);
     cairo_surface_t *png = cairo_image_surface_create_from_png(path);
     assert_int_equal(cairo_surface_status(png), CAIRO_STATUS_SUCCESS);
@@ -556,13 +552,13 @@ static void test_render_files_png_pdf_svg(void **state) {
     remove(path);
 
     static char buf[1 << 20];
-    snprintf(path, sizeof path, "%s/render_test.pdf", tmp_dir());
+    snprintf(path, sizeof path, "%s/render_test.pdf", scratch_root());
     assert_int_equal(cdem_render_to_file(path, &sc, &o, &err), CDEM_OK);
     assert_true(file_read(path, buf, sizeof buf) > 100);
     assert_memory_equal(buf, "%PDF-", 5);
     remove(path);
 
-    snprintf(path, sizeof path, "%s/render_test.SVG", tmp_dir());
+    snprintf(path, sizeof path, "%s/render_test.SVG", scratch_root());
     assert_int_equal(cdem_render_to_file(path, &sc, &o, &err), CDEM_OK);
     assert_true(file_read(path, buf, sizeof buf) > 100);
     assert_memory_equal(buf, "<?xml", 5);
@@ -571,7 +567,7 @@ static void test_render_files_png_pdf_svg(void **state) {
     remove(path);
 
     /* unsupported extension, unwritable directory */
-    snprintf(path, sizeof path, "%s/render_test.jpg", tmp_dir());
+    snprintf(path, sizeof path, "%s/render_test.jpg", scratch_root());
     assert_int_equal(cdem_render_to_file(path, &sc, &o, &err), CDEM_ERR_UNSUPPORTED);
     assert_non_null(strstr(err.msg, ".jpg"));
     assert_non_null(strstr(err.msg, ".png, .pdf or .svg"));
@@ -759,7 +755,7 @@ static void test_render_bad_input_fails_cleanly(void **state) {
     cairo_surface_destroy(tiny);
     bo.width = 5;
     char path[512];
-    snprintf(path, sizeof path, "%s/render_small.png", tmp_dir());
+    snprintf(path, sizeof path, "%s/render_small.png", scratch_root());
     assert_int_equal(cdem_render_to_file(path, &b, &bo, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "width = 5"));
     assert_int_equal(cdem_render_to_surface(NULL, &b, &bo, &err), CDEM_ERR_INVALID);

@@ -16,8 +16,10 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "scratch.h"
 
-static char g_tmp[1024], g_run[1100], g_strain[1100], g_bin[1024];
+static scratch_dir g_scratch;
+static char g_run[1100], g_strain[1100], g_bin[1024];
 static int g_increments; /* increments in the run, from `cdem-strain info` */
 
 static int run(const char *cmd, char *out, size_t n) {
@@ -36,8 +38,8 @@ static int run(const char *cmd, char *out, size_t n) {
 
 static int setup(void **state) {
     (void)state;
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(g_tmp, sizeof g_tmp, "%s/render_cli_%d", t ? t : "/tmp", (int)getpid());
+    if (scratch_dir_make(&g_scratch, "render_cli") != 0)
+        return -1;
     const char *b = getenv("CDEM_BUILD");
     char *abs = realpath(b ? b : "build", NULL); /* tests cd elsewhere */
     if (!abs)
@@ -45,11 +47,8 @@ static int setup(void **state) {
     snprintf(g_bin, sizeof g_bin, "%s", abs);
     free(abs);
     snprintf(g_strain, sizeof g_strain, "%s/cdem-strain", g_bin);
-    snprintf(g_run, sizeof g_run, "%s/run.h5", g_tmp);
+    snprintf(g_run, sizeof g_run, "%s/run.h5", g_scratch.dir);
     char cmd[4096], out[8192];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", g_tmp);
-    if (system(cmd) != 0)
-        return -1;
     /* A 10 x 2.5 unit planar normal fault, 200 s equilibration and 100 s of faulting. */
     snprintf(cmd, sizeof cmd,
              "'%s/cdem-run' -q -s assembly.height=2.5 -s time.equilibration=200 "
@@ -70,9 +69,7 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     (void)state;
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp);
-    return system(cmd) == 0 ? 0 : -1;
+    return scratch_dir_remove(&g_scratch);
 }
 
 static void read_head(const char *path, char *buf, size_t n) {
@@ -93,7 +90,7 @@ static void test_render_cli_formats(void **state) {
     } cases[] = {{"png", "\x89PNG"}, {"pdf", "%PDF-"}, {"svg", "<svg"}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char cmd[4096], out[4096], path[1200], head[512];
-        snprintf(path, sizeof path, "%s/shear.%s", g_tmp, cases[i].ext);
+        snprintf(path, sizeof path, "%s/shear.%s", g_scratch.dir, cases[i].ext);
         snprintf(cmd, sizeof cmd,
                  "'%s' render '%s' --increment last --color total-max-shear --vectors total "
                  "--axes total-strain --width 600 -o '%s'",
@@ -105,7 +102,7 @@ static void test_render_cli_formats(void **state) {
     /* The PNG is as wide as asked: width is big-endian at byte 16 of the IHDR chunk. */
     char path[1200];
     unsigned char ihdr[24];
-    snprintf(path, sizeof path, "%s/shear.png", g_tmp);
+    snprintf(path, sizeof path, "%s/shear.png", g_scratch.dir);
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
@@ -118,7 +115,7 @@ static void test_render_cli_formats(void **state) {
 static void test_render_cli_all_increments(void **state) {
     (void)state;
     char cmd[4096], out[4096], dir[1200];
-    snprintf(dir, sizeof dir, "%s/frames", g_tmp);
+    snprintf(dir, sizeof dir, "%s/frames", g_scratch.dir);
     snprintf(cmd, sizeof cmd,
              "'%s' render '%s' --increment all --color incr-max-shear --width 200 --prefix inc "
              "-o '%s'",
@@ -147,9 +144,9 @@ static void test_render_cli_all_increments(void **state) {
     /* into a folder that does not exist yet, two levels deep */
     snprintf(cmd, sizeof cmd,
              "'%s' render '%s' --increment all --width 100 -o '%s/album/a' --prefix fr", g_strain,
-             g_run, g_tmp);
+             g_run, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
-    snprintf(dir, sizeof dir, "%s/album/a/fr%0*d.png", g_tmp, width, g_increments - 1);
+    snprintf(dir, sizeof dir, "%s/album/a/fr%0*d.png", g_scratch.dir, width, g_increments - 1);
     assert_int_equal(access(dir, R_OK), 0);
 }
 
@@ -166,7 +163,7 @@ static int gif_frames(const char *path) {
 static void test_render_cli_gif(void **state) {
     (void)state;
     char cmd[4096], out[4096], path[1200];
-    snprintf(path, sizeof path, "%s/movie.gif", g_tmp);
+    snprintf(path, sizeof path, "%s/movie.gif", g_scratch.dir);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' --width 240 --gif '%s'", g_strain, g_run, path);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_int_equal(gif_frames(path), g_increments);
@@ -194,14 +191,15 @@ static void test_render_cli_errors(void **state) {
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char cmd[4096], out[8192];
-        snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render '%s' %s", g_tmp, g_strain, g_run,
+        snprintf(cmd, sizeof cmd, "cd '%s' && '%s' render '%s' %s", g_scratch.dir, g_strain, g_run,
                  cases[i].args);
         int rc = run(cmd, out, sizeof out);
         if (rc != cases[i].code || !strstr(out, cases[i].message))
             fail_msg("case %zu (%s): exit %d, output: %s", i, cases[i].args, rc, out);
     }
     char cmd[4096], out[4096];
-    snprintf(cmd, sizeof cmd, "'%s' render '%s/missing.h5' -o '%s/x.png'", g_strain, g_tmp, g_tmp);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s/missing.h5' -o '%s/x.png'", g_strain, g_scratch.dir,
+             g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "missing.h5"));
 }

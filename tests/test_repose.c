@@ -18,13 +18,9 @@
 #include "params.h"
 #include "render.h"
 #include "repose.h"
+#include "scratch.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
 
 /* Surface heights (m) of the test piles. */
 static double wedge_surface(double x) { /* flat crest 2500 m, 30 degree slope, 200 m toe */
@@ -106,8 +102,8 @@ static void test_repose_bad_states_messages(void **state) {
 static void test_repose_command_prints_and_draws(void **state) {
     (void)state;
     char h5[512], png[512];
-    snprintf(h5, sizeof h5, "%s/repose.h5", tmp_dir());
-    snprintf(png, sizeof png, "%s/repose.png", tmp_dir());
+    snprintf(h5, sizeof h5, "%s/repose.h5", scratch_root());
+    snprintf(png, sizeof png, "%s/repose.png", scratch_root());
     cdem_state s = {0};
     make_pile(&s, wedge_surface, 11);
     cdem_params p;

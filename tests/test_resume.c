@@ -17,6 +17,7 @@
 
 #include "h5format.h"
 #include "snapshot.h"
+#include "scratch.h"
 
 #include <limits.h>
 #include <signal.h>
@@ -29,8 +30,8 @@
 #include <unistd.h>
 
 typedef struct {
-    char bin[1024]; /* path of cdem-run */
-    char tmp[1024]; /* private scratch directory */
+    char bin[1024];      /* path of cdem-run */
+    scratch_dir scratch; /* private scratch directory */
 } rs_ctx;
 
 /* The small model every test runs (1370 elements, 5322 steps, 22 increments). */
@@ -48,9 +49,7 @@ static int setup(void **state) {
     snprintf(rel, sizeof rel, "%s/cdem-run", b && b[0] ? b : "build");
     if (!realpath(rel, c->bin)) /* the tests cd into their scratch directory */
         snprintf(c->bin, sizeof c->bin, "%s", rel);
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(c->tmp, sizeof c->tmp, "%s/test_resume_XXXXXX", t && t[0] ? t : "/tmp");
-    if (!mkdtemp(c->tmp)) {
+    if (scratch_dir_make(&c->scratch, "test_resume") != 0) {
         free(c);
         return -1;
     }
@@ -60,11 +59,9 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     rs_ctx *c = *state;
-    char cmd[2200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->tmp);
-    int rc = system(cmd);
+    int rc = scratch_dir_remove(&c->scratch);
     free(c);
-    return rc == 0 ? 0 : -1;
+    return rc;
 }
 
 /* Runs "env ENV cdem-run ARGS" (shell syntax) with stderr to tmp/err.txt; the
@@ -76,7 +73,7 @@ static int run(const rs_ctx *c, const char *env, const char *args) {
     }
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "cd '%s' && env OMP_WAIT_POLICY=passive %s '%s' %s 2>'%s/err.txt'",
-             c->tmp, env ? env : "", c->bin, args, c->tmp);
+             c->scratch.dir, env ? env : "", c->bin, args, c->scratch.dir);
     int st = system(cmd);
     assert_true(WIFEXITED(st));
     return WEXITSTATUS(st);
@@ -84,7 +81,7 @@ static int run(const rs_ctx *c, const char *env, const char *args) {
 
 static char *slurp(const rs_ctx *c, const char *name) {
     char path[1100];
-    snprintf(path, sizeof path, "%s/%s", c->tmp, name);
+    snprintf(path, sizeof path, "%s/%s", c->scratch.dir, name);
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     char *buf = calloc(1, 1 << 16);
@@ -103,7 +100,7 @@ static void expect_err(const rs_ctx *c, const char *needle) {
 }
 
 static void path_of(const rs_ctx *c, const char *name, char *buf, size_t n) {
-    snprintf(buf, n, "%s/%s", c->tmp, name);
+    snprintf(buf, n, "%s/%s", c->scratch.dir, name);
 }
 
 #define SAME_BITS(a, b, what, ...)                                                                 \
@@ -278,7 +275,7 @@ static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
     assert_true(pid >= 0);
     if (pid == 0) {
         FILE *f = freopen(log, "wb", stderr);
-        if (!f || chdir(c->tmp) != 0)
+        if (!f || chdir(c->scratch.dir) != 0)
             _exit(99);
         execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
               "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",
@@ -433,7 +430,7 @@ static void test_resume_refused_while_running(void **state) {
     assert_true(pid >= 0);
     if (pid == 0) {
         FILE *f = freopen(log, "wb", stderr);
-        if (!f || chdir(c->tmp) != 0)
+        if (!f || chdir(c->scratch.dir) != 0)
             _exit(99);
         execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
               "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",

@@ -12,16 +12,12 @@
 #include "h5format.h"
 #include "model.h"
 #include "run.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%s", dir && *dir ? dir : "/tmp", name);
-}
 
 static cdem_params small_params(void) {
     cdem_params p;
@@ -45,7 +41,7 @@ static cdem_run_options quiet_options(const char *path) {
 static void test_run_small_model_end_to_end(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_run_small.h5");
+    scratch_path(path, sizeof path, "test_run_small.h5");
     cdem_params p = small_params();
     p.calculate_stress = 1;
     cdem_model m;
@@ -138,7 +134,7 @@ static void test_run_small_model_end_to_end(void **st) {
 static void test_run_stops_early_and_on_signal(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_run_stop.h5");
+    scratch_path(path, sizeof path, "test_run_stop.h5");
     cdem_params p = small_params();
     cdem_error err;
     cdem_run_options o = quiet_options(path);
@@ -210,7 +206,7 @@ static void test_run_stops_early_and_on_signal(void **st) {
 static void test_run_refuses_bad_requests(void **st) {
     (void)st;
     char path[1024];
-    tmp_path(path, sizeof path, "test_run_refused.h5");
+    scratch_path(path, sizeof path, "test_run_refused.h5");
     cdem_params p = small_params();
     cdem_error err;
     cdem_run_options o = quiet_options(path);

@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+#include "scratch.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -38,29 +39,6 @@ static double now_s(void) {
 static void sleep_s(double s) {
     struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
     nanosleep(&ts, NULL);
-}
-
-typedef struct {
-    char dir[1024]; /* private scratch folder */
-} ctx;
-
-static int setup(void **state) {
-    ctx *c = calloc(1, sizeof *c);
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(c->dir, sizeof c->dir, "%s/run_output_XXXXXX", t && *t ? t : "/tmp");
-    if (!mkdtemp(c->dir))
-        return -1;
-    *state = c;
-    return 0;
-}
-
-static int teardown(void **state) {
-    ctx *c = *state;
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", c->dir);
-    int rc = system(cmd);
-    free(c);
-    return rc == 0 ? 0 : -1;
 }
 
 /* Starts cdem-run with the short model (1370 elements; runtime in s sets its length) and extra
@@ -129,7 +107,7 @@ static int exit_code(int status) {
 
 /* Started together: exactly one runs; the other fails naming it; the file is complete. */
 static void test_run_output_two_runs_started_together(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char out[1100], ea[1100], eb[1100];
     snprintf(out, sizeof out, "%s/same.h5", c->dir);
     snprintf(ea, sizeof ea, "%s/a.err", c->dir);
@@ -153,7 +131,7 @@ static void test_run_output_two_runs_started_together(void **state) {
  * the first finishes and its file holds all its increments (once it wrote to a deleted
  * inode and both exited 0). */
 static void test_run_output_second_run_refused(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char out[1100], ea[1100], eb[1100], lock[1200];
     snprintf(out, sizeof out, "%s/busy.h5", c->dir);
     snprintf(ea, sizeof ea, "%s/a.err", c->dir);
@@ -197,7 +175,7 @@ static long mtime_ns(const char *path) {
 /* An existing run file is refused without --force and replaced with it; other files are
  * never replaced; nor is an input of the run. */
 static void test_run_output_overwrite_guard(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char out[1100], err[1100], model[1100], notes[1100], msg[4096];
     snprintf(out, sizeof out, "%s/done.h5", c->dir);
     snprintf(err, sizeof err, "%s/e.err", c->dir);
@@ -255,7 +233,7 @@ static void test_run_output_overwrite_guard(void **state) {
 /* SIGHUP (a closed terminal) stops the run cleanly, like SIGINT: once it killed the run
  * without a message and left the stop reason "running". */
 static void test_run_output_sighup_stops_cleanly(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char out[1100], err[1100], msg[4096];
     snprintf(out, sizeof out, "%s/hup.h5", c->dir);
     snprintf(err, sizeof err, "%s/hup.err", c->dir);
@@ -276,7 +254,7 @@ static void test_run_output_sighup_stops_cleanly(void **state) {
 /* A missing output folder is named; no advice to free space. A 23-digit --max-steps is
  * refused (strtol once made it LONG_MAX silently). */
 static void test_run_output_bad_requests(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char err[1100], msg[4096], out[1200];
     snprintf(err, sizeof err, "%s/bad.err", c->dir);
     snprintf(out, sizeof out, "%s/no-such-folder/run.h5", c->dir);
@@ -308,7 +286,7 @@ static double size_of(const char *path) {
  * copy. It once counted the element data only: 2.3 MB estimated for this run, 4.1 MB
  * written, so a run passed the check and failed at increment 18 of 40. */
 static void test_run_output_space_estimate(void **state) {
-    ctx *c = *state;
+    scratch_dir *c = *state;
     char out[1100], err[1100], xmf[1100];
     snprintf(out, sizeof out, "%s/space.h5", c->dir);
     snprintf(err, sizeof err, "%s/space.err", c->dir);
@@ -339,12 +317,18 @@ static void test_run_output_space_estimate(void **state) {
 
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(test_run_output_two_runs_started_together, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_run_output_second_run_refused, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_run_output_overwrite_guard, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_run_output_sighup_stops_cleanly, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_run_output_bad_requests, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_run_output_space_estimate, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_two_runs_started_together, scratch_setup,
+                                        scratch_teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_second_run_refused, scratch_setup,
+                                        scratch_teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_overwrite_guard, scratch_setup,
+                                        scratch_teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_sighup_stops_cleanly, scratch_setup,
+                                        scratch_teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_bad_requests, scratch_setup,
+                                        scratch_teardown),
+        cmocka_unit_test_setup_teardown(test_run_output_space_estimate, scratch_setup,
+                                        scratch_teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "runlock.h"
+#include "scratch.h"
 
 #include <signal.h>
 #include <stdio.h>
@@ -17,15 +18,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%d_%s", t && *t ? t : "/tmp", (int)getpid(), name);
-}
-
 static void test_runlock_second_writer_refused(void **state) {
     (void)state;
     char path[1024], lock[1100], pid[64];
-    tmp_path(path, sizeof path, "locked.h5");
+    scratch_path(path, sizeof path, "locked.h5");
     assert_int_equal(cdem_runlock_path(path, lock, sizeof lock), 0);
     cdem_error err;
     cdem_runlock *a = NULL, *b = NULL;
@@ -57,7 +53,7 @@ static void test_runlock_second_writer_refused(void **state) {
 static void test_runlock_dies_with_its_holder(void **state) {
     (void)state;
     char path[1024], lock[1100];
-    tmp_path(path, sizeof path, "killed.h5");
+    scratch_path(path, sizeof path, "killed.h5");
     cdem_runlock_path(path, lock, sizeof lock);
     int ready[2];
     assert_int_equal(pipe(ready), 0);

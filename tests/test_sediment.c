@@ -18,16 +18,12 @@
 #include "model.h"
 #include "run.h"
 #include "sediment.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static void tmp_path(char *buf, size_t n, const char *name) {
-    const char *dir = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/%s", dir && *dir ? dir : "/tmp", name);
-}
 
 static cdem_params small_params(void) {
     cdem_params p;
@@ -306,8 +302,8 @@ static cdem_status run_to(const cdem_params *p, const char *path, cdem_error *er
 static void test_sediment_end_to_end_reproducible(void **st) {
     (void)st;
     char pa[1024], pb[1024];
-    tmp_path(pa, sizeof pa, "test_sediment_a.h5");
-    tmp_path(pb, sizeof pb, "test_sediment_b.h5");
+    scratch_path(pa, sizeof pa, "test_sediment_a.h5");
+    scratch_path(pb, sizeof pb, "test_sediment_b.h5");
     cdem_params p = small_params();
     cdem_model m;
     cdem_error err;

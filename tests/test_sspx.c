@@ -11,6 +11,7 @@
 #include "analysis_fixtures.h"
 #include "biaxial.h"
 #include "sspx.h"
+#include "scratch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -19,11 +20,6 @@
 #include <unistd.h>
 
 #define NINC 8
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d ? d : "/tmp";
-}
 
 static void test_sspx_round_trip_total_displacement(void **st) {
     (void)st;
@@ -49,7 +45,7 @@ static void test_sspx_round_trip_total_displacement(void **st) {
     cdem_analysis *a;
     assert_int_equal(cdem_analysis_open_states(s, info, NINC, &p, &a, &err), CDEM_OK);
     char dir[1024];
-    snprintf(dir, sizeof dir, "%s/sspx_%d", tmp_dir(), (int)getpid());
+    snprintf(dir, sizeof dir, "%s/sspx_%d", scratch_root(), (int)getpid());
     char cmd[1100];
     snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
     assert_int_equal(system(cmd), 0);
@@ -114,7 +110,7 @@ static void test_sspx_round_trip_total_displacement(void **st) {
 static void test_sspx_read_malformed(void **st) {
     (void)st;
     char path[1100];
-    snprintf(path, sizeof path, "%s/sspx_bad_%d.txt", tmp_dir(), (int)getpid());
+    snprintf(path, sizeof path, "%s/sspx_bad_%d.txt", scratch_root(), (int)getpid());
     FILE *f = fopen(path, "w");
     fprintf(f, "0 1.0 2.0 50.0 1\n1 1.0 2.0 -5 1\n");
     fclose(f);
@@ -137,7 +133,7 @@ static void test_sspx_biaxial_table(void **st) {
         smp[i].differential_stress = 1.5e7 * i;
     }
     char path[1100];
-    snprintf(path, sizeof path, "%s/biaxial_%d.txt", tmp_dir(), (int)getpid());
+    snprintf(path, sizeof path, "%s/biaxial_%d.txt", scratch_root(), (int)getpid());
     cdem_error err;
     assert_int_equal(cdem_biaxial_write(path, smp, 3, &err), CDEM_OK);
     FILE *f = fopen(path, "r");

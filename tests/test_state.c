@@ -226,6 +226,75 @@ static void test_state_id_map_finds_slots(void **state) {
     cdem_state_free(&s);
 }
 
+/* The field table (CDEM_STATE_FIELDS as data) describes cdem_state exactly: every array
+ * member once, at its offset, with its element size; the fields stored in each increment of
+ * the run file are the ones docs/format.md lists, in that order; and copy and compaction
+ * carry every field (each element of each field gets a distinct value through the table,
+ * so a field the loops forgot would show). */
+static void test_state_field_table_drives_every_field(void **state) {
+    (void)state;
+    assert_int_equal(cdem_state_field_count, 15);
+    size_t members = 0;
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
+        assert_true(f->offset >= offsetof(cdem_state, id) &&
+                    f->offset <= offsetof(cdem_state, sxy));
+        assert_int_equal(f->offset, offsetof(cdem_state, id) + k * sizeof(void *));
+        members++;
+    }
+    assert_int_equal(members * sizeof(void *), sizeof(cdem_state) - offsetof(cdem_state, id));
+    static const char *const in_file[] = {"id",    "x",    "y",   "radius", "layer",
+                                          "flags", "born", "sxx", "syy",    "sxy"};
+    size_t j = 0;
+    for (size_t k = 0; k < cdem_state_field_count; k++)
+        if (cdem_state_fields[k].in_increments) {
+            assert_true(j < sizeof in_file / sizeof in_file[0]);
+            assert_string_equal(cdem_state_fields[k].name, in_file[j++]);
+        }
+    assert_int_equal(j, sizeof in_file / sizeof in_file[0]);
+
+    cdem_error err;
+    cdem_state s;
+    assert_int_equal(cdem_state_init(&s, 4, 1, &err), CDEM_OK);
+    for (int i = 0; i < 5; i++)
+        assert_int_equal(cdem_state_append(&s, -1, 0, 0, 1, 1, 1, 0, 0, NULL, &err), CDEM_OK);
+    /* value of element i in field k: 100 k + i, whatever the field's type */
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
+        void *a = cdem_state_field_array(&s, f);
+        assert_non_null(a);
+        assert_int_equal(cdem_field_type_size(f->type), f->type == CDEM_FIELD_F64 ? 8 : 4);
+        for (size_t i = 0; i < s.n; i++) {
+            const double v = 100.0 * (double)k + (double)i;
+            if (f->type == CDEM_FIELD_F64)
+                ((double *)a)[i] = v;
+            else if (f->type == CDEM_FIELD_I32)
+                ((int32_t *)a)[i] = (int32_t)v;
+            else
+                ((uint32_t *)a)[i] = (uint32_t)v;
+        }
+    }
+    cdem_state c;
+    assert_int_equal(cdem_state_copy(&c, &s, &err), CDEM_OK);
+    const unsigned char keep[5] = {1, 0, 1, 0, 1}; /* elements 0, 2, 4 stay */
+    cdem_state_compact(&c, keep, NULL);
+    assert_int_equal(c.n, 3);
+    for (size_t k = 0; k < cdem_state_field_count; k++) {
+        const cdem_state_field *f = &cdem_state_fields[k];
+        const void *a = cdem_state_field_array(&c, f);
+        for (size_t i = 0; i < c.n; i++) {
+            const double want = 100.0 * (double)k + (double)(2 * i);
+            const double got = f->type == CDEM_FIELD_F64   ? ((const double *)a)[i]
+                               : f->type == CDEM_FIELD_I32 ? (double)((const int32_t *)a)[i]
+                                                           : (double)((const uint32_t *)a)[i];
+            if (got != want)
+                fail_msg("field %s, element %zu: %g, expected %g", f->name, i, got, want);
+        }
+    }
+    cdem_state_free(&c);
+    cdem_state_free(&s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_state_append_assigns_ids),
@@ -235,6 +304,7 @@ int main(void) {
         cmocka_unit_test(test_state_copy_is_deep),
         cmocka_unit_test(test_state_copy_into_uninitialised_destination),
         cmocka_unit_test(test_state_id_map_finds_slots),
+        cmocka_unit_test(test_state_field_table_drives_every_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

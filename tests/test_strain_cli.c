@@ -9,6 +9,7 @@
 
 #include "analysis_fixtures.h"
 #include "h5format.h"
+#include "scratch.h"
 
 #include <hdf5.h>
 
@@ -21,7 +22,8 @@
 
 #define NINC 7
 
-static char g_tmp[1024], g_run[1100], g_exe[1024];
+static scratch_dir g_scratch;
+static char g_run[1100], g_exe[1024];
 
 /* Runs cmd (2>&1) and returns its exit status; output (truncated) in out. */
 static int run(const char *cmd, char *out, size_t n) {
@@ -39,15 +41,11 @@ static int run(const char *cmd, char *out, size_t n) {
 
 static int setup(void **state) {
     (void)state;
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(g_tmp, sizeof g_tmp, "%s/cli_%d", t ? t : "/tmp", (int)getpid());
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", g_tmp);
-    if (system(cmd) != 0)
+    if (scratch_dir_make(&g_scratch, "strain_cli") != 0)
         return -1;
     const char *b = getenv("CDEM_BUILD");
     snprintf(g_exe, sizeof g_exe, "%s/cdem-strain", b ? b : "build");
-    snprintf(g_run, sizeof g_run, "%s/run.h5", g_tmp);
+    snprintf(g_run, sizeof g_run, "%s/run.h5", g_scratch.dir);
     cdem_state st[NINC] = {{0}};
     cdem_error err;
     make_packing(&st[0], 120, 2000.0, 1200.0, 5);
@@ -84,9 +82,7 @@ static int setup(void **state) {
 
 static int teardown(void **state) {
     (void)state;
-    char cmd[1200];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", g_tmp);
-    return system(cmd) == 0 ? 0 : -1;
+    return scratch_dir_remove(&g_scratch);
 }
 
 static void test_strain_cli_compute_csv(void **state) {
@@ -120,10 +116,10 @@ static void test_strain_cli_compute_csv(void **state) {
     snprintf(cmd, sizeof cmd,
              "%s compute %s --increment all --quantity cum-max-shear --format h5 "
              "-o %s/q.h5",
-             g_exe, g_run, g_tmp);
+             g_exe, g_run, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     char path[1200];
-    snprintf(path, sizeof path, "%s/q.h5", g_tmp);
+    snprintf(path, sizeof path, "%s/q.h5", g_scratch.dir);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     assert_true(f >= 0);
     hid_t g = H5Gopen2(f, "increments", H5P_DEFAULT);
@@ -138,7 +134,7 @@ static void test_strain_cli_compute_csv(void **state) {
     H5Fclose(f);
     /* ... and the file its own sidecar (issue 18), which names it and resolves */
     char xmf[1300], text[65536];
-    snprintf(xmf, sizeof xmf, "%s/q.xmf", g_tmp);
+    snprintf(xmf, sizeof xmf, "%s/q.xmf", g_scratch.dir);
     snprintf(cmd, sizeof cmd, "xmllint --noout --xinclude %s && cat %s", xmf, xmf);
     assert_int_equal(run(cmd, text, sizeof text), 0);
     assert_non_null(strstr(text, ">q.h5:/increments/000006/xy|0 0:1 1:"));
@@ -152,26 +148,27 @@ static void test_strain_cli_compute_csv(void **state) {
 static void test_strain_cli_xdmf(void **state) {
     (void)state;
     char cmd[8192], out[65536];
-    snprintf(cmd, sizeof cmd, "cp %s %s/renamed.h5 && %s xdmf %s/renamed.h5", g_run, g_tmp, g_exe,
-             g_tmp);
+    snprintf(cmd, sizeof cmd, "cp %s %s/renamed.h5 && %s xdmf %s/renamed.h5", g_run, g_scratch.dir,
+             g_exe, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     char want[1300];
-    snprintf(want, sizeof want, "%s/renamed.xmf\n", g_tmp);
+    snprintf(want, sizeof want, "%s/renamed.xmf\n", g_scratch.dir);
     assert_string_equal(out, want);
     snprintf(cmd, sizeof cmd,
              "xmllint --noout --xinclude %s/renamed.xmf && grep -c "
              "'>renamed.h5:/increments/xy|' %s/renamed.xmf",
-             g_tmp, g_tmp);
+             g_scratch.dir, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_int_equal(atoi(out), NINC);
     snprintf(cmd, sizeof cmd,
              "%s xdmf %s/renamed.h5 --xdmf2 -o %s/legacy.xdmf2 && grep -c "
              "'GeometryType=\"X_Y\"' %s/legacy.xdmf2",
-             g_exe, g_tmp, g_tmp, g_tmp);
+             g_exe, g_scratch.dir, g_scratch.dir, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_non_null(strstr(out, "legacy.xdmf2\n"));
     assert_int_equal(atoi(strchr(out, '\n') + 1), NINC);
-    snprintf(cmd, sizeof cmd, "echo text > %s/not.h5 && %s xdmf %s/not.h5", g_tmp, g_exe, g_tmp);
+    snprintf(cmd, sizeof cmd, "echo text > %s/not.h5 && %s xdmf %s/not.h5", g_scratch.dir, g_exe,
+             g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "not.h5"));
 }
@@ -201,36 +198,37 @@ static void test_strain_cli_exports_and_import(void **state) {
     (void)state;
     char cmd[8192], out[65536], path[1200];
     snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments equil-last --prefix mod %s/", g_exe,
-             g_run, g_tmp);
+             g_run, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     for (int k = 2; k < NINC; k++) {
-        snprintf(path, sizeof path, "%s/mod%d.txt", g_tmp, k);
+        snprintf(path, sizeof path, "%s/mod%d.txt", g_scratch.dir, k);
         assert_int_equal(access(path, R_OK), 0);
     }
-    snprintf(path, sizeof path, "%s/mod1.txt", g_tmp);
+    snprintf(path, sizeof path, "%s/mod1.txt", g_scratch.dir);
     assert_int_not_equal(access(path, R_OK), 0);
     /* a folder that does not exist yet (two levels) is created (issue 18) */
     snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-4 %s/new/sspx", g_exe, g_run,
-             g_tmp);
+             g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
-    snprintf(path, sizeof path, "%s/new/sspx/cdem4.txt", g_tmp);
+    snprintf(path, sizeof path, "%s/new/sspx/cdem4.txt", g_scratch.dir);
     assert_int_equal(access(path, R_OK), 0);
     /* but not for a bad range: nothing is created then */
-    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-99 %s/never", g_exe, g_run, g_tmp);
+    snprintf(cmd, sizeof cmd, "%s export-sspx %s --increments 3-99 %s/never", g_exe, g_run,
+             g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
-    snprintf(path, sizeof path, "%s/never", g_tmp);
+    snprintf(path, sizeof path, "%s/never", g_scratch.dir);
     assert_int_not_equal(access(path, F_OK), 0);
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(cmd, sizeof cmd,
              "%s import-cdem2d %s/cdem2d_basic -o %s/imp.h5 && %s compute "
              "%s/imp.h5 --increment 3 --quantity total-disp-x",
-             g_exe, d ? d : "tests/data", g_tmp, g_exe, g_tmp);
+             g_exe, d ? d : "tests/data", g_scratch.dir, g_exe, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     /* element 0 starts at (100, 100) and moves 5 + 0.02 y = 7 m per increment; the end of
      * equilibration is increment 1, so at increment 3 it sits at x = 121 with u = 14 m */
     assert_non_null(strstr(out, "\n0,121.000000,100.000000,14\n"));
     /* info of an imported run: no step, time or displacement invented (issue 18) */
-    snprintf(cmd, sizeof cmd, "%s info %s/imp.h5", g_exe, g_tmp);
+    snprintf(cmd, sizeof cmd, "%s info %s/imp.h5", g_exe, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     int number, elements;
     char step[16], time[16], phase[32], net[16];
@@ -245,8 +243,8 @@ static void test_strain_cli_exports_and_import(void **state) {
 static void test_strain_cli_export_biaxial(void **state) {
     (void)state;
     char path[1200], out_path[1200], cmd[8192], out[8192];
-    snprintf(path, sizeof path, "%s/biax.h5", g_tmp);
-    snprintf(out_path, sizeof out_path, "%s/biax.txt", g_tmp);
+    snprintf(path, sizeof path, "%s/biax.h5", g_scratch.dir);
+    snprintf(out_path, sizeof out_path, "%s/biax.txt", g_scratch.dir);
     cdem_params p;
     cdem_params_defaults(&p);
     p.mode = CDEM_MODE_BIAXIAL;
@@ -299,7 +297,7 @@ static void test_strain_cli_export_biaxial(void **state) {
 static void test_strain_cli_series_and_json(void **state) {
     (void)state;
     char cmd[8192], out[65536];
-    snprintf(cmd, sizeof cmd, "%s/biax.h5", g_tmp); /* written by the export-biaxial test */
+    snprintf(cmd, sizeof cmd, "%s/biax.h5", g_scratch.dir); /* written by the export-biaxial test */
     if (access(cmd, R_OK) != 0)
         skip();
     snprintf(
@@ -315,7 +313,7 @@ static void test_strain_cli_series_and_json(void **state) {
         "    for r, v in zip(rows, f[\"series/\" + c][:]):\n"
         "        assert (math.isnan(v) and r[c] == \"nan\") or float(r[c]) == v, (c, r[c], v)\n"
         "print(len(rows))' %s/series.csv %s/biax.h5",
-        g_exe, g_tmp, g_tmp, g_tmp, g_tmp);
+        g_exe, g_scratch.dir, g_scratch.dir, g_scratch.dir, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_int_equal(atoi(out), 12);
     snprintf(cmd, sizeof cmd,
@@ -369,15 +367,15 @@ static void test_strain_cli_errors(void **state) {
     snprintf(cmd, sizeof cmd, "%s frobnicate", g_exe);
     assert_int_equal(run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "unknown command 'frobnicate'"));
-    snprintf(cmd, sizeof cmd, "%s info %s/missing.h5", g_exe, g_tmp);
+    snprintf(cmd, sizeof cmd, "%s info %s/missing.h5", g_exe, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "missing.h5"));
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(cmd, sizeof cmd, "%s import-cdem2d %s/cdem2d_malformed -o %s/bad.h5", g_exe,
-             d ? d : "tests/data", g_tmp);
+             d ? d : "tests/data", g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "modelresults_1.txt:3:"));
-    snprintf(cmd, sizeof cmd, "%s export-biaxial %s -o %s/b.txt", g_exe, g_run, g_tmp);
+    snprintf(cmd, sizeof cmd, "%s export-biaxial %s -o %s/b.txt", g_exe, g_run, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "needs a biaxial test run"));
 }

@@ -20,13 +20,9 @@
 #include "h5format.h"
 #include "params.h"
 #include "wedge.h"
+#include "scratch.h"
 
 static const double deg = 3.14159265358979323846 / 180.0;
-
-static const char *tmp_dir(void) {
-    const char *d = getenv("CDEM_TEST_TMP");
-    return d && d[0] ? d : "/tmp";
-}
 
 /* A square lattice of discs of radius 50 m: n_cols columns (x = 50 + 100 c) of n_rows rows
  * (y = 50 + 100 j), a fixed left wall column at x = -50, a base row at y = -50 and a moving
@@ -311,7 +307,7 @@ static void test_wedge_csv_round_trip(void **state) {
                                    .n_fitted = (size_t)(3 * k)};
     }
     char path[1100];
-    snprintf(path, sizeof path, "%s/wedge_rt_%d.csv", tmp_dir(), (int)getpid());
+    snprintf(path, sizeof path, "%s/wedge_rt_%d.csv", scratch_root(), (int)getpid());
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     cdem_error err;
@@ -416,7 +412,7 @@ static void test_wedge_end_to_end_detachment(void **state) {
     char *bin = realpath(b ? b : "build", NULL);
     assert_non_null(bin);
     char dir[1100], cmd[4096], out[8192];
-    snprintf(dir, sizeof dir, "%s/wedge_e2e_%d", tmp_dir(), (int)getpid());
+    snprintf(dir, sizeof dir, "%s/wedge_e2e_%d", scratch_root(), (int)getpid());
     snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
     assert_int_equal(system(cmd), 0);
     snprintf(cmd, sizeof cmd,

@@ -11,17 +11,13 @@
 #include <cmocka.h>
 
 #include "xdmf.h"
+#include "scratch.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static void scratch(char *buf, size_t n, const char *name) {
-    const char *t = getenv("CDEM_TEST_TMP");
-    snprintf(buf, n, "%s/xdmf_%d_%s", t && t[0] ? t : "/tmp", (int)getpid(), name);
-}
 
 /* Two grids of 3 and 0 points, then one of 5; the one of 0 must be left out. */
 static int grid_cb(void *ctx, size_t k, cdem_xdmf_grid *g) {
@@ -119,7 +115,7 @@ static void test_xdmf_names_and_references(void **state) {
     free(p);
     char h5[1024], other[1500], ref[4096];
     cdem_error err;
-    scratch(h5, sizeof h5, "ref.h5");
+    scratch_path(h5, sizeof h5, "ref.h5");
     assert_true(snprintf(other, sizeof other, "%s.d", h5) < (int)sizeof other);
     assert_int_equal(mkdir(other, 0777), 0);
     char xmf[1400];
@@ -178,7 +174,7 @@ static hsize_t read_xy(hid_t file, const char *name, double *out) {
 static void test_xdmf_xy_view(void **state) {
     (void)state;
     char path[1024];
-    scratch(path, sizeof path, "view.h5");
+    scratch_path(path, sizeof path, "view.h5");
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
     hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);

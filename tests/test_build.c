@@ -1,0 +1,117 @@
+/* The Makefile's promises (issue 20, item 8), checked on `make -n -B` (the commands make
+ * would run; nothing is compiled): a user's CFLAGS are appended to the project's flags,
+ * never replace them; each layer compiles with the include paths of the layers it may use
+ * (common: itself; solver and analysis: common and themselves); cdem-strain links no
+ * solver code. Runs make from the repository root into a scratch BUILD. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The dry-run command line make prints for TARGET (with EXTRA make arguments) in OUT. */
+static void dry_run(const char *target, const char *extra, char *out, size_t cap) {
+    /* MAKEFLAGS of an enclosing make (its jobserver) must not leak into this one */
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd,
+             "env -u MAKEFLAGS -u MAKELEVEL make -n -B BUILD=dryrun-build %s "
+             "dryrun-build/%s 2>&1",
+             extra, target);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, cap - 1, p);
+    out[n] = '\0';
+    assert_int_equal(pclose(p), 0);
+}
+
+/* The line of OUT that compiles or links WHAT (a path in the command). */
+static const char *line_with(const char *out, const char *what, char *line, size_t cap) {
+    const char *hit = strstr(out, what);
+    if (!hit)
+        fail_msg("no command mentions %s in:\n%s", what, out);
+    const char *start = hit;
+    while (start > out && start[-1] != '\n')
+        start--;
+    const char *end = strchr(hit, '\n');
+    size_t len = end ? (size_t)(end - start) : strlen(start);
+    assert_true(len < cap);
+    memcpy(line, start, len);
+    line[len] = '\0';
+    return line;
+}
+
+/* LINE = the command make would run for TARGET (with EXTRA make arguments) that mentions
+ * WHAT. */
+static void command_for(const char *target, const char *extra, const char *what, char *line,
+                        size_t cap) {
+    static char out[1 << 17];
+    dry_run(target, extra, out, sizeof out);
+    line_with(out, what, line, cap);
+}
+
+static int has_word(const char *line, const char *word) {
+    size_t n = strlen(word);
+    for (const char *p = strstr(line, word); p; p = strstr(p + 1, word))
+        if ((p == line || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0'))
+            return 1;
+    return 0;
+}
+
+static void test_build_user_cflags_are_appended(void **state) {
+    (void)state;
+    char line[4096];
+    command_for("common/state.o", "CFLAGS=-O1", "common/state.c", line, sizeof line);
+    const char *kept[] = {"-std=c17", "-Werror", "-fopenmp", "-O1", "-Icommon"};
+    for (size_t i = 0; i < sizeof kept / sizeof kept[0]; i++)
+        if (!has_word(line, kept[i]))
+            fail_msg("make CFLAGS=-O1 lost %s: %s", kept[i], line);
+    /* the user's -O1 comes after the project's -O2, so it is the one that counts */
+    assert_true(strstr(line, "-O1") > strstr(line, "-O2"));
+}
+
+static void test_build_layer_include_paths(void **state) {
+    (void)state;
+    static const struct {
+        const char *object, *source;
+        const char *allowed[2], *forbidden[2];
+    } layers[] = {
+        {"common/state.o", "common/state.c", {"-Icommon", NULL}, {"-Isolver", "-Ianalysis"}},
+        {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis", NULL}},
+        {"analysis/render.o", "analysis/render.c", {"-Icommon", "-Ianalysis"}, {"-Isolver", NULL}},
+    };
+    char line[4096];
+    for (size_t i = 0; i < sizeof layers / sizeof layers[0]; i++) {
+        command_for(layers[i].object, "", layers[i].source, line, sizeof line);
+        for (size_t k = 0; k < 2; k++) {
+            if (layers[i].allowed[k] && !has_word(line, layers[i].allowed[k]))
+                fail_msg("%s compiles without %s: %s", layers[i].source, layers[i].allowed[k],
+                         line);
+            if (layers[i].forbidden[k] && has_word(line, layers[i].forbidden[k]))
+                fail_msg("%s compiles with %s: %s", layers[i].source, layers[i].forbidden[k], line);
+        }
+    }
+}
+
+static void test_build_strain_links_no_solver(void **state) {
+    (void)state;
+    char line[8192];
+    command_for("cdem-strain", "", "-o dryrun-build/cdem-strain", line, sizeof line);
+    assert_non_null(strstr(line, "libcdemanalysis.a"));
+    assert_non_null(strstr(line, "libcdem.a"));
+    if (strstr(line, "libcdemsolver.a"))
+        fail_msg("cdem-strain links the solver library: %s", line);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_build_user_cflags_are_appended),
+        cmocka_unit_test(test_build_layer_include_paths),
+        cmocka_unit_test(test_build_strain_links_no_solver),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
