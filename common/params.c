@@ -69,7 +69,7 @@ static const cdem_param_def param_table[] = {
     {"assembly", "wall_height_multiplier", CDEM_PTYPE_INT, P_OFF(wall_height_multiplier), 0, "", "1", 1, 4, 0, 0, NULL,
      "lateral wall height as a multiple of the assembly height"},
     {"assembly", "base_spacing", CDEM_PTYPE_DOUBLE, P_OFF(base_spacing), 0, "wall radii", "2", 1, 2, 0, 0, NULL,
-     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base)"},
+     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base); the biaxial test's platens are always smooth (1)"},
     {"assembly", "seed", CDEM_PTYPE_LONG, P_OFF(seed), 0, "", "1", 0, 2147483647.0, 0, 0, NULL,
      "random seed of the packing and of all other randomness"},
 

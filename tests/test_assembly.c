@@ -522,6 +522,15 @@ static void test_assembly_walls_complete(void **unused) {
         assert_true(info.wall_radius == rw && info.wall_spacing == rw);
         assert_true(info.base_spacing <= p.base_spacing * rw * (1.0 + 1e-12) &&
                     info.base_spacing > 0.9 * p.base_spacing * rw);
+        if (mult == 1) { /* the biaxial test's base row is a smooth platen, whatever is set */
+            cdem_params pb = p;
+            pb.mode = CDEM_MODE_BIAXIAL;
+            cdem_state sb;
+            cdem_assembly_info ib;
+            build(&pb, &m, &sb, &ib);
+            assert_true(ib.base_spacing <= rw * (1.0 + 1e-12) && ib.base_spacing > 0.9 * rw);
+            cdem_state_free(&sb);
+        }
         double *base = malloc(s.n * sizeof *base), *left = malloc(s.n * sizeof *left),
                *right = malloc(s.n * sizeof *right);
         size_t nb = 0, nl = 0, nr = 0;
