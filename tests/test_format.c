@@ -1,7 +1,7 @@
-/* Tests of the HDF5 element-state format (common/h5format.c): round trips of every field,
- * variable element counts, optional stress, error handling of foreign, wrong-version,
- * truncated and corrupt files, increment look-up, a writer killed mid-run, the size of a
- * realistic run and the XDMF sidecar. Files go to $CDEM_TEST_TMP (default /tmp). */
+/* Tests of the HDF5 element-state format (common/h5format.h, implemented in common/h5/): round
+ * trips of every field, variable element counts, optional stress, error handling of foreign,
+ * wrong-version, truncated and corrupt files, increment look-up, a writer killed mid-run, the size
+ * of a realistic run and the XDMF sidecar. Files go to $CDEM_TEST_TMP (default /tmp). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
