@@ -18,7 +18,7 @@
 
 BUILD   ?= build
 CC      ?= gcc
-PKGS    := hdf5 gsl cairo
+PKGS    := hdf5 gsl cairo zlib
 OPT     ?= -O2
 # The project's flags live in CDEM_CFLAGS; a user's CFLAGS (and CPPFLAGS, LDFLAGS) come
 # after them, so `make CFLAGS=-O1` changes the optimisation (the last -O wins) but never

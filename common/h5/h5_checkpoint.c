@@ -4,7 +4,11 @@
  * not hold the newest checkpoint is overwritten, the file flushed (and synced), and only then
  * is that slot's row of /checkpoint/index written (sequence = previous + 1, length, FNV-1a
  * checksum): a kill at any moment leaves one valid checkpoint. The reader tries the newest
- * sequence first and falls back to the other slot when a checksum or the blob fails. */
+ * sequence first and falls back to the other slot when a checksum or the blob fails.
+ * A slot holds the blob compressed (h5i_snap_pack); length and checksum in the index are
+ * those of the bytes in the slot, so a torn slot is found before anything is inflated. The
+ * slots are unfiltered and chunked in CKPT_CHUNK (16 KiB) pieces: a rewrite stays in place
+ * (docs/format.md, "Size"), and a slot holds at most 16 KiB more than its checkpoint. */
 #include "h5_internal.h"
 
 #include <stdio.h>
@@ -26,14 +30,15 @@ cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapsh
     if (w->failed)
         return CDEM_FAIL(err, CDEM_ERR_IO, "%s: an earlier write failed; no checkpoint written",
                          w->path);
-    size_t len = 0;
-    CDEM_TRY(h5i_snap_encode(snap, &w->ckpt_buf, &w->ckpt_cap, &len, w->path, err));
+    size_t raw = 0, len = 0;
+    CDEM_TRY(h5i_snap_encode(snap, &w->ckpt_buf, &w->ckpt_cap, &raw, w->path, err));
+    CDEM_TRY(h5i_snap_pack(w->ckpt_buf, raw, &w->ckpt_zbuf, &w->ckpt_zcap, &len, w->path, err));
     /* Double buffering: overwrite the slot that does not hold the newest checkpoint, flush,
      * and only then point the index at it. */
     int slot = w->ckpt[0].sequence > w->ckpt[1].sequence ? 1 : 0;
     int64_t seq =
         (w->ckpt[0].sequence > w->ckpt[1].sequence ? w->ckpt[0].sequence : w->ckpt[1].sequence) + 1;
-    if (h5i_write_rows(w->ckpt_data[slot], H5T_NATIVE_UINT8, 0, len, w->ckpt_buf) < 0) {
+    if (h5i_write_rows(w->ckpt_data[slot], H5T_NATIVE_UINT8, 0, len, w->ckpt_zbuf) < 0) {
         w->failed = 1;
         return H5FAIL(err, CDEM_ERR_IO,
                       "%s: cannot write a checkpoint of %zu bytes to /checkpoint/slot%d (disk "
@@ -41,7 +46,8 @@ cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapsh
                       w->path, len, slot);
     }
     CDEM_TRY(h5i_commit_flush(w, err));
-    ckpt_row row = {seq, w->last_number, w->last_step, (int64_t)len, h5i_fnv1a64(w->ckpt_buf, len)};
+    ckpt_row row = {seq, w->last_number, w->last_step, (int64_t)len,
+                    h5i_fnv1a64(w->ckpt_zbuf, len)};
     hsize_t start = (hsize_t)slot, one = 1;
     hid_t fs = H5Dget_space(w->ckpt_index), ms = H5Screate_simple(1, &one, NULL);
     int ok = fs >= 0 && ms >= 0 &&
@@ -104,7 +110,7 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
             continue;
         tried++;
         hsize_t ext = h5i_extent_of(slot[s]);
-        if (rows[s].length < SNAP_HEADER + 8 || (uint64_t)rows[s].length > SNAP_MAX_BYTES ||
+        if (rows[s].length < 16 || (uint64_t)rows[s].length > SNAP_MAX_BYTES ||
             (hsize_t)rows[s].length > ext) {
             snprintf(why[o], sizeof why[o], "slot%d: length %lld does not fit (slot has %llu)", s,
                      (long long)rows[s].length, (unsigned long long)ext);
@@ -128,12 +134,18 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
             snprintf(what, sizeof what, "%s: /checkpoint/slot%d", r->path, s);
             cdem_error e2;
             cdem_error_clear(&e2);
-            if (h5i_snap_decode(buf, len, snap, what, &e2) == CDEM_OK) {
+            const unsigned char *raw = NULL;
+            size_t raw_len = 0;
+            int owned = 0;
+            if (h5i_snap_unpack(buf, len, &raw, &raw_len, &owned, what, &e2) == CDEM_OK &&
+                h5i_snap_decode(raw, raw_len, snap, what, &e2) == CDEM_OK) {
                 found = 1;
                 *increment_number = rows[s].increment;
             } else {
                 snprintf(why[o], sizeof why[o], "%.400s", e2.msg);
             }
+            if (owned)
+                free((void *)raw);
         }
         free(buf);
     }

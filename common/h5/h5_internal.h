@@ -34,7 +34,7 @@
 #define SERIES_BUFFER   256
 #define XMF_EVERY_LIMIT 1000
 #define INDEX_CHUNK     256       /* rows of /increments/index per chunk */
-#define CKPT_CHUNK      (1 << 20) /* bytes of a checkpoint slot per chunk */
+#define CKPT_CHUNK      (1 << 14) /* bytes of a checkpoint slot per chunk (h5_checkpoint.c) */
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
 /* Largest element count an increment may have to be loaded (~2 GB of state; cdem-run's
@@ -210,6 +210,8 @@ struct cdem_h5_writer {
     ckpt_row ckpt[2];               /* the checkpoint index as on disk */
     unsigned char *ckpt_buf;        /* serialised snapshot, grown as needed */
     size_t ckpt_cap;                /* bytes allocated in ckpt_buf */
+    unsigned char *ckpt_zbuf;       /* the same compressed (what a slot holds), grown */
+    size_t ckpt_zcap;               /* bytes allocated in ckpt_zbuf */
     int failed;                     /* 1 after a failed write: the file keeps what it had */
     xmf_entry *entries;             /* one per written increment, in write order */
     size_t n_entries, cap_entries;  /* used / allocated entries */
@@ -294,5 +296,14 @@ cdem_status h5i_snap_encode(const cdem_snapshot *snap, unsigned char **buf, size
 /* Parses a blob into snap (cleared first). what names the blob in messages. */
 cdem_status h5i_snap_decode(const unsigned char *p, size_t len, cdem_snapshot *snap,
                             const char *what, cdem_error *err);
+/* What a checkpoint slot holds: the blob compressed (deflate), behind its own header. Packs
+ * the blob raw[0, raw_len) into *buf (grown, *cap its size; *len the packed length). */
+cdem_status h5i_snap_pack(const unsigned char *raw, size_t raw_len, unsigned char **buf,
+                          size_t *cap, size_t *len, const char *path, cdem_error *err);
+/* The blob of a slot's bytes p[0, len): *raw points into p for an uncompressed blob (files
+ * written before compression) or to a malloc'd copy (*owned = 1, the caller frees it) for a
+ * packed one. CDEM_ERR_FORMAT naming what when the bytes are neither. */
+cdem_status h5i_snap_unpack(const unsigned char *p, size_t len, const unsigned char **raw,
+                            size_t *raw_len, int *owned, const char *what, cdem_error *err);
 
 #endif

@@ -22,7 +22,8 @@ double cdem_h5_estimate_file_size(double n_elements, double n_increments, int wi
 /* Checkpoint and sidecar sizes for cdem_h5_estimate_run_space, measured on cdem-run files
  * (docs/format.md, "Size"): a checkpoint holds about CKPT_BYTES_PER_ELEMENT bytes per
  * element (state, neighbour list, contact histories) plus the parameter text and the
- * summary; a sidecar increment is about XMF_BYTES_PER_INCREMENT bytes of XML. */
+ * summary, before compression: a bound, compressed it is about half (h5_ckpt_codec.c); a
+ * sidecar increment is about XMF_BYTES_PER_INCREMENT bytes of XML. */
 #define CKPT_BYTES_FIXED        65536.0
 #define CKPT_BYTES_PER_ELEMENT  400.0
 #define XMF_BYTES_PER_INCREMENT 3400.0

@@ -145,6 +145,7 @@ void h5i_writer_release(cdem_h5_writer *w) {
     free(w->column);
     free(w->entries);
     free(w->ckpt_buf);
+    free(w->ckpt_zbuf);
     free(w);
 }
 
