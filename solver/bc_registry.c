@@ -66,13 +66,13 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
                           cdem_error *err) {
     if (!bc->ops)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_apply: boundary mode not initialised");
-    if (k <= 0)
-        return bc->ops->equilibrate ? bc->ops->equilibrate(bc->ctx, s, du, dt, err) : CDEM_OK;
-    return bc->ops->apply(bc->ctx, s, k, du, dt, err);
+    if (k <= 0 && !bc->ops->moves_in_equilibration)
+        return CDEM_OK;
+    return bc->ops->apply(bc->ctx, s, k <= 0 ? 0 : k, du, dt, err);
 }
 
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
-    return bc && bc->ops && bc->ops->equilibrate;
+    return bc && bc->ops && bc->ops->moves_in_equilibration;
 }
 
 double cdem_bc_net_displacement(const cdem_bc *bc) {
