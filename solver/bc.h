@@ -11,7 +11,8 @@
  * settings); free (releases what init allocated in the context; NULL: nothing);
  * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
  * of elements to remove, e.g. repose drops its walls; the solver removes them through the
- * escape path, histories of the rest kept); lateral_pressure, measure (optional, see below).
+ * escape path, histories of the rest kept); confined (a flag: the solver loads the free side
+ * edges with boundary.confining_pressure); measure (optional, see below).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
@@ -42,8 +43,10 @@ typedef struct {
     /* may be NULL; keep has s->n entries, all 1 on entry; *n_remove = number cleared */
     cdem_status (*begin_deformation)(void *ctx, const cdem_state *s, unsigned char *keep,
                                      size_t *n_remove, cdem_error *err);
-    /* may be NULL (0): confining pressure in N/m on the free left/right edge elements */
-    double (*lateral_pressure)(const void *ctx);
+    /* 1: the solver applies boundary.confining_pressure (N/m, ramped over equilibration:
+     * cdem_bc_confining_ramp) to the free left/right edge elements (biaxial); 0: no lateral
+     * load */
+    int confined;
     /* may be NULL (both 0): sample = 1 at every time-series sample, after the step's boundary
      * forces are summed (the mode may record them); sample = 0 for an increment (current
      * values from what was recorded, forces not read); step = completed time steps */
@@ -59,8 +62,9 @@ typedef struct {
 
 /* A mode instance: its ops and its private context. */
 typedef struct {
-    const cdem_bc_ops *ops; /* NULL before init */
-    void *ctx;              /* calloc'd state_size bytes */
+    const cdem_bc_ops *ops;  /* NULL before init */
+    void *ctx;               /* calloc'd state_size bytes */
+    double lateral_pressure; /* N/m: boundary.confining_pressure when ops->confined, else 0 */
 } cdem_bc;
 
 /* The ops of a mode; CDEM_ERR_UNSUPPORTED naming the mode and the implemented ones when it
@@ -84,7 +88,7 @@ double cdem_bc_net_displacement(const cdem_bc *bc);
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,
                                       size_t *n_remove, cdem_error *err);
 void cdem_bc_view(const cdem_bc *bc, FILE *out);
-/* The mode's lateral (confining) pressure in N/m; 0 without the hook or bc. */
+/* The mode's lateral (confining) pressure in N/m; 0 for a mode that is not confined or bc. */
 double cdem_bc_lateral_pressure(const cdem_bc *bc);
 /* The mode's measurements at a sample (both 0 without the hook). */
 void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,

@@ -225,10 +225,6 @@ static double biaxial_net(const void *vctx) {
     return ((const biaxial_ctx *)vctx)->closure;
 }
 
-static double biaxial_pressure(const void *vctx) {
-    return ((const biaxial_ctx *)vctx)->pressure;
-}
-
 static void biaxial_measure(void *vctx, const cdem_state *s, long step, int sample,
                             double *axial_strain, double *differential_stress) {
     biaxial_ctx *c = vctx;
@@ -351,19 +347,19 @@ static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_e
 }
 
 static const cdem_bc_ops biaxial_ops = {
-    .name = "biaxial",                    /* name */
-    .state_size = sizeof(biaxial_ctx),    /* state_size */
-    .init = biaxial_init,                 /* adds the top platen */
-    .apply = biaxial_apply,               /* moves both platens (servo in equilibration) */
-    .moves_in_equilibration = 1,          /* servo platens: isotropic start */
-    .net_displacement = biaxial_net,      /* platen closure */
-    .view = biaxial_view,                 /* view */
-    .free = biaxial_free,                 /* averaging buffers */
-    .begin_deformation = biaxial_begin,   /* removes the lateral walls */
-    .lateral_pressure = biaxial_pressure, /* confining pressure */
-    .measure = biaxial_measure,           /* axial strain, differential stress */
-    .save = biaxial_save,                 /* checkpoint: platens, window, reference */
-    .restore = biaxial_restore,           /* resume */
+    .name = "biaxial",                  /* name */
+    .state_size = sizeof(biaxial_ctx),  /* state_size */
+    .init = biaxial_init,               /* adds the top platen */
+    .apply = biaxial_apply,             /* moves both platens (servo in equilibration) */
+    .moves_in_equilibration = 1,        /* servo platens: isotropic start */
+    .net_displacement = biaxial_net,    /* platen closure */
+    .view = biaxial_view,               /* view */
+    .free = biaxial_free,               /* averaging buffers */
+    .begin_deformation = biaxial_begin, /* removes the lateral walls */
+    .confined = 1,                      /* confining pressure on the free side edges */
+    .measure = biaxial_measure,         /* axial strain, differential stress */
+    .save = biaxial_save,               /* checkpoint: platens, window, reference */
+    .restore = biaxial_restore,         /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

@@ -54,6 +54,7 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
     if (!bc->ctx)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the %s boundary mode", ops->name);
     bc->ops = ops;
+    bc->lateral_pressure = ops->confined ? p->confining_pressure : 0.0;
     cdem_status st = ops->init(bc->ctx, p, m, s, err);
     if (st != CDEM_OK) {
         cdem_bc_free(bc);
@@ -96,7 +97,7 @@ void cdem_bc_view(const cdem_bc *bc, FILE *out) {
 }
 
 double cdem_bc_lateral_pressure(const cdem_bc *bc) {
-    return (bc && bc->ops && bc->ops->lateral_pressure) ? bc->ops->lateral_pressure(bc->ctx) : 0.0;
+    return (bc && bc->ops) ? bc->lateral_pressure : 0.0;
 }
 
 void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
@@ -115,6 +116,7 @@ void cdem_bc_free(cdem_bc *bc) {
     free(bc->ctx);
     bc->ctx = NULL;
     bc->ops = NULL;
+    bc->lateral_pressure = 0.0;
 }
 
 cdem_status cdem_bc_find_walls(const cdem_state *s, const cdem_model *m, const char *mode,
