@@ -18,7 +18,7 @@
 
 BUILD   ?= build
 CC      ?= gcc
-PKGS    := hdf5 gsl cairo
+PKGS    := hdf5 gsl cairo zlib
 OPT     ?= -O2
 # The project's flags live in CDEM_CFLAGS; a user's CFLAGS (and CPPFLAGS, LDFLAGS) come
 # after them, so `make CFLAGS=-O1` changes the optimisation (the last -O wins) but never
@@ -49,7 +49,7 @@ INC_tests    := -Icommon -Isolver -Ianalysis
 layer_inc = $(INC_$(firstword $(subst /, ,$(1))))
 compile_flags = $(CDEM_CFLAGS) $(1) $(PKG_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 
-COMMON_SRC   := $(wildcard common/*.c)
+COMMON_SRC   := $(wildcard common/*.c common/h5/*.c)
 SOLVER_SRC   := $(filter-out solver/main.c,$(wildcard solver/*.c))
 ANALYSIS_SRC := $(filter-out analysis/main.c,$(wildcard analysis/*.c))
 TEST_SRC     := $(wildcard tests/test_*.c)
@@ -133,7 +133,7 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
 	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
 
 format:
-	clang-format -i common/*.[ch] solver/*.[ch] analysis/*.[ch] tests/*.[ch] 2>/dev/null || true
+	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*.[ch] tests/*.[ch] 2>/dev/null || true
 
 clean:
 	rm -rf build build-asan build-fuzz

@@ -210,7 +210,7 @@ cdem_status cdem_h5_write_xdmf(const char *h5_path, const char *xmf_path, int fl
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress);
 
 /* Estimated disk space a whole run needs (for the free-space check before it): the file as
- * above, its two checkpoint slots when with_checkpoints (each a whole number of 1 MiB
+ * above, its two checkpoint slots when with_checkpoints (each a whole number of 16 KiB
  * chunks holding one checkpoint of n_elements elements) and the .xmf sidecar, counted twice
  * because it is rewritten through a temporary copy. */
 double cdem_h5_estimate_run_space(double n_elements, double n_increments, int with_stress,

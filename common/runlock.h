@@ -14,7 +14,7 @@
  *  - the kernel releases the lock when its holder dies, so a killed run never leaves a stale
  *    lock, only a stale PATH.lock file that the next holder reuses (and that readers ignore:
  *    a lock file that nobody holds means "no live writer").
- * A reader asks cdem_runlock_probe whether a writer is alive (common/h5format.c opens a file
+ * A reader asks cdem_runlock_probe whether a writer is alive (common/h5/h5_reader.c opens a file
  * whose writer is alive in SWMR-read mode, a finished or abandoned one as a complete file).
  * Filesystems without lock support (ENOLCK, EINVAL: some network mounts) give a handle that
  * locks nothing (cdem_runlock_effective returns 0) rather than refusing to run.

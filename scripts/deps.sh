@@ -4,7 +4,7 @@
 set -eu
 # clang, libclang-rt-14-dev (libFuzzer + sanitizer runtimes) and libomp-14-dev (OpenMP for
 # clang) are for `make fuzz` only (tests/fuzz/README.md).
-PKGS="gcc make pkg-config libhdf5-dev hdf5-tools libgsl-dev libcairo2-dev libcmocka-dev \
+PKGS="gcc make pkg-config libhdf5-dev zlib1g-dev hdf5-tools libgsl-dev libcairo2-dev libcmocka-dev \
 libgif-dev libxml2-utils python3 python3-numpy python3-scipy python3-h5py \
 clang libclang-rt-14-dev libomp-14-dev \
     python3-pil"  # python3-pil: examples/montage.py tiles the example figures

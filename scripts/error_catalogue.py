@@ -12,6 +12,9 @@ import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 
+# The run file's implementation, one file per concept (common/h5/h5_internal.h)
+H5_SOURCES = sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "common/h5/*.c")))
+
 GROUPS = [  # (title, source files, what to do)
     ("Parameter files and -s overrides", ["common/params.c", "common/model.c", "common/summary.c"],
      "The message names the file, line, key and value and says what is allowed: correct that "
@@ -31,7 +34,7 @@ GROUPS = [  # (title, source files, what to do)
      "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
      "`keep_constants = off` at small unit scaling or use the default constants; "
      "\"settling > displacement\" gives the display_interval and equilibration that work."),
-    ("cdem (HDF5) files", ["common/h5format.c", "common/state.c", "common/runlock.c",
+    ("cdem (HDF5) files", [*H5_SOURCES, "common/state.c", "common/runlock.c",
                            "common/xdmf.c", "common/outfile.c"],
      "The file is not a cdem file, is damaged (a checksum failed: copy it again or re-run) or "
      "truncated (cut short by a full disk or an interrupted copy), of another format version "
@@ -124,7 +127,8 @@ def show(fmt):
 
 
 def main():
-    files = sorted(glob.glob(os.path.join(ROOT, d, "*.c")) for d in ("common", "solver", "analysis"))
+    files = sorted(glob.glob(os.path.join(ROOT, d, "*.c"))
+                   for d in ("common", "common/h5", "solver", "analysis"))
     files = [f for group in files for f in group]
     rows = {}
     for path in files:

@@ -5,12 +5,14 @@
  * by cdem_bc_init); init (after the assembly is built: add/flag the mode's boundary elements
  * CDEM_FLAG_WALL / FAULT / MOVING, record its geometry); apply (deformation step k, 1-based:
  * move the prescribed elements by this step's boundary increment du, sense decided by the
- * mode, and set their velocity to the boundary velocity; walls never move otherwise);
+ * mode, and set their velocity to the boundary velocity; walls never move otherwise; a mode
+ * with moves_in_equilibration = 1 is also called on every equilibration step, with k = 0);
  * net_displacement (m, of the moving boundary so far); view (one paragraph of the effective
  * settings); free (releases what init allocated in the context; NULL: nothing);
  * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
  * of elements to remove, e.g. repose drops its walls; the solver removes them through the
- * escape path, histories of the rest kept); lateral_pressure, measure (optional, see below).
+ * escape path, histories of the rest kept); confined (a flag: the solver loads the free side
+ * edges with boundary.confining_pressure); measure (optional, see below).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
@@ -30,14 +32,21 @@ typedef struct {
     cdem_status (*init)(void *ctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
                         cdem_error *err);
     cdem_status (*apply)(void *ctx, cdem_state *s, long k, double du, double dt, cdem_error *err);
+    /* 1: the mode also moves boundaries during equilibration: apply is then called on every
+     * equilibration step with k = 0, after the drift, with s->fx/fy of the boundary elements
+     * holding their contact forces of the previous step (biaxial servo platens); 0: apply
+     * sees only deformation steps (k >= 1) */
+    int moves_in_equilibration;
     double (*net_displacement)(const void *ctx);
     void (*view)(const void *ctx, FILE *out);
     void (*free)(void *ctx); /* may be NULL when the context owns no memory */
     /* may be NULL; keep has s->n entries, all 1 on entry; *n_remove = number cleared */
     cdem_status (*begin_deformation)(void *ctx, const cdem_state *s, unsigned char *keep,
                                      size_t *n_remove, cdem_error *err);
-    /* may be NULL (0): confining pressure in N/m on the free left/right edge elements */
-    double (*lateral_pressure)(const void *ctx);
+    /* 1: the solver applies boundary.confining_pressure (N/m, ramped over equilibration:
+     * cdem_bc_confining_ramp) to the free left/right edge elements (biaxial); 0: no lateral
+     * load */
+    int confined;
     /* may be NULL (both 0): sample = 1 at every time-series sample, after the step's boundary
      * forces are summed (the mode may record them); sample = 0 for an increment (current
      * values from what was recorded, forces not read); step = completed time steps */
@@ -49,16 +58,13 @@ typedef struct {
      * init; a stored one that differs fails with CDEM_ERR_CONFLICT) */
     cdem_status (*save)(const void *ctx, cdem_snapshot *snap, cdem_error *err);
     cdem_status (*restore)(void *ctx, const cdem_snapshot *snap, cdem_error *err);
-    /* may be NULL (boundaries still in equilibration): called on every equilibration step
-     * (cdem_bc_apply with k = 0), after the drift, with s->fx/fy of the boundary elements
-     * holding their contact forces of the previous step; du, dt as for apply */
-    cdem_status (*equilibrate)(void *ctx, cdem_state *s, double du, double dt, cdem_error *err);
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
 typedef struct {
-    const cdem_bc_ops *ops; /* NULL before init */
-    void *ctx;              /* calloc'd state_size bytes */
+    const cdem_bc_ops *ops;  /* NULL before init */
+    void *ctx;               /* calloc'd state_size bytes */
+    double lateral_pressure; /* N/m: boundary.confining_pressure when ops->confined, else 0 */
 } cdem_bc;
 
 /* The ops of a mode; CDEM_ERR_UNSUPPORTED naming the mode and the implemented ones when it
@@ -72,17 +78,17 @@ const char *cdem_bc_implemented(void);
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          cdem_error *err);
 /* k >= 1: the mode's apply (deformation step k); k <= 0: an equilibration step, the mode's
- * equilibrate hook (nothing without one). */
+ * apply with k = 0 when it moves boundaries in equilibration (nothing otherwise). */
 cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
                           cdem_error *err);
-/* 1 when the mode moves boundaries during equilibration (has an equilibrate hook). */
+/* 1 when the mode moves boundaries during equilibration (ops->moves_in_equilibration). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
 double cdem_bc_net_displacement(const cdem_bc *bc);
 /* Runs the mode's begin_deformation hook (none: *n_remove = 0, keep untouched). */
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,
                                       size_t *n_remove, cdem_error *err);
 void cdem_bc_view(const cdem_bc *bc, FILE *out);
-/* The mode's lateral (confining) pressure in N/m; 0 without the hook or bc. */
+/* The mode's lateral (confining) pressure in N/m; 0 for a mode that is not confined or bc. */
 double cdem_bc_lateral_pressure(const cdem_bc *bc);
 /* The mode's measurements at a sample (both 0 without the hook). */
 void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,

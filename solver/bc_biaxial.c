@@ -4,7 +4,7 @@
  * the base length beyond each end and are CDEM_FLAG_MOVING. Platen contacts are wall-class
  * contacts (material.wall_*), as in every mode. Equilibration: the lateral walls
  * hold the sample while the solver ramps the confining pressure p on the free edges from 0 at
- * mid-equilibration to full at its end; the platens are servo-controlled (equilibrate) to
+ * mid-equilibration to full at its end; the platens are servo-controlled (apply, k = 0) to
  * carry the same ramped pressure, so the sample starts isotropic. Deformation: the lateral
  * walls are removed; each platen moves inward at half the boundary speed (closure per step =
  * du = net displacement). Measurements (each time-series sample): axial strain = closure / H0
@@ -124,10 +124,14 @@ static cdem_status biaxial_init(void *vctx, const cdem_params *p, const cdem_mod
     return CDEM_OK;
 }
 
+static cdem_status biaxial_equilibrate(void *vctx, cdem_state *s, double du, double dt,
+                                       cdem_error *err);
+
+/* k >= 1: a deformation step; k = 0: an equilibration step (moves_in_equilibration). */
 static cdem_status biaxial_apply(void *vctx, cdem_state *s, long k, double du, double dt,
                                  cdem_error *err) {
-    (void)k;
-    (void)err;
+    if (k <= 0)
+        return biaxial_equilibrate(vctx, s, du, dt, err);
     biaxial_ctx *c = vctx;
     const double h = 0.5 * du, v = dt > 0.0 ? h / dt : 0.0;
     for (size_t i = 0; i < s->n; i++) {
@@ -219,10 +223,6 @@ static cdem_status biaxial_begin(void *vctx, const cdem_state *s, unsigned char 
 
 static double biaxial_net(const void *vctx) {
     return ((const biaxial_ctx *)vctx)->closure;
-}
-
-static double biaxial_pressure(const void *vctx) {
-    return ((const biaxial_ctx *)vctx)->pressure;
 }
 
 static void biaxial_measure(void *vctx, const cdem_state *s, long step, int sample,
@@ -347,19 +347,19 @@ static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_e
 }
 
 static const cdem_bc_ops biaxial_ops = {
-    .name = "biaxial",                    /* name */
-    .state_size = sizeof(biaxial_ctx),    /* state_size */
-    .init = biaxial_init,                 /* adds the top platen */
-    .apply = biaxial_apply,               /* moves both platens */
-    .net_displacement = biaxial_net,      /* platen closure */
-    .view = biaxial_view,                 /* view */
-    .free = biaxial_free,                 /* averaging buffers */
-    .begin_deformation = biaxial_begin,   /* removes the lateral walls */
-    .lateral_pressure = biaxial_pressure, /* confining pressure */
-    .measure = biaxial_measure,           /* axial strain, differential stress */
-    .save = biaxial_save,                 /* checkpoint: platens, window, reference */
-    .restore = biaxial_restore,           /* resume */
-    .equilibrate = biaxial_equilibrate,   /* servo platens: isotropic start */
+    .name = "biaxial",                  /* name */
+    .state_size = sizeof(biaxial_ctx),  /* state_size */
+    .init = biaxial_init,               /* adds the top platen */
+    .apply = biaxial_apply,             /* moves both platens (servo in equilibration) */
+    .moves_in_equilibration = 1,        /* servo platens: isotropic start */
+    .net_displacement = biaxial_net,    /* platen closure */
+    .view = biaxial_view,               /* view */
+    .free = biaxial_free,               /* averaging buffers */
+    .begin_deformation = biaxial_begin, /* removes the lateral walls */
+    .confined = 1,                      /* confining pressure on the free side edges */
+    .measure = biaxial_measure,         /* axial strain, differential stress */
+    .save = biaxial_save,               /* checkpoint: platens, window, reference */
+    .restore = biaxial_restore,         /* resume */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

@@ -54,6 +54,7 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
     if (!bc->ctx)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the %s boundary mode", ops->name);
     bc->ops = ops;
+    bc->lateral_pressure = ops->confined ? p->confining_pressure : 0.0;
     cdem_status st = ops->init(bc->ctx, p, m, s, err);
     if (st != CDEM_OK) {
         cdem_bc_free(bc);
@@ -66,13 +67,13 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
                           cdem_error *err) {
     if (!bc->ops)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_apply: boundary mode not initialised");
-    if (k <= 0)
-        return bc->ops->equilibrate ? bc->ops->equilibrate(bc->ctx, s, du, dt, err) : CDEM_OK;
-    return bc->ops->apply(bc->ctx, s, k, du, dt, err);
+    if (k <= 0 && !bc->ops->moves_in_equilibration)
+        return CDEM_OK;
+    return bc->ops->apply(bc->ctx, s, k <= 0 ? 0 : k, du, dt, err);
 }
 
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
-    return bc && bc->ops && bc->ops->equilibrate;
+    return bc && bc->ops && bc->ops->moves_in_equilibration;
 }
 
 double cdem_bc_net_displacement(const cdem_bc *bc) {
@@ -96,7 +97,7 @@ void cdem_bc_view(const cdem_bc *bc, FILE *out) {
 }
 
 double cdem_bc_lateral_pressure(const cdem_bc *bc) {
-    return (bc && bc->ops && bc->ops->lateral_pressure) ? bc->ops->lateral_pressure(bc->ctx) : 0.0;
+    return (bc && bc->ops) ? bc->lateral_pressure : 0.0;
 }
 
 void cdem_bc_measure(cdem_bc *bc, const cdem_state *s, long step, int sample, double *axial_strain,
@@ -115,6 +116,7 @@ void cdem_bc_free(cdem_bc *bc) {
     free(bc->ctx);
     bc->ctx = NULL;
     bc->ops = NULL;
+    bc->lateral_pressure = 0.0;
 }
 
 cdem_status cdem_bc_find_walls(const cdem_state *s, const cdem_model *m, const char *mode,

@@ -1,7 +1,7 @@
-/* Tests of the HDF5 element-state format (common/h5format.c): round trips of every field,
- * variable element counts, optional stress, error handling of foreign, wrong-version,
- * truncated and corrupt files, increment look-up, a writer killed mid-run, the size of a
- * realistic run and the XDMF sidecar. Files go to $CDEM_TEST_TMP (default /tmp). */
+/* Tests of the HDF5 element-state format (common/h5format.h, implemented in common/h5/): round
+ * trips of every field, variable element counts, optional stress, error handling of foreign,
+ * wrong-version, truncated and corrupt files, increment look-up, a writer killed mid-run, the size
+ * of a realistic run and the XDMF sidecar. Files go to $CDEM_TEST_TMP (default /tmp). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -22,6 +22,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -1572,6 +1573,23 @@ static void test_format_checkpoint_roundtrip(void **state) {
     remove_pair(path);
 }
 
+/* The extent (bytes) of /checkpoint/slot<slot>. */
+static hsize_t slot_extent(const char *path, int slot) {
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(f >= 0);
+    char name[32];
+    snprintf(name, sizeof name, "checkpoint/slot%d", slot);
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    assert_true(ds >= 0);
+    hid_t sp = H5Dget_space(ds);
+    hsize_t n = 0;
+    H5Sget_simple_extent_dims(sp, &n, NULL);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    H5Fclose(f);
+    return n;
+}
+
 /* Overwrites bytes [at, at + n) of /checkpoint/slot<slot> with pattern (HDF5 API). */
 static void scribble_slot(const char *path, int slot, hsize_t at, hsize_t n,
                           unsigned char pattern) {
@@ -1613,7 +1631,8 @@ static void test_format_checkpoint_torn(void **state) {
         if (variant == 0)
             scribble_slot(path, 1, 100, 1, 0x5a); /* one corrupt byte in the newest */
         else if (variant == 1)
-            scribble_slot(path, 1, 0, 2000, 0xff); /* a new blob half-written over it */
+            /* a new blob half-written over it */
+            scribble_slot(path, 1, 0, slot_extent(path, 1) / 2, 0xff);
         else
             scribble_slot(path, 1, 30, 8, 0x00); /* zeros in an array name/length */
         assert_checkpoint(path, 1);
@@ -1633,6 +1652,143 @@ static void test_format_checkpoint_torn(void **state) {
     assert_int_equal(inc, -1);
     cdem_snapshot_free(snap);
     cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
+/* FNV-1a 64, as the writer checksums a slot (docs/format.md, "Checkpoints"). */
+static uint64_t fnv1a64(const unsigned char *p, size_t n) {
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+/* Checkpoint slots hold the blob compressed ("CDEMSNPZ" | u64 blob length | zlib stream),
+ * rewritten in place: a run with a checkpoint after each of 20 increments is no bigger than
+ * one with 2 checkpoints (a filtered HDF5 chunk would move at each rewrite, and SWMR never
+ * frees the old place), and each slot is one 16 KiB chunk for this small snapshot. */
+static void test_format_checkpoint_compressed_in_place(void **state) {
+    (void)state;
+    char few[1024], many[1024];
+    scratch_path(few, sizeof few, "ckpt-few.h5");
+    scratch_path(many, sizeof many, "ckpt-many.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_error err;
+    int every[20];
+    for (int k = 0; k < 20; k++)
+        every[k] = k;
+    const int last_two[] = {18, 19};
+    for (int variant = 0; variant < 2; variant++) {
+        cdem_h5_writer *w = NULL;
+        assert_int_equal(cdem_h5_writer_create(variant ? many : few, &meta, &w, &err), CDEM_OK);
+        write_with_checkpoints(w, 0, 20, variant ? every : last_two, variant ? 20 : 2);
+        assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    }
+    assert_checkpoint(many, 19);
+    long size_few = file_size(few), size_many = file_size(many);
+    printf("20 increments: %ld bytes with 2 checkpoints, %ld with 20\n", size_few, size_many);
+    assert_true(size_many <= size_few + 4096);
+
+    hid_t f = H5Fopen(many, H5F_ACC_RDONLY, H5P_DEFAULT);
+    assert_true(f >= 0);
+    cdem_snapshot *snap = make_snapshot(19);
+    size_t raw = 24 + 8; /* the blob: header, arrays, checksum (h5_ckpt_codec.c) */
+    for (size_t i = 0; i < cdem_snapshot_count(snap); i++) {
+        const cdem_snapshot_array *a = cdem_snapshot_at(snap, i);
+        raw += 2 + strlen(a->name) + 1 + 8 + a->count * cdem_snapshot_type_size(a->type);
+    }
+    for (int s = 0; s < 2; s++) {
+        char name[32];
+        snprintf(name, sizeof name, "checkpoint/slot%d", s);
+        hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+        assert_true(ds >= 0);
+        hsize_t n = 0;
+        unsigned char head[16];
+        hid_t sp = H5Dget_space(ds), ms = H5Screate_simple(1, (hsize_t[]){16}, NULL);
+        H5Sget_simple_extent_dims(sp, &n, NULL);
+        assert_true(n > 16 && n < raw); /* compressed */
+        assert_true(H5Sselect_hyperslab(sp, H5S_SELECT_SET, (hsize_t[]){0}, NULL, (hsize_t[]){16},
+                                        NULL) >= 0);
+        assert_true(H5Dread(ds, H5T_NATIVE_UINT8, ms, sp, H5P_DEFAULT, head) >= 0);
+        assert_memory_equal(head, "CDEMSNPZ", 8);
+        uint64_t blob = 0;
+        for (int i = 7; i >= 0; i--)
+            blob = (blob << 8) | head[8 + i];
+        assert_int_equal(blob, raw);
+        assert_int_equal(H5Dget_storage_size(ds), 16384);
+        H5Sclose(ms);
+        H5Sclose(sp);
+        H5Dclose(ds);
+    }
+    cdem_snapshot_free(snap);
+    H5Fclose(f);
+    remove_pair(few);
+    remove_pair(many);
+}
+
+/* A file written before checkpoints were compressed holds the bare "CDEMSNAP" blob in its
+ * slot: still read (the slot is rewritten here the way such a writer left it). */
+static void test_format_checkpoint_reads_uncompressed(void **state) {
+    (void)state;
+    char path[1024];
+    scratch_path(path, sizeof path, "ckpt-raw.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_error err;
+    cdem_h5_writer *w = NULL;
+    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+    const int after[] = {1};
+    write_with_checkpoints(w, 0, 3, after, 1);
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    hid_t ds = H5Dopen2(f, "checkpoint/slot0", H5P_DEFAULT);
+    assert_true(ds >= 0);
+    hsize_t n = 0;
+    hid_t sp = H5Dget_space(ds);
+    H5Sget_simple_extent_dims(sp, &n, NULL);
+    H5Sclose(sp);
+    unsigned char *packed = malloc(n);
+    assert_true(H5Dread(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, packed) >= 0);
+    assert_memory_equal(packed, "CDEMSNPZ", 8);
+    uLongf raw_len = 0;
+    for (int i = 7; i >= 0; i--)
+        raw_len = (raw_len << 8) | packed[8 + i];
+    unsigned char *raw = malloc(raw_len);
+    uLongf got = raw_len;
+    assert_int_equal(uncompress(raw, &got, packed + 16, (uLong)(n - 16)), Z_OK);
+    assert_int_equal(got, raw_len);
+    assert_memory_equal(raw, "CDEMSNAP", 8);
+    hsize_t len = raw_len;
+    assert_true(H5Dset_extent(ds, &len) >= 0);
+    assert_true(H5Dwrite(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw) >= 0);
+    H5Dclose(ds);
+    /* the index row of slot 0: length and checksum of the bytes now in the slot */
+    hid_t ix = H5Dopen2(f, "checkpoint/index", H5P_DEFAULT);
+    assert_true(ix >= 0);
+    hid_t ct = H5Tcreate(H5T_COMPOUND, 2 * sizeof(int64_t));
+    H5Tinsert(ct, "length", 0, H5T_NATIVE_INT64);
+    H5Tinsert(ct, "checksum", sizeof(int64_t), H5T_NATIVE_UINT64);
+    struct {
+        int64_t length;
+        uint64_t checksum;
+    } rows[2];
+    assert_true(H5Dread(ix, ct, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
+    rows[0].length = (int64_t)raw_len;
+    rows[0].checksum = fnv1a64(raw, raw_len);
+    assert_true(H5Dwrite(ix, ct, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
+    H5Tclose(ct);
+    H5Dclose(ix);
+    H5Fclose(f);
+    free(packed);
+    free(raw);
+    assert_checkpoint(path, 1);
     remove_pair(path);
 }
 
@@ -2187,6 +2343,8 @@ int main(void) {
         cmocka_unit_test(test_format_reads_version_1),
         cmocka_unit_test(test_format_checkpoint_roundtrip),
         cmocka_unit_test(test_format_checkpoint_torn),
+        cmocka_unit_test(test_format_checkpoint_compressed_in_place),
+        cmocka_unit_test(test_format_checkpoint_reads_uncompressed),
         cmocka_unit_test(test_format_reopen_truncate_append),
         cmocka_unit_test(test_format_swmr_live_refresh),
         cmocka_unit_test(test_format_write_failure_keeps_increments),

@@ -1,8 +1,8 @@
-/* fuzz_h5: the HDF5 element-state reader (common/h5format.c, reader API only). The input is
- * written to a temporary file, which is opened and read the way cdem-strain and cdem-run
- * --resume do: every increment's info, find_increment for each spec form, every increment
- * loaded, the time series, the parameter record, the newest checkpoint, a refresh and the
- * stored texts. Invariants checked: loaded states hold the element count their info
+/* fuzz_h5: the HDF5 element-state reader (common/h5/h5_reader*.c and h5_checkpoint.c, reader
+ * API only). The input is written to a temporary file, which is opened and read the way
+ * cdem-strain and cdem-run --resume do: every increment's info, find_increment for each spec form,
+ * every increment loaded, the time series, the parameter record, the newest checkpoint, a refresh
+ * and the stored texts. Invariants checked: loaded states hold the element count their info
  * announces; failures carry a message. Nobody holds the file's lock, so a file marked as
  * being written is read as a complete one, like a killed run's (no SWMR retries: a damaged
  * one once hung the reader). HDF5 itself is not instrumented, so coverage guidance comes

@@ -1,0 +1,348 @@
+/* h5_writer: appending to a run file that h5_create.c made (or h5_resume.c re-opened):
+ * increments, time-series samples, the stop reason, and the close.
+ * The commit protocol (docs/reliability.md, "Power cuts"): an increment's data is written,
+ * flushed and synced (fdatasync), and only then its row of /increments/index, flushed and
+ * synced again: the index row is the commit record, so a writer killed at any moment (or a
+ * power cut) leaves every committed increment readable and never a row pointing at data
+ * that is not there. All objects exist before SWMR writing starts (HDF5 1.10 forbids
+ * creating objects in SWMR-write mode); from then on the file is only appended to.
+ * append_series is called from the time-step loop: it never allocates (fixed buffer).
+ * After a failed write (disk full) the writer refuses further writes and close leaves the
+ * file as a killed writer would (closing would rewrite the superblock with an end-of-file
+ * the disk cannot hold). */
+#include "h5_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+cdem_status h5i_flush_file(cdem_h5_writer *w, cdem_error *err) {
+    if (H5Fflush(w->file, H5F_SCOPE_GLOBAL) < 0) {
+        w->failed = 1;
+        if (!w->placed)
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot create the run file: writing it (as %s.creating) failed "
+                          "(disk full?); that temporary file was removed and nothing was "
+                          "replaced",
+                          w->path, w->path);
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot flush the file (disk full?); the file keeps the %llu "
+                      "increments completed before",
+                      w->path, (unsigned long long)w->index_len);
+    }
+    return CDEM_OK;
+}
+
+/* H5Fflush hands the bytes to the operating system, which may keep them in memory for
+ * seconds: a killed process loses nothing, a power cut may lose the commit record or, worse,
+ * keep the record and lose the data it points to (the kernel writes pages in any order).
+ * A sync after the data and again after the record orders them on the disk. fdatasync, not
+ * fsync: it writes the data and the metadata needed to read it back (the file's size), not
+ * the time stamps, which saves a journal commit where nothing else changed. */
+static cdem_status sync_file(cdem_h5_writer *w, cdem_error *err) {
+    if (!w->sync)
+        return CDEM_OK;
+    void *handle = NULL;
+    if (H5Fget_vfd_handle(w->file, H5P_DEFAULT, &handle) < 0 || !handle) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot reach the file's descriptor to flush it to disk; the file keeps "
+                      "the %llu increments completed before",
+                      w->path, (unsigned long long)w->index_len);
+    }
+    int fd = *(int *)handle; /* the default (sec2) driver's handle is its descriptor */
+    if (fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+        w->failed = 1;
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: cannot flush the file to disk: %s; the file keeps the %llu "
+                         "increments committed before",
+                         w->path, strerror(errno), (unsigned long long)w->index_len);
+    }
+    return CDEM_OK;
+}
+
+/* h5i_flush_file, then to stable storage when durability is on. */
+cdem_status h5i_commit_flush(cdem_h5_writer *w, cdem_error *err) {
+    CDEM_TRY(h5i_flush_file(w, err));
+    return sync_file(w, err);
+}
+
+/* After a rename, the directory entry is durable only once the folder is synced. */
+void h5i_sync_folder_of(const char *path) {
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        if (fsync(fd) != 0)
+            errno = 0; /* best effort: some filesystems refuse fsync on folders */
+        close(fd);
+    }
+}
+
+void cdem_h5_writer_set_sync(cdem_h5_writer *w, int sync) {
+    if (w)
+        w->sync = sync ? 1 : 0;
+}
+
+static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
+    if (w->nbuf == 0)
+        return CDEM_OK;
+    for (size_t c = 0; c < N_SERIES; c++) {
+        const series_column *col = &h5i_series_columns[c];
+        for (size_t i = 0; i < w->nbuf; i++) {
+            const char *src = (const char *)&w->buf[i] + col->offset;
+            memcpy((char *)w->column + i * 8, src, 8);
+        }
+        if (h5i_write_rows(w->series[c],
+                           col->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE,
+                           w->series_len, w->nbuf, w->column) < 0) {
+            w->failed = 1;
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot append %zu samples to /series/%s (disk full?)", w->path,
+                          w->nbuf, col->name);
+        }
+    }
+    w->series_len += w->nbuf;
+    w->nbuf = 0;
+    return CDEM_OK;
+}
+
+void h5i_writer_release(cdem_h5_writer *w) {
+    hid_t ds[N_SERIES + N_ELEMENT_FIELDS + 6];
+    size_t n = 0;
+    for (size_t c = 0; c < N_SERIES; c++)
+        ds[n++] = w->series[c];
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        ds[n++] = w->data[k];
+    ds[n++] = w->index;
+    ds[n++] = w->stop_reason;
+    ds[n++] = w->stop_detail;
+    ds[n++] = w->ckpt_data[0];
+    ds[n++] = w->ckpt_data[1];
+    ds[n++] = w->ckpt_index;
+    for (size_t i = 0; i < n; i++)
+        if (ds[i] >= 0)
+            H5Dclose(ds[i]);
+    if (w->index_mtype >= 0)
+        H5Tclose(w->index_mtype);
+    if (w->ckpt_mtype >= 0)
+        H5Tclose(w->ckpt_mtype);
+    if (w->file >= 0)
+        H5Fclose(w->file);
+    cdem_runlock_release(w->lock); /* last: nothing of ours is touched after this */
+    free(w->path);
+    free(w->xmf_path);
+    free(w->buf);
+    free(w->column);
+    free(w->entries);
+    free(w->ckpt_buf);
+    free(w->ckpt_zbuf);
+    free(w);
+}
+
+cdem_status h5i_grow_entries(cdem_h5_writer *w, cdem_error *err) {
+    if (w->n_entries < w->cap_entries)
+        return CDEM_OK;
+    size_t cap = w->cap_entries ? 2 * w->cap_entries : 64;
+    xmf_entry *e = realloc(w->entries, cap * sizeof *e);
+    if (!e)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory listing %zu increments", cap);
+    w->entries = e;
+    w->cap_entries = cap;
+    return CDEM_OK;
+}
+
+cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increment_info *info,
+                                           const cdem_state *s, cdem_error *err) {
+    if (!w || !info || !s)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_h5_writer_write_increment: writer, info and state are required");
+    if (info->number < 0)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: increment number %d is negative", w->path,
+                         (int)info->number);
+    int missing = 0;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+        missing |= (!h5i_element_fields[k].optional || s->has_stress) && !h5i_element_array(s, k);
+    if (s->n > 0 && missing)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: increment %d: the state has %zu elements but missing arrays", w->path,
+                         (int)info->number, s->n);
+    if (info->number <= w->last_number)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: increment %d was already written or is out of order (the last "
+                         "written is %d; numbers must increase)",
+                         w->path, (int)info->number, (int)w->last_number);
+    if (w->failed)
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: an earlier write failed; increment %d is not written (the file "
+                         "keeps the %llu increments before)",
+                         w->path, (int)info->number, (unsigned long long)w->index_len);
+    CDEM_TRY(h5i_grow_entries(w, err));
+    CDEM_TRY(flush_series(w, err));
+    /* The data first, then (after a flush) the index row: the index is the commit record. */
+    const hsize_t n = s->n;
+    const int stress = s->has_stress && n > 0;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+        const element_field *fd = &h5i_element_fields[k];
+        if (fd->optional && !stress)
+            continue;
+        hsize_t start = fd->optional ? w->stress_len : w->data_len;
+        if (h5i_write_rows(w->data[k], h5i_el_mem_type(fd->type), start, n,
+                           h5i_element_array(s, k)) < 0) {
+            w->failed = 1;
+            return H5FAIL(err, CDEM_ERR_IO,
+                          "%s: cannot write increment %d to /increments/%s (%llu values; disk "
+                          "full?); the file keeps the %llu increments before",
+                          w->path, (int)info->number, fd->name, (unsigned long long)n,
+                          (unsigned long long)w->index_len);
+        }
+    }
+    CDEM_TRY(h5i_commit_flush(w, err)); /* the data is on disk before the record points to it */
+    index_row row = {
+        .number = info->number,
+        .phase = info->phase,
+        .step = info->step,
+        .time = info->time,
+        .net_displacement = info->net_displacement,
+        .axial_strain = info->axial_strain,
+        .differential_stress = info->differential_stress,
+        .sea_level = info->sea_level,
+        .offset = n ? (int64_t)w->data_len : (int64_t)w->data_ext,
+        .n = (int64_t)n,
+        .has_stress = stress,
+        .stress_offset = stress ? (int64_t)w->stress_len : -1,
+    };
+    if (h5i_write_rows(w->index, w->index_mtype, w->index_len, 1, &row) < 0) {
+        w->failed = 1;
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot write the index row of increment %d (disk full?); the file "
+                      "keeps the %llu increments before",
+                      w->path, (int)info->number, (unsigned long long)w->index_len);
+    }
+    CDEM_TRY(h5i_commit_flush(w, err));
+    w->index_len++;
+    if (n) {
+        w->data_ext = w->data_len + n;
+        w->data_len = h5i_chunk_end(w->data_ext);
+    }
+    if (stress) {
+        w->stress_ext = w->stress_len + n;
+        w->stress_len = h5i_chunk_end(w->stress_ext);
+    }
+    w->last_number = info->number;
+    w->last_step = info->step;
+    w->entries[w->n_entries++] =
+        (xmf_entry){info->number, info->time, (int64_t)n, stress, row.offset, row.stress_offset};
+    /* Rewriting the whole sidecar costs O(increments); past XMF_EVERY_LIMIT increments it is
+     * rewritten only when 5 % more have accumulated (and at close), so a run's total
+     * sidecar I/O stays linear in its length. */
+    if (w->n_entries <= XMF_EVERY_LIMIT || w->n_entries - w->xmf_written >= w->n_entries / 20)
+        return h5i_write_xmf(w, err);
+    return CDEM_OK;
+}
+
+cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sample *sample,
+                                         cdem_error *err) {
+    if (!w || !sample)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_h5_writer_append_series: writer and sample are required");
+    if (w->nbuf == SERIES_BUFFER) {
+        if (w->failed)
+            return CDEM_FAIL(err, CDEM_ERR_IO, "%s: an earlier write failed; no more samples",
+                             w->path);
+        CDEM_TRY(flush_series(w, err));
+    }
+    w->buf[w->nbuf++] = *sample;
+    return CDEM_OK;
+}
+
+cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason,
+                                           const char *detail, cdem_error *err) {
+    if (!w)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_writer_set_stop_reason: no writer");
+    /* Preallocated datasets: overwriting them needs no new file space (works on a full
+     * disk). The detail is cut to STOP_DETAIL_LEN - 1 bytes. */
+    if (h5i_write_fixed_string(w->stop_detail, STOP_DETAIL_LEN, detail) < 0 ||
+        h5i_write_fixed_string(w->stop_reason, STOP_REASON_LEN, reason) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot write the stop reason '%s'", w->path,
+                      reason ? reason : "");
+    if (H5Dflush(w->stop_detail) < 0 || H5Dflush(w->stop_reason) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s'", w->path,
+                      reason ? reason : "");
+    /* not sync_file: after a failed write it would mark nothing new, and w->failed must not
+     * turn a recorded stop reason into an error */
+    if (w->sync && !w->failed) {
+        void *handle = NULL;
+        if (H5Fget_vfd_handle(w->file, H5P_DEFAULT, &handle) >= 0 && handle &&
+            fdatasync(*(int *)handle) != 0 && errno != EINVAL && errno != EROFS)
+            return CDEM_FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s' to disk: %s",
+                             w->path, reason ? reason : "", strerror(errno));
+        H5Eclear2(H5E_DEFAULT);
+    }
+    return CDEM_OK;
+}
+
+cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
+    if (!w)
+        return CDEM_OK;
+    cdem_status st = w->failed ? CDEM_OK : flush_series(w, err);
+    if (st == CDEM_OK && w->xmf_written != w->n_entries)
+        st = h5i_write_xmf(w, err);
+    hid_t file = w->file;
+    w->file = -1;
+    hid_t es = -1;
+    if (file >= 0 && w->failed) {
+        /* After a failed write (disk full) the file is left as a killed writer leaves it:
+         * closing would rewrite the superblock with an end-of-file the disk cannot hold
+         * (the file then reads as truncated) and HDF5 1.10.8 crashes later on the
+         * half-closed file. Its handles are abandoned (this process is about to stop);
+         * every committed increment and the stop reason are already on disk. */
+        for (size_t c = 0; c < N_SERIES; c++)
+            w->series[c] = -1;
+        for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
+            w->data[k] = -1;
+        w->index = w->stop_reason = w->stop_detail = w->ckpt_index = -1;
+        w->ckpt_data[0] = w->ckpt_data[1] = -1;
+        if (st == CDEM_OK)
+            st = CDEM_FAIL(err, CDEM_ERR_IO,
+                           "%s: left unfinished after a failed write; it keeps its %llu "
+                           "complete increments (readable like the file of a killed run)",
+                           w->path, (unsigned long long)w->index_len);
+        file = -1;
+    }
+    if (file >= 0) {
+        /* Close the datasets first so that H5Fclose really closes the file. */
+        for (size_t c = 0; c < N_SERIES; c++) {
+            if (w->series[c] >= 0)
+                H5Dclose(w->series[c]);
+            w->series[c] = -1;
+        }
+        for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+            if (w->data[k] >= 0)
+                H5Dclose(w->data[k]);
+            w->data[k] = -1;
+        }
+        hid_t *rest[] = {&w->index,        &w->stop_reason,  &w->stop_detail,
+                         &w->ckpt_data[0], &w->ckpt_data[1], &w->ckpt_index};
+        for (size_t i = 0; i < sizeof rest / sizeof rest[0]; i++) {
+            if (*rest[i] >= 0)
+                H5Dclose(*rest[i]);
+            *rest[i] = -1;
+        }
+        if (H5Fclose(file) < 0 && st == CDEM_OK)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close the file (disk full?)", w->path);
+        es = h5i_keep_errors(st != CDEM_OK);
+    }
+    h5i_writer_release(w);
+    h5i_restore_errors(es);
+    return st;
+}
