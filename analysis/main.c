@@ -21,7 +21,7 @@
 enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2 };
 
 int main(int argc, char **argv) {
-    cdem_threads_settle_wait_policy(argv); /* idle threads spin briefly, then sleep */
+    cdem_threads_settle_wait_policy(argv); /* idle threads sleep: threads.h */
     if (argc < 2) {
         cdem_cli_usage_print(stderr, &cdem_strain_help, "missing command");
         return EXIT_USAGE;

@@ -7,7 +7,8 @@
 # Usage: sh bench/contended.sh [BUILD]
 # Environment:
 #   WAITS="cdem"   wait settings to compare, each run in the same way:
-#                  cdem      the environment as it comes (cdem-run chooses: threads.h)
+#                  cdem      the environment as it comes (cdem-run chooses: common/threads.h,
+#                            OMP_WAIT_POLICY=passive)
 #                  libgomp   GOMP_SPINCOUNT=300000, libgomp's own default
 #                  passive   OMP_WAIT_POLICY=passive
 #                  spin:N    GOMP_SPINCOUNT=N

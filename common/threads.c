@@ -8,7 +8,7 @@
 void cdem_threads_settle_wait_policy(char **argv) {
     if (getenv("OMP_WAIT_POLICY") || getenv("GOMP_SPINCOUNT") || getenv("CDEM_NO_REEXEC"))
         return;
-    if (setenv("GOMP_SPINCOUNT", CDEM_SPIN_COUNT, 1) != 0)
+    if (setenv("OMP_WAIT_POLICY", CDEM_WAIT_POLICY, 1) != 0)
         return;
     execv("/proc/self/exe", argv);
     /* not reached unless exec failed: go on with libgomp's defaults; the variable set above

@@ -1,17 +1,18 @@
 /* threads: how cdem-c's programs wait for their OpenMP threads, and how many they use.
  *
  * libgomp's default wait policy keeps an idle thread spinning for 300,000 iterations
- * (tenths of a millisecond) before it sleeps. On an idle machine that makes a barrier cost
- * well under a microsecond. But when another process keeps a core busy, the thread our
- * barrier waits for is descheduled, and its partner spins away the time slice it could
- * have given it: on 2 cores with one competitor, a 2-thread cdem-run took 4.2x the 1-thread
- * time (docs/performance.md, "Threads on a busy machine"). OMP_WAIT_POLICY=passive (sleep
- * at once) fixes that but costs a futex wake-up (~40 us on a VM) at every parallel region,
- * which takes away the idle machine's speed-up.
+ * (tenths of a millisecond) before it sleeps. When another process keeps a core busy, the
+ * thread a barrier waits for is descheduled, and its partner spins away the time slice it
+ * could have given it: on this 2-core machine with one competitor, 2 threads took 2.2x the
+ * 1-thread time (bench/contended.sh, docs/performance.md "Threads on a busy machine").
  *
- * cdem_threads_settle_wait_policy gives the programs a short spin instead: GOMP_SPINCOUNT
- * = CDEM_SPIN_COUNT (a few tens of microseconds of spinning, then sleep). It covers the
- * load imbalance of a step on an idle machine and gives the core away soon on a busy one.
+ * cdem_threads_settle_wait_policy makes idle threads sleep at once (OMP_WAIT_POLICY =
+ * passive). Measured with bench/contended.sh against libgomp's default and shorter spins
+ * (GOMP_SPINCOUNT 1000, 3000, 10000): passive is the only one that keeps the busy-machine
+ * slowdown within 1.15x (1.00-1.09x), and on an idle machine its 2-thread time equals the
+ * default's within the noise at 8,300 and 16,700 elements (a step has few parallel regions,
+ * so a thread's wake-up, tens of microseconds, is small beside it; smaller models run
+ * serially, below CDEM_PAR_MIN). Short spins were worse on both counts (1.13-1.76x busy).
  * libgomp reads its environment before main runs, so the only way to change it is to set
  * the variable and execute the program again (once: the new process finds it set). A user's
  * own OMP_WAIT_POLICY or GOMP_SPINCOUNT is always honoured, and so is CDEM_NO_REEXEC=1
@@ -30,7 +31,7 @@
 #define CDEM_THREADS_MAX 1024 /* the --threads messages say 1024 */
 
 /* When neither OMP_WAIT_POLICY, GOMP_SPINCOUNT nor CDEM_NO_REEXEC is set: sets
- * GOMP_SPINCOUNT = CDEM_SPIN_COUNT and re-executes the program (/proc/self/exe) with argv.
+ * OMP_WAIT_POLICY = CDEM_WAIT_POLICY and re-executes the program (/proc/self/exe) with argv.
  * Returns only when nothing was to be done or the re-execution failed (the program then
  * runs with libgomp's defaults). */
 void cdem_threads_settle_wait_policy(char **argv);

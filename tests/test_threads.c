@@ -1,6 +1,6 @@
 /* Tests of threads.[ch]: the --threads value parser, and the wait-policy re-execution (a
  * child process calls cdem_threads_settle_wait_policy; when it re-executes this test binary
- * with --report-spin, the new process prints the GOMP_SPINCOUNT it started with). */
+ * with --report-spin, the new process prints the OMP_WAIT_POLICY it started with). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -69,9 +69,9 @@ static void test_threads_wait_policy(void **st) {
     (void)st;
     static const char *const all[] = {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "CDEM_NO_REEXEC", NULL};
     char out[256];
-    /* nothing set: re-executed with the short spin */
+    /* nothing set: re-executed with the passive wait policy */
     child_report(NULL, all, out, sizeof out);
-    assert_string_equal(out, "GOMP_SPINCOUNT=" CDEM_SPIN_COUNT "\n");
+    assert_string_equal(out, "OMP_WAIT_POLICY=" CDEM_WAIT_POLICY "\n");
     /* the user's choices are honoured: no re-execution */
     static const char *const passive[] = {"OMP_WAIT_POLICY=passive", NULL};
     child_report(passive, all, out, sizeof out);
@@ -86,8 +86,8 @@ static void test_threads_wait_policy(void **st) {
 
 int main(int argc, char **argv) {
     if (argc > 1 && !strcmp(argv[1], "--report-spin")) {
-        const char *v = getenv("GOMP_SPINCOUNT");
-        printf("GOMP_SPINCOUNT=%s\n", v ? v : "(unset)");
+        const char *v = getenv("OMP_WAIT_POLICY");
+        printf("OMP_WAIT_POLICY=%s\n", v ? v : "(unset)");
         return 0;
     }
     self_path = argv[0];
