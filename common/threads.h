@@ -26,8 +26,8 @@
 #ifndef CDEM_THREADS_H
 #define CDEM_THREADS_H
 
-/* Spin iterations before an idle libgomp thread sleeps (libgomp's default: 300,000). */
-#define CDEM_SPIN_COUNT  "10000"
+/* The wait policy the programs choose when the user has not: idle threads sleep at once. */
+#define CDEM_WAIT_POLICY "passive"
 #define CDEM_THREADS_MAX 1024 /* the --threads messages say 1024 */
 
 /* When neither OMP_WAIT_POLICY, GOMP_SPINCOUNT nor CDEM_NO_REEXEC is set: sets
