@@ -12,18 +12,22 @@
 #      original program's 10.1 MB), reading every increment (bench/bench_io.c), strain and
 #      rendering with cdem-strain on that file, the synthetic strain benchmark beside its
 #      numpy/scipy baseline (bench/bench_strain.sh) and the renderer (bench/bench_render.c).
+#   5. Threads on a busy machine (bench/contended.sh): 1 and 2 threads, idle and with one
+#      CPU-bound competitor process that the script starts and stops, with cdem-run's own
+#      wait policy and with libgomp's default, in the same run.
 # Usage: sh bench/run_bench.sh [BUILD]   (make bench; about 6 minutes on an idle 2-core box)
 # Environment:
 #   SIZES="10:5:0 10:5:1 40:5:1 100:7.5:1"  width:height:half_radii of the scaling table
 #   LARGE=1     adds 200 x 7.5 half radii (~250,000 elements; ~1.5 more minutes)
 #   REPS=3      timed runs per size and thread count (medians)
 #   ELSTEPS=2e7 element-steps per timed run;  SETTLE=3000 untimed settling steps
-#   PARTS="machine scale full lammps analysis"  the parts to run
+#   PARTS="machine scale full lammps analysis contended"  the parts to run
 #   WORK=/tmp/cdem_bench  scratch directory (the default run's file is kept there)
-# OMP_WAIT_POLICY is left as the caller has it: unset, libgomp's default (an idle thread spins
-# for a while, then sleeps), which is what a user of cdem-run gets. OMP_WAIT_POLICY=passive
-# makes every parallel region wake a sleeping thread (~40 us on a VM against ~0.5 us; a step
-# has two): use it, or OMP_NUM_THREADS=1, only on a machine shared with other CPU-bound jobs.
+# OMP_WAIT_POLICY is left as the caller has it. cdem-run and cdem-strain, when it is unset,
+# choose passive themselves (common/threads.h; part 5 measures why); the benchmark programs
+# built here (bench_scale, bench_io) do not, so with it unset parts 1-2 measure libgomp's
+# default (an idle thread spins for a while, then sleeps), which on an idle machine gives the
+# same 2-thread times within the noise (part 5).
 # Every figure is printed with the load average beside it: on a loaded machine the
 # wall-clock figures measure the other jobs too; the CPU-time figures are steadier but also
 # inflated (shared caches and cores).
@@ -33,7 +37,7 @@ SIZES=${SIZES:-"10:5:0 10:5:1 40:5:1 100:7.5:1"}
 REPS=${REPS:-3}
 ELSTEPS=${ELSTEPS:-2e7}
 SETTLE=${SETTLE:-3000}
-PARTS=${PARTS:-"machine scale full lammps analysis"}
+PARTS=${PARTS:-"machine scale full lammps analysis contended"}
 WORK=${WORK:-/tmp/cdem_bench}
 PKGS="hdf5 gsl"
 CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon -Isolver"
@@ -173,4 +177,11 @@ if has analysis; then
         $(pkg-config --libs cairo) -lgif -lm -fopenmp -o "$BUILD/bench_render"
     "$BUILD/bench_render" "$WORK" render | sed 's/^/   /'
     echo "   load average now $(load)"
+fi
+
+if has contended; then
+    echo
+    echo "== 5. Threads on a busy machine (bench/contended.sh): cdem-run's wait policy (passive, common/threads.h)"
+    echo "      and libgomp's default spin, idle and with one CPU-bound competitor"
+    WAITS="cdem libgomp" sh bench/contended.sh "$BUILD"
 fi
