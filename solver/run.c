@@ -75,6 +75,7 @@ struct cdem_run_ctx {
     long mark_step;        /* step at the last accounting */
     double element_steps;  /* sum over the steps taken by this process of the element count */
     int tty_line_open;     /* 1 when a progress line is drawn without newline */
+    int tty_drawn;         /* 1 once a progress line has been drawn on the tty */
     cdem_sediment sed;     /* syn-tectonic sedimentation (disabled when off) */
     long k_def;            /* deformation steps applied by the mode (settling excluded) */
     int finished;          /* 1 once the stop reason is recorded (completed/stopped-early) */
@@ -162,8 +163,11 @@ static void progress_line(run_ctx *r, int force, const char *ending) {
     else
         snprintf(tail, sizeof tail, "%.0f s left", left);
     if (r->opt->progress_is_tty) {
-        if (!force && t - r->t_last_log < 0.25)
+        /* the first line at once (a user sees the run start, and a short run still shows
+         * its phases), then at most 4 redraws a second */
+        if (!force && r->tty_drawn && t - r->t_last_log < 0.25)
             return;
+        r->tty_drawn = 1;
         fprintf(r->opt->log,
                 "\r\033[K%s, increment %d (0..%d), net displacement %.1f m, %zu elements, %.0f "
                 "steps/s, %s",
