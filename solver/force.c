@@ -299,7 +299,7 @@ static void update_shares(cdem_force *f, int nchunk) {
  * by pj still left the lower chunk, with more touching pairs and free elements, 10 % more
  * to do. The cut does not change any result (every element sum has the same additions in
  * the same order for any cut). Falls back to one chunk when the buffer is too small (never
- * after a build through rebuild/remove_marked, which reserve it). */
+ * after a list build: the stepper calls cdem_force_reserve after each). */
 static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t *flags, size_t n,
                         int nchunk, long par_min) {
     const size_t np = nb->np;

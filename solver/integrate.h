@@ -109,9 +109,8 @@ void cdem_integrator_classify(cdem_integrator *it, const cdem_state *s);
 
 /* Erosion: removes every free element whose centre is above ymax (m) through the same
  * path as escaping elements (ids in removal.removed_ids, count in removal.n_removed_last and
- * *count),
- * rebuilds the list and recomputes the forces of the current positions (no tangential
- * increment, velocities unchanged). */
+ * *count), rebuilds the list and recomputes the forces of the current positions (no
+ * tangential increment, velocities unchanged). */
 cdem_status cdem_integrator_erode(cdem_integrator *it, cdem_state *s, double ymax, long *count,
                                   cdem_error *err);
 

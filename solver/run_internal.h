@@ -48,10 +48,10 @@ typedef struct {
     cdem_snapshot *snap; /* checkpoint buffer (NULL until the first checkpoint) */
     int last_inc;        /* increment of the last periodic checkpoint (0: none yet) */
     int off;             /* 1 when the file layer cannot store checkpoints */
-    /* 1 when the forces on boundary elements in the state are those a sample reports (the
-     * run loop sets it every step); 0: a checkpoint stores them as 0 (cdem_ckpt_state_put),
-     * so that checkpoints are the same for any thread count. Stored as "it.boundary_forces"
-     * (cdem_integrator_snapshot_put), where the layout has it. */
+    /* 1 on the steps whose sample reports the forces on boundary elements (the run loop sets
+     * it every step); 0: a checkpoint stores those forces as 0 (cdem_ckpt_state_put says why).
+     * Stored as "it.boundary_forces" (cdem_integrator_snapshot_put), where the checkpoint
+     * layout has it. */
     int boundary_forces;
 } run_ckpt_state;
 
