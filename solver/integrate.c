@@ -15,6 +15,7 @@
 
 #include "checkpoint.h"
 #include "parallel.h"
+#include "surface.h"
 
 #include <math.h>
 #include <omp.h>
@@ -311,12 +312,11 @@ cdem_status cdem_integrator_find_edges(cdem_integrator *it, cdem_state *s, cdem_
     }
     for (size_t b = 0; b < nb; b++)
         it->band_lo[b] = it->band_hi[b] = -1;
+    const cdem_grid bands = {.x0 = 0.0, .y0 = ymin, .cell = w, .nx = 1, .ny = nb};
     for (size_t i = 0; i < s->n; i++) {
         if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
             continue;
-        size_t b = (size_t)((s->y[i] - ymin) / w);
-        if (b >= nb)
-            b = nb - 1;
+        const size_t b = cdem_grid_row(&bands, s->y[i]);
         const int32_t lo = it->band_lo[b], hi = it->band_hi[b];
         if (lo < 0 || s->x[i] < s->x[lo])
             it->band_lo[b] = (int32_t)i;
@@ -359,27 +359,17 @@ cdem_status cdem_integrator_find_surface(cdem_integrator *it, cdem_state *s, cde
     const size_t ncol = (size_t)span + 1;
     if (ncol > it->colcap) {
         size_t c = ncol + ncol / 2 + 16;
-        int32_t *q = realloc(it->col_top, c * sizeof *q);
+        size_t *q = realloc(it->col_top, c * sizeof *q);
         if (!q)
             return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu columns)", c);
         it->col_top = q;
         it->colcap = c;
     }
-    for (size_t c = 0; c < ncol; c++)
-        it->col_top[c] = -1;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        size_t c = (size_t)((s->x[i] - xmin) / w);
-        if (c >= ncol)
-            c = ncol - 1;
-        const int32_t b = it->col_top[c];
-        if (b < 0 || s->y[i] > s->y[b])
-            it->col_top[c] = (int32_t)i;
-    }
+    const cdem_grid cols = {.x0 = xmin, .y0 = 0.0, .cell = w, .nx = ncol, .ny = 1};
+    cdem_surface_columns(s, &cols, CDEM_SURFACE_BY_CENTRE, -INFINITY, INFINITY, it->col_top);
     long count = 0;
     for (size_t c = 0; c < ncol; c++) {
-        if (it->col_top[c] < 0)
+        if (it->col_top[c] == SIZE_MAX)
             continue;
         s->flags[it->col_top[c]] |= CDEM_FLAG_SURFACE;
         count++;

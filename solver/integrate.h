@@ -116,7 +116,7 @@ typedef struct {
     double column_width;        /* m, surface-search column width = 2 x max_radius, > 0 */
     double overburden_force;    /* N, force on each surface element = pressure x column_width */
     long n_surface;             /* surface elements flagged at the last rebuild */
-    int32_t *col_top;           /* per-column scratch: index of the highest element (colcap) */
+    size_t *col_top;            /* per-column scratch: the surface element (colcap) */
     size_t colcap;              /* capacity of col_top */
 
     /* confining pressure on the free side edges (enabled when confining_pressure > 0) */
@@ -166,8 +166,9 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
 cdem_status cdem_integrator_set_overburden(cdem_integrator *it, double pressure, cdem_error *err);
 
 /* Flags the surface elements now (clears CDEM_FLAG_SURFACE elsewhere): in columns of width
- * column_width from the leftmost free element, the free element with the highest centre.
- * Called at every rebuild when the overburden is on; public for tests and views. */
+ * column_width from the leftmost free element, the free element with the highest centre
+ * (common/surface.h, CDEM_SURFACE_BY_CENTRE). Called at every rebuild when the overburden is on;
+ * public for tests and views. */
 cdem_status cdem_integrator_find_surface(cdem_integrator *it, cdem_state *s, cdem_error *err);
 
 /* Enables the confining pressure: pressure in N/m (>= 0, finite; 0 disables) on the free side
