@@ -8,9 +8,9 @@
  * tangencies, so the packing has no overlap. A disc whose lowest point rests above the
  * assembly height is discarded; filling stops after a run of consecutive discards (the
  * region below the height is then saturated). The cell grid (common/grid.h: cells of 2 x max
- * radius, one linked list per cell, as discs arrive one by one, plus the highest centre per
- * grid column) makes every drop O(1), so
- * building N discs is O(N). Everything lives in a `packer` context local to the call.
+ * radius, one linked list per cell as the discs arrive one by one, plus the highest centre
+ * per grid column) makes every drop O(1), so building N discs is O(N). Everything lives in
+ * a `packer` context local to the call.
  */
 #include "assembly.h"
 
