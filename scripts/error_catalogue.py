@@ -52,7 +52,7 @@ GROUPS = [  # (title, source files, what to do)
      "(modelforces_N.txt); docs/formats-text.md."),
     ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/cmd_basic.c",
       "analysis/analysis.c", "analysis/strain.c",
-      "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "analysis/cellgrid.c",
+      "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "common/grid.c",
       "analysis/biaxial.c", "analysis/repose.c", "analysis/mohr.c", "analysis/qexport.c", "analysis/sspx.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
      "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "

@@ -2,6 +2,8 @@
 #include "loads.h"
 
 #include "bc.h"
+#include "grid.h"
+#include "surface.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -81,12 +83,11 @@ cdem_status cdem_loads_find_edges(cdem_loads *l, cdem_state *s, cdem_error *err)
     }
     for (size_t b = 0; b < nb; b++)
         l->band_lo[b] = l->band_hi[b] = -1;
+    const cdem_grid bands = {.x0 = 0.0, .y0 = ymin, .cell = w, .nx = 1, .ny = nb};
     for (size_t i = 0; i < s->n; i++) {
         if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
             continue;
-        size_t b = (size_t)((s->y[i] - ymin) / w);
-        if (b >= nb)
-            b = nb - 1;
+        const size_t b = cdem_grid_row(&bands, s->y[i]);
         const int32_t lo = l->band_lo[b], hi = l->band_hi[b];
         if (lo < 0 || s->x[i] < s->x[lo])
             l->band_lo[b] = (int32_t)i;
@@ -129,27 +130,17 @@ cdem_status cdem_loads_find_surface(cdem_loads *l, cdem_state *s, cdem_error *er
     const size_t ncol = (size_t)span + 1;
     if (ncol > l->colcap) {
         size_t c = ncol + ncol / 2 + 16;
-        int32_t *q = realloc(l->col_top, c * sizeof *q);
+        size_t *q = realloc(l->col_top, c * sizeof *q);
         if (!q)
             return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu columns)", c);
         l->col_top = q;
         l->colcap = c;
     }
-    for (size_t c = 0; c < ncol; c++)
-        l->col_top[c] = -1;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        size_t c = (size_t)((s->x[i] - xmin) / w);
-        if (c >= ncol)
-            c = ncol - 1;
-        const int32_t b = l->col_top[c];
-        if (b < 0 || s->y[i] > s->y[b])
-            l->col_top[c] = (int32_t)i;
-    }
+    const cdem_grid cols = {.x0 = xmin, .y0 = 0.0, .cell = w, .nx = ncol, .ny = 1};
+    cdem_surface_columns(s, &cols, CDEM_SURFACE_BY_CENTRE, -INFINITY, INFINITY, l->col_top);
     long count = 0;
     for (size_t c = 0; c < ncol; c++) {
-        if (l->col_top[c] < 0)
+        if (l->col_top[c] == SIZE_MAX)
             continue;
         s->flags[l->col_top[c]] |= CDEM_FLAG_SURFACE;
         count++;

@@ -22,7 +22,7 @@ typedef struct {
     /* overburden (on when overburden_force > 0) */
     double overburden_force; /* N, force on each surface element = pressure x column_width */
     long n_surface;          /* surface elements flagged at the last rebuild */
-    int32_t *col_top;        /* per-column scratch: index of the highest element (colcap) */
+    size_t *col_top;         /* per-column scratch: the surface element (colcap) */
     size_t colcap;           /* capacity of col_top */
 
     /* confining pressure on the free side edges (on when confining_pressure > 0) */
@@ -59,8 +59,8 @@ void cdem_loads_begin_step(cdem_loads *l, long step);
 cdem_status cdem_loads_after_build(cdem_loads *l, cdem_state *s, cdem_error *err);
 
 /* Flags the surface elements now (clears CDEM_FLAG_SURFACE elsewhere): in columns of width
- * column_width from the leftmost free element, the free element with the highest centre.
- * Public for tests and views. */
+ * column_width from the leftmost free element, the free element with the highest centre
+ * (common/surface.h, CDEM_SURFACE_BY_CENTRE). Public for tests and views. */
 cdem_status cdem_loads_find_surface(cdem_loads *l, cdem_state *s, cdem_error *err);
 
 /* Flags the edge elements now (clears CDEM_FLAG_BIAXIAL_EDGE elsewhere): per band of height

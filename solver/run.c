@@ -20,6 +20,7 @@
 #include "run_internal.h"
 
 #include "checkpoint.h"
+#include "grid.h"
 #include "stress.h"
 
 #include <limits.h>
@@ -52,17 +53,15 @@ static void assign_layers(cdem_state *s) {
     if (!(hi > lo))
         return;
     const double th = (hi - lo) / CDEM_PREGROWTH_LAYERS;
+    /* layer k - 1 is row k - 1 of bands of height th from lo (off the bands: the end ones) */
+    const cdem_grid layers = {
+        .x0 = 0.0, .y0 = lo, .cell = th, .nx = 1, .ny = CDEM_PREGROWTH_LAYERS};
     for (size_t i = 0; i < s->n; i++) {
         if (s->flags[i] & CDEM_FLAGS_BOUNDARY) {
             s->layer[i] = 0;
             continue;
         }
-        long k = (long)floor((s->y[i] - lo) / th) + 1;
-        if (k < 1)
-            k = 1;
-        if (k > CDEM_PREGROWTH_LAYERS)
-            k = CDEM_PREGROWTH_LAYERS;
-        s->layer[i] = (int32_t)k;
+        s->layer[i] = (int32_t)cdem_grid_row(&layers, s->y[i]) + 1;
     }
 }
 
