@@ -1665,10 +1665,63 @@ static uint64_t fnv1a64(const unsigned char *p, size_t n) {
     return h;
 }
 
-/* Checkpoint slots hold the blob compressed ("CDEMSNPZ" | u64 blob length | zlib stream),
- * rewritten in place: a run with a checkpoint after each of 20 increments is no bigger than
- * one with 2 checkpoints (a filtered HDF5 chunk would move at each rewrite, and SWMR never
- * frees the old place), and each slot is one 16 KiB chunk for this small snapshot. */
+static uint64_t get_le64(const unsigned char *p) {
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; i--)
+        v = (v << 8) | p[i];
+    return v;
+}
+
+/* The blob in a slot's bytes packed[0, n), decoded here from docs/format.md ("Checkpoints"),
+ * not by the library: "CDEMSNPT" | u64 blob length | zlib stream of the blob whose arrays
+ * with the high bit of the type byte set hold their values byte-transposed. Returns the
+ * blob (malloc'd) with every array put back, its length in *blob_len and the number of
+ * transposed arrays in *transposed. */
+static unsigned char *slot_blob(const unsigned char *packed, size_t n, size_t *blob_len,
+                                int *transposed) {
+    assert_true(n > 16);
+    assert_memory_equal(packed, "CDEMSNPT", 8);
+    uLongf len = (uLongf)get_le64(packed + 8), got = len;
+    unsigned char *blob = malloc(len), *tmp = malloc(len);
+    assert_non_null(blob);
+    assert_non_null(tmp);
+    assert_int_equal(uncompress(blob, &got, packed + 16, (uLong)(n - 16)), Z_OK);
+    assert_int_equal(got, len);
+    assert_memory_equal(blob, "CDEMSNAP", 8);
+    static const size_t sizes[] = {8, 8, 4, 4, 1}; /* f64 i64 i32 u32 u8 */
+    uint32_t count = (uint32_t)blob[12] | (uint32_t)blob[13] << 8 | (uint32_t)blob[14] << 16 |
+                     (uint32_t)blob[15] << 24;
+    size_t at = 24;
+    *transposed = 0;
+    for (uint32_t a = 0; a < count; a++) {
+        size_t name_len = (size_t)blob[at] | (size_t)blob[at + 1] << 8;
+        at += 2 + name_len;
+        unsigned char type = blob[at];
+        size_t values = (size_t)get_le64(blob + at + 1), size = sizes[type & 0x7f];
+        at += 9;
+        assert_true(at + values * size <= len - 8);
+        if (type & 0x80) {
+            (*transposed)++;
+            blob[at - 9] = type & 0x7f;
+            for (size_t i = 0; i < values; i++)
+                for (size_t b = 0; b < size; b++)
+                    tmp[i * size + b] = blob[at + b * values + i];
+            memcpy(blob + at, tmp, values * size);
+        }
+        at += values * size;
+    }
+    assert_int_equal(at, len - 8);
+    assert_true(get_le64(blob + at) == fnv1a64(blob, at)); /* the blob's own checksum */
+    free(tmp);
+    *blob_len = len;
+    return blob;
+}
+
+/* Checkpoint slots hold the blob packed ("CDEMSNPT" | u64 blob length | zlib stream of the
+ * blob with some arrays byte-transposed), rewritten in place: a run with a checkpoint after
+ * each of 20 increments is no bigger than one with 2 checkpoints (a filtered HDF5 chunk
+ * would move at each rewrite, and SWMR never frees the old place), and each slot is a whole
+ * number of 4 KiB chunks. The packed bytes decode, by docs/format.md alone, to the blob. */
 static void test_format_checkpoint_compressed_in_place(void **state) {
     (void)state;
     char few[1024], many[1024];
@@ -1707,21 +1760,20 @@ static void test_format_checkpoint_compressed_in_place(void **state) {
         hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
         assert_true(ds >= 0);
         hsize_t n = 0;
-        unsigned char head[16];
-        hid_t sp = H5Dget_space(ds), ms = H5Screate_simple(1, (hsize_t[]){16}, NULL);
+        hid_t sp = H5Dget_space(ds);
         H5Sget_simple_extent_dims(sp, &n, NULL);
-        assert_true(n > 16 && n < raw); /* compressed */
-        assert_true(H5Sselect_hyperslab(sp, H5S_SELECT_SET, (hsize_t[]){0}, NULL, (hsize_t[]){16},
-                                        NULL) >= 0);
-        assert_true(H5Dread(ds, H5T_NATIVE_UINT8, ms, sp, H5P_DEFAULT, head) >= 0);
-        assert_memory_equal(head, "CDEMSNPZ", 8);
-        uint64_t blob = 0;
-        for (int i = 7; i >= 0; i--)
-            blob = (blob << 8) | head[8 + i];
-        assert_int_equal(blob, raw);
-        assert_int_equal(H5Dget_storage_size(ds), 16384);
-        H5Sclose(ms);
         H5Sclose(sp);
+        assert_true(n > 16 && n < raw); /* compressed */
+        unsigned char *packed = malloc(n);
+        assert_true(H5Dread(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, packed) >= 0);
+        size_t blob_len = 0;
+        int transposed = 0;
+        unsigned char *blob = slot_blob(packed, n, &blob_len, &transposed);
+        assert_int_equal(blob_len, raw);
+        assert_true(transposed >= 1); /* state.x: 300 doubles */
+        assert_int_equal(H5Dget_storage_size(ds), (n + 4095) / 4096 * 4096);
+        free(blob);
+        free(packed);
         H5Dclose(ds);
     }
     cdem_snapshot_free(snap);
@@ -1730,22 +1782,10 @@ static void test_format_checkpoint_compressed_in_place(void **state) {
     remove_pair(many);
 }
 
-/* A file written before checkpoints were compressed holds the bare "CDEMSNAP" blob in its
- * slot: still read (the slot is rewritten here the way such a writer left it). */
-static void test_format_checkpoint_reads_uncompressed(void **state) {
-    (void)state;
-    char path[1024];
-    scratch_path(path, sizeof path, "ckpt-raw.h5");
-    cdem_params p;
-    cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
-    cdem_error err;
-    cdem_h5_writer *w = NULL;
-    assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
-    const int after[] = {1};
-    write_with_checkpoints(w, 0, 3, after, 1);
-    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
-
+/* Rewrites slot 0 of path (and its index row) the way an older writer left it: the bare
+ * blob (old_form 0, before checkpoints were compressed) or "CDEMSNPZ" | u64 blob length |
+ * the blob deflated as it is (old_form 1, before arrays were transposed). */
+static void write_old_slot(const char *path, int old_form) {
     hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
     assert_true(f >= 0);
     hid_t ds = H5Dopen2(f, "checkpoint/slot0", H5P_DEFAULT);
@@ -1756,40 +1796,70 @@ static void test_format_checkpoint_reads_uncompressed(void **state) {
     H5Sclose(sp);
     unsigned char *packed = malloc(n);
     assert_true(H5Dread(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, packed) >= 0);
-    assert_memory_equal(packed, "CDEMSNPZ", 8);
-    uLongf raw_len = 0;
-    for (int i = 7; i >= 0; i--)
-        raw_len = (raw_len << 8) | packed[8 + i];
-    unsigned char *raw = malloc(raw_len);
-    uLongf got = raw_len;
-    assert_int_equal(uncompress(raw, &got, packed + 16, (uLong)(n - 16)), Z_OK);
-    assert_int_equal(got, raw_len);
-    assert_memory_equal(raw, "CDEMSNAP", 8);
-    hsize_t len = raw_len;
+    size_t raw_len = 0;
+    int transposed = 0;
+    unsigned char *raw = slot_blob(packed, n, &raw_len, &transposed);
+    unsigned char *old = raw;
+    size_t old_len = raw_len;
+    if (old_form == 1) {
+        uLongf z = compressBound((uLong)raw_len);
+        old = malloc(16 + z);
+        assert_int_equal(compress2(old + 16, &z, raw, (uLong)raw_len, 4), Z_OK);
+        memcpy(old, "CDEMSNPZ", 8);
+        for (int i = 0; i < 8; i++)
+            old[8 + i] = (unsigned char)((uint64_t)raw_len >> (8 * i));
+        old_len = 16 + z;
+    }
+    hsize_t len = old_len;
     assert_true(H5Dset_extent(ds, &len) >= 0);
-    assert_true(H5Dwrite(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw) >= 0);
+    assert_true(H5Dwrite(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, old) >= 0);
     H5Dclose(ds);
     /* the index row of slot 0: length and checksum of the bytes now in the slot */
     hid_t ix = H5Dopen2(f, "checkpoint/index", H5P_DEFAULT);
     assert_true(ix >= 0);
     hid_t ct = H5Tcreate(H5T_COMPOUND, 2 * sizeof(int64_t));
     H5Tinsert(ct, "length", 0, H5T_NATIVE_INT64);
-    H5Tinsert(ct, "checksum", sizeof(int64_t), H5T_NATIVE_UINT64);
+    /* the file's member is int64 holding the hash's bits; a uint64 memory type would be
+     * converted, and clipped above INT64_MAX */
+    H5Tinsert(ct, "checksum", sizeof(int64_t), H5T_NATIVE_INT64);
     struct {
         int64_t length;
-        uint64_t checksum;
+        int64_t checksum;
     } rows[2];
     assert_true(H5Dread(ix, ct, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
-    rows[0].length = (int64_t)raw_len;
-    rows[0].checksum = fnv1a64(raw, raw_len);
+    rows[0].length = (int64_t)old_len;
+    const uint64_t hash = fnv1a64(old, old_len);
+    memcpy(&rows[0].checksum, &hash, sizeof hash);
     assert_true(H5Dwrite(ix, ct, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) >= 0);
     H5Tclose(ct);
     H5Dclose(ix);
     H5Fclose(f);
-    free(packed);
+    if (old != raw)
+        free(old);
     free(raw);
-    assert_checkpoint(path, 1);
-    remove_pair(path);
+    free(packed);
+}
+
+/* Files written before hold the bare "CDEMSNAP" blob (before compression) or the blob
+ * deflated untransposed ("CDEMSNPZ") in a slot: both still read, so such runs resume. */
+static void test_format_checkpoint_reads_uncompressed(void **state) {
+    (void)state;
+    for (int old_form = 0; old_form < 2; old_form++) {
+        char path[1024];
+        scratch_path(path, sizeof path, old_form ? "ckpt-npz.h5" : "ckpt-raw.h5");
+        cdem_params p;
+        cdem_params_defaults(&p);
+        cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+        cdem_error err;
+        cdem_h5_writer *w = NULL;
+        assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);
+        const int after[] = {1};
+        write_with_checkpoints(w, 0, 3, after, 1);
+        assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+        write_old_slot(path, old_form);
+        assert_checkpoint(path, 1);
+        remove_pair(path);
+    }
 }
 
 /* Reads a whole 1-D dataset as bytes of mtype (malloc'd), with its length. */
