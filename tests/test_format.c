@@ -1403,6 +1403,104 @@ static void test_format_xmf_sidecar(void **state) {
     remove_pair(path);
 }
 
+/* ------------------------------------------------------------------ older version-2 files */
+
+/* The element values of tests/data/format_v2_chunk8192.h5 (make_format_v2_chunk8192.c). */
+static void assert_fixture_increment(const cdem_state *s, const cdem_increment_info *in, int k) {
+    assert_int_equal(in->number, k);
+    assert_int_equal(in->step, 1000 * k + 7);
+    assert_int_equal(s->n, 40);
+    for (size_t i = 0; i < 40; i++) {
+        assert_true(s->x[i] == 100.0 * (double)i + k / 8.0);
+        assert_true(s->y[i] == 50.0 + (double)i / 3.0 + k);
+        assert_true(s->radius[i] == 10.0 + (double)(i % 4));
+        assert_int_equal(s->id[i], 1000 + (int)i);
+        assert_int_equal(s->layer[i], 1 + (int)(i % 5));
+        assert_int_equal(s->flags[i], i % 2);
+    }
+}
+
+/* A file written before the chunks shrank (tests/data/format_v2_chunk8192.h5: element chunks
+ * of 8192 rows, a checkpoint slot packed as "CDEMSNPZ") reads, its checkpoint reads, and a
+ * resume appends at its own 8192-row boundaries (never into a compressed chunk). */
+static void test_format_reads_and_resumes_chunk8192_file(void **state) {
+    (void)state;
+    const char *dir = getenv("CDEM_TEST_DATA");
+    char fixture[1024], path[1100];
+    snprintf(fixture, sizeof fixture, "%s/format_v2_chunk8192.h5",
+             dir && *dir ? dir : "tests/data");
+    scratch_path(path, sizeof path, "chunk8192.h5");
+    copy_truncated(fixture, path, file_size(fixture));
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 4);
+    cdem_state s = {0};
+    cdem_increment_info in;
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(cdem_h5_reader_load_increment(r, (size_t)k, &s, &in, &err), CDEM_OK);
+        assert_fixture_increment(&s, &in, k);
+    }
+    cdem_snapshot *snap = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    int32_t inc = -1;
+    if (cdem_h5_reader_read_checkpoint(r, snap, &inc, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(inc, 2);
+    const cdem_snapshot_array *a = cdem_snapshot_get(snap, "state.x");
+    assert_non_null(a);
+    assert_int_equal(a->count, 40);
+    for (size_t i = 0; i < 40; i++)
+        assert_true(((const double *)a->data)[i] == 100.0 * (double)i + 2 / 8.0);
+    cdem_snapshot_free(snap);
+    cdem_h5_reader_close(r);
+
+    /* resume after increment 2 and write 3 and 4 again (x shifted by 0.5 m) */
+    cdem_h5_writer *w = NULL;
+    if (cdem_h5_writer_reopen(path, 2, 2007, &w, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    cdem_h5_writer_set_sync(w, 0);
+    for (int k = 3; k < 5; k++) {
+        cdem_state t = {0};
+        assert_int_equal(cdem_state_init(&t, 40, 0, &err), CDEM_OK);
+        for (int i = 0; i < 40; i++)
+            assert_int_equal(cdem_state_append(&t, 1000 + i, 100.0 * i + k / 8.0 + 0.5,
+                                               50.0 + i / 3.0 + k, 10.0 + i % 4, 1.0, 1 + i % 5,
+                                               (uint32_t)(i % 2), 0, NULL, &err),
+                             CDEM_OK);
+        cdem_increment_info row = make_info(k, 0);
+        assert_int_equal(cdem_h5_writer_write_increment(w, &row, &t, &err), CDEM_OK);
+        cdem_state_free(&t);
+    }
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 5);
+    for (int k = 0; k < 5; k++) {
+        assert_int_equal(cdem_h5_reader_load_increment(r, (size_t)k, &s, &in, &err), CDEM_OK);
+        if (k < 3) {
+            assert_fixture_increment(&s, &in, k);
+            continue;
+        }
+        for (size_t i = 0; i < 40; i++)
+            assert_true(s.x[i] == 100.0 * (double)i + k / 8.0 + 0.5);
+    }
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t ix = H5Dopen2(f, "increments/index", H5P_DEFAULT);
+    hid_t ot = H5Tcreate(H5T_COMPOUND, sizeof(int64_t));
+    H5Tinsert(ot, "offset", 0, H5T_NATIVE_INT64);
+    int64_t offset[5];
+    assert_true(H5Dread(ix, ot, H5S_ALL, H5S_ALL, H5P_DEFAULT, offset) >= 0);
+    for (int k = 0; k < 5; k++)
+        assert_int_equal(offset[k], 8192 * k); /* the file's chunks, not CHUNK_ELEMS */
+    H5Tclose(ot);
+    H5Dclose(ix);
+    H5Fclose(f);
+    remove_pair(path);
+}
+
 /* ------------------------------------------------------------------ version 1 files */
 
 /* tests/data/format_v1.h5 was written by the version-1 writer (one group per increment):
@@ -2415,6 +2513,7 @@ int main(void) {
         cmocka_unit_test(test_format_checkpoint_torn),
         cmocka_unit_test(test_format_checkpoint_compressed_in_place),
         cmocka_unit_test(test_format_checkpoint_reads_uncompressed),
+        cmocka_unit_test(test_format_reads_and_resumes_chunk8192_file),
         cmocka_unit_test(test_format_reopen_truncate_append),
         cmocka_unit_test(test_format_swmr_live_refresh),
         cmocka_unit_test(test_format_write_failure_keeps_increments),
