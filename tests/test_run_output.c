@@ -319,7 +319,7 @@ static void test_run_output_space_estimate(void **state) {
  * (MB = 10^6 bytes, as everywhere in the docs; 10.43 MB measured). The issue's goal, the
  * original program's 10.1 MB, is not reached without changing stored values: the element
  * data alone are 9.70 MB for 2422 elements (the original had 2271; 14.2 bytes per element
- * and increment against its 15.7), the rest of the file without checkpoints 0.21 MB, and
+ * and increment against its 15.7), the rest of the file without checkpoints 0.20 MB, and
  * the two checkpoint slots 0.52 MB that resume needs bit for bit. */
 #define DEFAULT_RUN_FILE_LIMIT 10450000.0
 static void test_run_output_default_file_size(void **state) {

@@ -13,7 +13,8 @@
  * The low bytes of a double are noise, its high bytes repeat: transposed, deflate finds the
  * repeats (the default run's slots: 267 KB at level 4 untransposed, 245 KB now). An array is
  * transposed when a level-1 trial on its first SHUFFLE_PROBE bytes says it compresses better
- * so (masses and radius sums, few distinct values, compress better as they are). Unpacking
+ * so (masses, flags and the pairs' shear displacements and forces compress better as they
+ * are). Unpacking
  * undoes the transposition, so the blob's bytes, and so the restored run, are the same (its
  * checksum is checked after). Compressing here, not with an HDF5 filter: a filtered chunk
  * that is rewritten with another compressed size moves, and in SWMR mode HDF5 never frees the
