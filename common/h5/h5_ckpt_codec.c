@@ -14,10 +14,9 @@
  * repeats (the default run's slots: 267 KB at level 4 untransposed, 245 KB now). An array is
  * transposed when a level-1 trial on its first SHUFFLE_PROBE bytes says it compresses better
  * so (masses, flags and the pairs' shear displacements and forces compress better as they
- * are). Unpacking
- * undoes the transposition, so the blob's bytes, and so the restored run, are the same (its
- * checksum is checked after). Compressing here, not with an HDF5 filter: a filtered chunk
- * that is rewritten with another compressed size moves, and in SWMR mode HDF5 never frees the
+ * are). Unpacking undoes the transposition, so the blob's bytes, and so the restored run, are
+ * the same (its checksum is checked after). Compressing here, not with an HDF5 filter: a filtered
+ * chunk that is rewritten with another compressed size moves, and in SWMR mode HDF5 never frees the
  * old place, so every checkpoint would leave its predecessor behind in the file (28 per
  * default run); the unfiltered slot is rewritten in place. Slots of older files hold
  * "CDEMSNPZ" | u64 blob length | the blob as one zlib stream, or the bare "CDEMSNAP" blob;

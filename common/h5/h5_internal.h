@@ -27,12 +27,13 @@
 
 /* Compression settings, chosen by measurement (docs/format.md, "Size"): element data deflate
  * level 4 after byte shuffle (level 6 saved 0.3 % of the default run's file for 25 % more
- * writing CPU, level 9 0.5 % for 80 %); checkpoints level 6 (h5_ckpt_codec.c: 8 KB less
+ * writing CPU, level 9 about 0.4 % for 85 %); checkpoints level 6 (h5_ckpt_codec.c: 8 KB less
  * than level 4 per run for 3 ms per checkpoint; level 9 saved nothing more and took 2.3 times
  * as long). An increment of the element datasets starts at a chunk boundary and is one chunk
  * up to CHUNK_ELEMS elements (4096 doubles = 32 KiB): the rows up to the next boundary are
  * padding, and deflate still spends bytes on zeros (a match per 258 bytes: about 250 bytes for
- * the 5770 padding rows of a double dataset), so the chunk should be near the element count;
+ * the 5770 padding rows of a double dataset with 8192-row chunks), so the chunk should be near
+ * the element count;
  * a larger count spans several chunks (each split costs about 70 bytes per dataset). For the
  * default run (2422 elements) 4096 rows took 143 KB less than 8192 (files written before),
  * a chunk of exactly 2422 rows 78 KB less again; 2048 rows (two chunks) 80 KB more. The
