@@ -33,13 +33,12 @@
  * up to CHUNK_ELEMS elements (4096 doubles = 32 KiB): the rows up to the next boundary are
  * padding, and deflate still spends bytes on zeros (a match per 258 bytes: about 250 bytes for
  * the 5770 padding rows of a double dataset with 8192-row chunks), so the chunk should be near
- * the element count;
- * a larger count spans several chunks (each split costs about 70 bytes per dataset). For the
- * default run (2422 elements) 4096 rows took 143 KB less than 8192 (files written before),
- * a chunk of exactly 2422 rows 78 KB less again; 2048 rows (two chunks) 80 KB more. The
- * series, index and checkpoint-slot chunks are allocated whole, so their last chunk is partly
- * empty: 128 samples (1 KiB), 64 index rows (4.75 KiB) and 4 KiB of slot keep that small
- * (512, 256 and 16 KiB before: 51 KB more in the default run's file). */
+ * the element count; a larger count spans several chunks (each split costs about 70 bytes
+ * per dataset). For the default run (2422 elements) 4096 rows took 143 KB less than 8192
+ * (files written before), a chunk of exactly 2422 rows 78 KB less again; 2048 rows (two
+ * chunks) 80 KB more. The series, index and checkpoint-slot chunks are allocated whole, so
+ * their last chunk is partly empty: 128 samples (1 KiB), 64 index rows (4.75 KiB) and 4 KiB
+ * of slot keep that small (512, 256 and 16 KiB before: 51 KB more in the default run's file). */
 #define DEFLATE_LEVEL      4
 #define CKPT_DEFLATE_LEVEL 6
 #define CHUNK_ELEMS        4096
