@@ -4,7 +4,8 @@
  * Layout: root attributes (format, version, seed, texts); /stop_reason, /stop_detail;
  * /parameters; /increments/index (one row per increment, written after its data: the commit
  * record) and ragged extendible element datasets /increments/{id,x,y,...}; /series/<column>;
- * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs).
+ * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs; empty in a
+ * completed run's file, whose close drops them).
  * Every object is created with the file; the writer then runs in HDF5 SWMR-write mode, so a
  * writer killed at any moment leaves every completed increment readable and a reader can
  * follow a running simulation (cdem_h5_reader_refresh). A writer holds the path's lock
