@@ -146,7 +146,7 @@ man: all
 	/usr/bin/python3 scripts/help2roff.py $(BUILD) man
 
 # docs/measured.md: the default model's counts and file sizes quoted by the docs, measured
-# afresh (two default runs); make validate fails when the committed page is stale.
+# afresh (three default runs); make validate fails when the committed page is stale.
 .PHONY: measured
 measured: all
 	/usr/bin/python3 scripts/measure_docs.py $(BUILD) > docs/measured.md.tmp

@@ -4,7 +4,8 @@
  * Layout: root attributes (format, version, seed, texts); /stop_reason, /stop_detail;
  * /parameters; /increments/index (one row per increment, written after its data: the commit
  * record) and ragged extendible element datasets /increments/{id,x,y,...}; /series/<column>;
- * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs).
+ * /checkpoint/{index,slot0,slot1} (double-buffered, checksummed snapshot blobs; empty in a
+ * completed run's file, whose close drops them).
  * Every object is created with the file; the writer then runs in HDF5 SWMR-write mode, so a
  * writer killed at any moment leaves every completed increment readable and a reader can
  * follow a running simulation (cdem_h5_reader_refresh). A writer holds the path's lock
@@ -116,8 +117,27 @@ cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sa
 cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason,
                                            const char *detail, cdem_error *err);
 
-/* Flushes everything and closes; w may be NULL. Returns the first error met. */
+/* Flushes everything and closes; w may be NULL. Returns the first error met.
+ * A run whose stop reason is "completed" is never resumed, so when its file holds checkpoints
+ * close drops them: it writes a copy without them next to the file (PATH.compacting), syncs it
+ * and renames it over PATH (docs/format.md, "Completed runs"); /checkpoint stays, empty. Any
+ * other stop reason keeps the checkpoints for cdem-run --resume. A crash while compacting
+ * leaves the complete original; a compaction that cannot be done (no space for the copy)
+ * leaves the file with its checkpoints and is not an error (cdem_h5_writer_close_report says
+ * why). The environment variable CDEM_KEEP_CHECKPOINTS=1 turns compaction off (tests). */
 cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err);
+
+/* What close did with a completed run's checkpoints. */
+typedef struct {
+    int compacted;         /* 1: the checkpoints were dropped and the file compacted */
+    uint64_t bytes_before; /* file size before compacting (0: not tried) */
+    uint64_t bytes_after;  /* file size after (= before when not compacted) */
+    char note[640];        /* why a completed run's file kept its checkpoints, else "" */
+} cdem_h5_close_report;
+
+/* cdem_h5_writer_close, also reporting the compaction (rep may be NULL). */
+cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report *rep,
+                                        cdem_error *err);
 
 /* Durability (on by default): every commit (an increment's index row, a checkpoint's index
  * row, the stop reason) is flushed to stable storage with fsync before the writer goes on,

@@ -459,10 +459,13 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
         }
         cdem_error e3;
         cdem_error_clear(&e3);
-        cdem_status cst = cdem_h5_writer_close(r->w, st == CDEM_OK ? err : &e3);
+        cdem_h5_close_report rep;
+        cdem_status cst = cdem_h5_writer_close_report(r->w, &rep, st == CDEM_OK ? err : &e3);
         if (st == CDEM_OK)
             st = cst;
         r->w = NULL;
+        if (rep.note[0] && run_logging(r)) /* the file is complete, only larger */
+            fprintf(r->opt->log, "cdem-run: note: %s\n", rep.note);
         if (cst == CDEM_OK)
             run_log_wrote(r, st, had_writer);
     }

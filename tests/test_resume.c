@@ -4,7 +4,9 @@
  *    datasets, the series, the texts and the newest checkpoint (compared through the reader;
  *    the creation time is the only attribute left out);
  *  - a run SIGKILLed after a checkpoint, or stopped by --max-steps, and resumed gives the
- *    file (and newest checkpoint) of an uninterrupted run;
+ *    file (and newest checkpoint) of an uninterrupted run; an interrupted or stopped run keeps
+ *    its checkpoints, a completed one drops them (its values are those of a run that keeps
+ *    them, CDEM_KEEP_CHECKPOINTS=1) and cannot be resumed;
  *  - refused resumes: a completed run, -s overrides, a model file, -o, a missing file, a
  *    non-HDF5 file, a file without checkpoint, each with its message and exit status.
  * Scratch files go to a private directory under $CDEM_TEST_TMP. */
@@ -33,6 +35,9 @@ typedef struct {
     char bin[1024];      /* path of cdem-run */
     scratch_dir scratch; /* private scratch directory */
 } rs_ctx;
+
+/* cdem-run's environment to keep a completed run's checkpoints (h5format.h) */
+#define KEEP "CDEM_KEEP_CHECKPOINTS=1"
 
 /* The small model every test runs (1370 elements, 5322 steps, 22 increments). */
 #define SMALL                                                                                      \
@@ -207,9 +212,12 @@ static void compare_checkpoints(const char *pa, const char *pb);
 static void test_resume_determinism_threads_1_2_3(void **state) {
     const rs_ctx *c = *state;
     char p1[1200], p2[1200], p3[1200];
-    assert_int_equal(run(c, "OMP_NUM_THREADS=1", "-q -o t1.h5 --par-min 64 " SMALL), 0);
-    assert_int_equal(run(c, "OMP_NUM_THREADS=2", "-q -o t2.h5 --par-min 64 " SMALL), 0);
-    assert_int_equal(run(c, "OMP_NUM_THREADS=3", "-q -o t3.h5 --par-min 64 " SMALL), 0);
+    assert_int_equal(
+        run(c, "OMP_NUM_THREADS=1 CDEM_KEEP_CHECKPOINTS=1", "-q -o t1.h5 --par-min 64 " SMALL), 0);
+    assert_int_equal(
+        run(c, "OMP_NUM_THREADS=2 CDEM_KEEP_CHECKPOINTS=1", "-q -o t2.h5 --par-min 64 " SMALL), 0);
+    assert_int_equal(
+        run(c, "OMP_NUM_THREADS=3 CDEM_KEEP_CHECKPOINTS=1", "-q -o t3.h5 --par-min 64 " SMALL), 0);
     path_of(c, "t1.h5", p1, sizeof p1);
     path_of(c, "t2.h5", p2, sizeof p2);
     path_of(c, "t3.h5", p3, sizeof p3);
@@ -243,6 +251,23 @@ static void compare_checkpoints(const char *pa, const char *pb) {
     cdem_snapshot_free(sb);
     cdem_h5_reader_close(a);
     cdem_h5_reader_close(b);
+}
+
+/* What reading the newest checkpoint of path returns (CDEM_OK: it has one). */
+static cdem_status checkpoint_status(const char *path) {
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    cdem_snapshot *snap = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    int32_t inc = -1;
+    cdem_status st = cdem_h5_reader_read_checkpoint(r, snap, &inc, &err);
+    if (st == CDEM_ERR_NOTFOUND && !strstr(err.msg, "checkpoints were dropped"))
+        fail_msg("no checkpoint, but not said to be dropped: %s", err.msg);
+    cdem_snapshot_free(snap);
+    cdem_h5_reader_close(r);
+    return st;
 }
 
 /* 1 when the file contains needle. */
@@ -307,7 +332,9 @@ static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
  * straight run's increments, series and newest checkpoint. */
 static void test_resume_after_sigkill_is_bit_identical(void **state) {
     const rs_ctx *c = *state;
-    assert_int_equal(run(c, NULL, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
+    /* completed runs keep their checkpoints only with CDEM_KEEP_CHECKPOINTS (docs/format.md,
+     * "Completed runs"): kept here to compare them */
+    assert_int_equal(run(c, KEEP, "-q -o straight.h5 -s output.checkpoint_interval=2 " SMALL), 0);
     char ps[1200], pk[1200], pi[1200];
     path_of(c, "straight.h5", ps, sizeof ps);
     path_of(c, "killed.h5", pk, sizeof pk);
@@ -315,7 +342,7 @@ static void test_resume_after_sigkill_is_bit_identical(void **state) {
 
     int st = start_and_signal(c, "killed", SIGKILL);
     assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
-    assert_int_equal(run(c, NULL, "-q --resume killed.h5"), 0);
+    assert_int_equal(run(c, KEEP, "-q --resume killed.h5"), 0);
     compare_files(ps, pk);
     compare_checkpoints(ps, pk);
     /* and now it is complete */
@@ -329,17 +356,31 @@ static void test_resume_after_sigkill_is_bit_identical(void **state) {
     assert_int_equal(cdem_h5_reader_open(pi, &r, &err), CDEM_OK);
     assert_string_equal(cdem_h5_reader_stop_reason(r), "interrupted");
     cdem_h5_reader_close(r);
+    assert_int_equal(checkpoint_status(pi), CDEM_OK); /* an interrupted run keeps them */
+    /* resumed to completion with the default: the checkpoints are dropped, the file is
+     * compacted, every value is the straight run's */
     assert_int_equal(run(c, NULL, "-q --resume stopped.h5"), 0);
     compare_files(ps, pi);
-    compare_checkpoints(ps, pi);
+    assert_int_equal(checkpoint_status(pi), CDEM_ERR_NOTFOUND);
+    struct stat sa, sb;
+    assert_int_equal(stat(ps, &sa), 0);
+    assert_int_equal(stat(pi, &sb), 0);
+    if (sb.st_size >= sa.st_size)
+        fail_msg("the compacted file has %lld bytes, the one with checkpoints %lld",
+                 (long long)sb.st_size, (long long)sa.st_size);
+    char leftover[1300];
+    snprintf(leftover, sizeof leftover, "%s.compacting", pi);
+    assert_int_not_equal(access(leftover, F_OK), 0);
+    assert_int_equal(run(c, NULL, "--resume stopped.h5"), 1);
+    expect_err(c, "already completed");
 }
 
 /* Stopped by --max-steps between checkpoints (its stop checkpoint is the
  * newest) and resumed: the uninterrupted run's file and newest checkpoint. */
 static void test_resume_after_max_steps_is_bit_identical(void **state) {
     const rs_ctx *c = *state;
-    assert_int_equal(run(c, NULL, "-q -o straight3.h5 -s output.checkpoint_interval=3 " SMALL), 0);
-    assert_int_equal(run(c, NULL,
+    assert_int_equal(run(c, KEEP, "-q -o straight3.h5 -s output.checkpoint_interval=3 " SMALL), 0);
+    assert_int_equal(run(c, KEEP,
                          "-q -o early.h5 --max-steps 4321 -s "
                          "output.checkpoint_interval=3 " SMALL),
                      0);
@@ -351,7 +392,8 @@ static void test_resume_after_max_steps_is_bit_identical(void **state) {
     assert_int_equal(cdem_h5_reader_open(pe, &r, &err), CDEM_OK);
     assert_string_equal(cdem_h5_reader_stop_reason(r), "stopped-early");
     cdem_h5_reader_close(r);
-    assert_int_equal(run(c, NULL, "-q --resume early.h5"), 0);
+    assert_int_equal(checkpoint_status(pe), CDEM_OK); /* stopped early: kept */
+    assert_int_equal(run(c, KEEP, "-q --resume early.h5"), 0);
     compare_files(ps, pe);
     compare_checkpoints(ps, pe);
 }

@@ -158,8 +158,14 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
         H5Dclose(ix);
     if (st != CDEM_OK || found)
         return st;
-    if (tried == 0)
-        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: the file holds no checkpoint", r->path);
+    if (tried == 0) {
+        /* a completed run's file, compacted without them (h5_compact.c) */
+        htri_t dropped = H5Aexists_by_name(r->file, "checkpoint", "dropped", H5P_DEFAULT);
+        H5Eclear2(H5E_DEFAULT);
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: the file holds no checkpoint%s", r->path,
+                         dropped > 0 ? " (the run completed and its checkpoints were dropped)"
+                                     : "");
+    }
     return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: no valid checkpoint (%s%s%s)", r->path, why[0],
                      why[0][0] && why[1][0] ? "; " : "", why[1]);
 }

@@ -301,6 +301,15 @@ cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta 
         st = CDEM_FAIL(err, CDEM_ERR_IO,
                        "%s: cannot remove %s, left by an earlier run that was killed: %s", path,
                        tmp, strerror(errno));
+    /* and a crashed compaction's copy (h5_compact.c): the file at path is the complete one */
+    if (st == CDEM_OK) {
+        char *compacting = malloc(strlen(path) + 12);
+        if (compacting) {
+            snprintf(compacting, strlen(path) + 12, "%s.compacting", path);
+            (void)unlink(compacting);
+            free(compacting);
+        }
+    }
     if (st == CDEM_OK)
         st = writer_setup(w, meta, tmp, replace, err);
     if (st != CDEM_OK) {

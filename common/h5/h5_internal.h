@@ -5,6 +5,7 @@
  * h5_create.c (a new file: layout, then SWMR, then the rename into place), h5_writer.c
  * (appending increments and series; the commit protocol: data, flush, index row, flush),
  * h5_resume.c (re-opening a file for --resume), h5_checkpoint.c (the two checkpoint slots),
+ * h5_compact.c (a completed run's file rewritten without its checkpoints),
  * h5_ckpt_codec.c (a snapshot as bytes), h5_superblock.c (the superblock read before HDF5
  * does), h5_reader.c (open, index, increments, series, texts), h5_reader_v1.c (the version-1
  * layout), h5_sidecar.c (the XDMF grids; the XML itself is common/xdmf.c) and h5_output.c
@@ -235,6 +236,7 @@ struct cdem_h5_writer {
     cdem_runlock *lock;             /* the path's lock (PATH.lock), held until close */
     int sync;                       /* 1: sync (fdatasync) every commit (_set_sync) */
     int placed;                     /* 1 once the file is at path (before: PATH.creating) */
+    int completed;                  /* 1: the last stop reason recorded is "completed" */
 };
 
 /* h5_create.c */
@@ -248,6 +250,10 @@ cdem_status h5i_commit_flush(cdem_h5_writer *w, cdem_error *err);
 void h5i_sync_folder_of(const char *path);
 void h5i_writer_release(cdem_h5_writer *w);
 cdem_status h5i_grow_entries(cdem_h5_writer *w, cdem_error *err);
+
+/* h5_compact.c: replaces the closed file at path by a copy without checkpoints (the caller
+ * holds the path's lock); never fails the run: rep says what happened. */
+void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep);
 
 /* h5_sidecar.c: rewrites the writer's sidecar from its list of increments. */
 cdem_status h5i_write_xmf(cdem_h5_writer *w, cdem_error *err);

@@ -278,6 +278,7 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
     if (H5Dflush(w->stop_detail) < 0 || H5Dflush(w->stop_reason) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot flush the stop reason '%s'", w->path,
                       reason ? reason : "");
+    w->completed = reason && strcmp(reason, "completed") == 0;
     /* not sync_file: after a failed write it would mark nothing new, and w->failed must not
      * turn a recorded stop reason into an error */
     if (w->sync && !w->failed) {
@@ -292,6 +293,15 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
 }
 
 cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
+    return cdem_h5_writer_close_report(w, NULL, err);
+}
+
+cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report *rep,
+                                        cdem_error *err) {
+    cdem_h5_close_report scratch;
+    if (!rep)
+        rep = &scratch;
+    memset(rep, 0, sizeof *rep);
     if (!w)
         return CDEM_OK;
     cdem_status st = w->failed ? CDEM_OK : flush_series(w, err);
@@ -331,6 +341,9 @@ cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
                 H5Dclose(w->data[k]);
             w->data[k] = -1;
         }
+        /* a completed run's checkpoints are dropped below, when there are any */
+        const int has_checkpoints = (w->ckpt_data[0] >= 0 && h5i_extent_of(w->ckpt_data[0]) > 0) ||
+                                    (w->ckpt_data[1] >= 0 && h5i_extent_of(w->ckpt_data[1]) > 0);
         hid_t *rest[] = {&w->index,        &w->stop_reason,  &w->stop_detail,
                          &w->ckpt_data[0], &w->ckpt_data[1], &w->ckpt_index};
         for (size_t i = 0; i < sizeof rest / sizeof rest[0]; i++) {
@@ -341,6 +354,9 @@ cdem_status cdem_h5_writer_close(cdem_h5_writer *w, cdem_error *err) {
         if (H5Fclose(file) < 0 && st == CDEM_OK)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close the file (disk full?)", w->path);
         es = h5i_keep_errors(st != CDEM_OK);
+        /* closed cleanly: compact under the lock, which h5i_writer_release gives up */
+        if (st == CDEM_OK && w->completed && has_checkpoints && w->placed)
+            h5i_compact_completed(w->path, w->sync, rep);
     }
     h5i_writer_release(w);
     h5i_restore_errors(es);
