@@ -61,6 +61,13 @@ typedef struct {
     double boundary_force_y;    /* N */
     double base_force_x;        /* N, total contact force on the fixed base elements */
     double base_force_y;        /* N */
+    double left_wall_force_x;   /* N, total contact force on the left lateral wall's elements
+                                   (wall elements off the base row, left of the model's
+                                   middle; fixed or moving); NaN when read from a file
+                                   written before the column existed */
+    double left_wall_force_y;   /* N */
+    double right_wall_force_x;  /* N, the same for the right lateral wall */
+    double right_wall_force_y;  /* N */
     double axial_strain;        /* biaxial */
     double differential_stress; /* biaxial, N/m */
     double sea_level;           /* m, NaN when none */

@@ -156,6 +156,15 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
         if (r->s.flags[i] & CDEM_FLAG_WALL)
             ywall = fmin(ywall, r->s.y[i]);
     r->base_tol_y = ywall + 0.5 * r->m.radius[0];
+    /* the lateral walls' sides: halfway between the outermost wall elements (the walls only
+     * ever move inward, never past the middle) */
+    double xlo = INFINITY, xhi = -INFINITY;
+    for (size_t i = 0; i < r->s.n; i++)
+        if (r->s.flags[i] & CDEM_FLAG_WALL) {
+            xlo = fmin(xlo, r->s.x[i]);
+            xhi = fmax(xhi, r->s.x[i]);
+        }
+    r->wall_mid_x = 0.5 * (xlo + xhi);
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     r->it.unstable_guard = 1;    /* check_unstable */

@@ -73,6 +73,7 @@ struct cdem_run_ctx {
     long next_inc_step;          /* step of increment next_inc on the model schedule */
     long last_written_step;      /* step of the last increment written (-1: none) */
     double base_tol_y;           /* m, wall elements with y below this are the base */
+    double wall_mid_x;           /* m, lateral wall elements left of this are the left wall's */
     long removed;                /* escaped elements removed */
     long eroded;                 /* elements removed by erosion, whole run */
     double erosion_y;            /* m, erosion level (INFINITY until the end of equilibration) */

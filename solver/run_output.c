@@ -40,16 +40,28 @@ cdem_status run_write_sample(run_ctx *r, cdem_error *err) {
     q.time = (double)r->step * r->m.dt;
     const cdem_state *s = &r->s;
     double ke = 0.0, bfx = 0.0, bfy = 0.0, gfx = 0.0, gfy = 0.0;
-    for (size_t i = 0; i < s->n; i++) { /* serial, fixed order: reproducible sums */
+    double wall[2][2] = {{0.0, 0.0}, {0.0, 0.0}}; /* [left, right][x, y] */
+    for (size_t i = 0; i < s->n; i++) {           /* serial, fixed order: reproducible sums */
         const uint32_t f = s->flags[i];
         if (!(f & CDEM_FLAGS_BOUNDARY)) {
             ke += 0.5 * s->mass[i] * (s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i]);
-        } else if (f & CDEM_FLAG_MOVING) {
+            continue;
+        }
+        if (f & CDEM_FLAG_MOVING) {
             bfx += s->fx[i];
             bfy += s->fy[i];
         } else if ((f & CDEM_FLAG_WALL) && s->y[i] <= r->base_tol_y) {
             gfx += s->fx[i];
             gfy += s->fy[i];
+        }
+        /* lateral walls, fixed or moving: wall elements off the base row (the biaxial
+         * platens are base rows), not faces of a fault */
+        if ((f & (CDEM_FLAG_WALL | CDEM_FLAG_BASE | CDEM_FLAG_FAULT | CDEM_FLAG_MYLAR |
+                  CDEM_FLAG_FOOTWALL)) == CDEM_FLAG_WALL &&
+            s->y[i] > r->base_tol_y) {
+            double *side = wall[s->x[i] < r->wall_mid_x ? 0 : 1];
+            side[0] += s->fx[i];
+            side[1] += s->fy[i];
         }
     }
     long contacts = 0, bonds = 0;
@@ -63,6 +75,10 @@ cdem_status run_write_sample(run_ctx *r, cdem_error *err) {
     q.boundary_force_y = bfy;
     q.base_force_x = gfx;
     q.base_force_y = gfy;
+    q.left_wall_force_x = wall[0][0];
+    q.left_wall_force_y = wall[0][1];
+    q.right_wall_force_x = wall[1][0];
+    q.right_wall_force_y = wall[1][1];
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
     cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;

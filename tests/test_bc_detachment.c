@@ -14,6 +14,7 @@
 #include "contact.h"
 #include "scratch.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -154,6 +155,20 @@ static void test_bc_detachment_cdem_run(void **st) {
             deform++;
         }
         assert_int_equal(deform, 6); /* 300 steps / ~50.3 steps per increment, + the last */
+        /* the lateral walls' forces, each wall on its own: the material pushes the left wall
+         * left and the right wall right; the moving walls' sum is the boundary force */
+        cdem_series_sample *smp = NULL;
+        size_t ns = 0;
+        assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);
+        assert_true(ns > 0);
+        const cdem_series_sample *q = &smp[ns - 1];
+        assert_true(q->left_wall_force_x < 0.0);
+        assert_true(q->right_wall_force_x > 0.0);
+        const double moving =
+            k == 0 ? q->right_wall_force_x : q->left_wall_force_x + q->right_wall_force_x;
+        const double scale = fabs(q->left_wall_force_x) + fabs(q->right_wall_force_x);
+        assert_float_equal(q->boundary_force_x, moving, 1e-9 * scale);
+        free(smp);
         cdem_h5_reader_close(r);
     }
 }

@@ -104,6 +104,10 @@ static cdem_series_sample make_sample(size_t i) {
     s.boundary_force_y = -2e9 - (double)i;
     s.base_force_x = 3e8 * (double)i;
     s.base_force_y = -4e8;
+    s.left_wall_force_x = 5e8 + (double)i;
+    s.left_wall_force_y = -6e7 * (double)i;
+    s.right_wall_force_x = -5e8 - 2.0 * (double)i;
+    s.right_wall_force_y = 7e7;
     s.axial_strain = 1e-4 * (double)i;
     s.differential_stress = 1e6 * (double)i;
     s.sea_level = i % 3 ? 2500.0 + (double)i : NAN;
@@ -122,6 +126,10 @@ static void assert_same_sample(const cdem_series_sample *a, const cdem_series_sa
                          a->boundary_force_y,
                          a->base_force_x,
                          a->base_force_y,
+                         a->left_wall_force_x,
+                         a->left_wall_force_y,
+                         a->right_wall_force_x,
+                         a->right_wall_force_y,
                          a->axial_strain,
                          a->differential_stress};
     const double db[] = {b->time,
@@ -131,6 +139,10 @@ static void assert_same_sample(const cdem_series_sample *a, const cdem_series_sa
                          b->boundary_force_y,
                          b->base_force_x,
                          b->base_force_y,
+                         b->left_wall_force_x,
+                         b->left_wall_force_y,
+                         b->right_wall_force_x,
+                         b->right_wall_force_y,
                          b->axial_strain,
                          b->differential_stress};
     for (size_t k = 0; k < sizeof da / sizeof da[0]; k++)
@@ -1420,6 +1432,43 @@ static void assert_fixture_increment(const cdem_state *s, const cdem_increment_i
     }
 }
 
+/* A file written before the lateral-wall force columns existed (they are removed from a fresh
+ * file here) reads: those columns are NaN ("not measured"), every other column as written. */
+static void test_format_series_without_wall_columns(void **state) {
+    (void)state;
+    char path[1024];
+    scratch_path(path, sizeof path, "no_wall_columns.h5");
+    write_small(path, 4, 0);
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    const char *cols[] = {"series/left_wall_force_x", "series/left_wall_force_y",
+                          "series/right_wall_force_x", "series/right_wall_force_y"};
+    for (size_t c = 0; c < 4; c++)
+        assert_true(H5Ldelete(f, cols[c], H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    cdem_series_sample *smp = NULL;
+    size_t n = 0;
+    if (cdem_h5_reader_read_series(r, &smp, &n, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(n, 12);
+    for (size_t i = 0; i < n; i++) {
+        cdem_series_sample ex = make_sample(i);
+        assert_true(isnan(smp[i].left_wall_force_x) && isnan(smp[i].left_wall_force_y) &&
+                    isnan(smp[i].right_wall_force_x) && isnan(smp[i].right_wall_force_y));
+        smp[i].left_wall_force_x = ex.left_wall_force_x;
+        smp[i].left_wall_force_y = ex.left_wall_force_y;
+        smp[i].right_wall_force_x = ex.right_wall_force_x;
+        smp[i].right_wall_force_y = ex.right_wall_force_y;
+        assert_same_sample(&smp[i], &ex);
+    }
+    free(smp);
+    cdem_h5_reader_close(r);
+}
+
 /* A file written before the chunks shrank (tests/data/format_v2_chunk8192.h5: element chunks
  * of 8192 rows, a checkpoint slot packed as "CDEMSNPZ") reads, its checkpoint reads, and a
  * resume appends at its own 8192-row boundaries (never into a compressed chunk). */
@@ -2516,6 +2565,7 @@ int main(void) {
         cmocka_unit_test(test_format_checkpoint_compressed_in_place),
         cmocka_unit_test(test_format_checkpoint_reads_uncompressed),
         cmocka_unit_test(test_format_reads_and_resumes_chunk8192_file),
+        cmocka_unit_test(test_format_series_without_wall_columns),
         cmocka_unit_test(test_format_reopen_truncate_append),
         cmocka_unit_test(test_format_swmr_live_refresh),
         cmocka_unit_test(test_format_write_failure_keeps_increments),

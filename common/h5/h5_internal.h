@@ -114,9 +114,11 @@ typedef struct {
     const char *name; /* dataset name under /series */
     col_type type;    /* int64 or float64 */
     size_t offset;    /* offsetof(cdem_series_sample, field) */
+    int optional;     /* 1: added after format version 2 first shipped; a file without it
+                         reads as NaN (its writer did not measure it) */
 } series_column;
 
-#define N_SERIES 14
+#define N_SERIES 18
 extern const series_column h5i_series_columns[N_SERIES];
 
 /* Per-element datasets of an increment: the rows of CDEM_STATE_FIELDS (state.h) marked

@@ -13,7 +13,9 @@
 #include <string.h>
 
 #define SCOL(field, type)                                                                          \
-    { #field, type, offsetof(cdem_series_sample, field) }
+    { #field, type, offsetof(cdem_series_sample, field), 0 }
+#define SCOL_OPTIONAL(field, type)                                                                 \
+    { #field, type, offsetof(cdem_series_sample, field), 1 }
 const series_column h5i_series_columns[] = {
     SCOL(step, COL_I64),
     SCOL(time, COL_F64),
@@ -29,8 +31,13 @@ const series_column h5i_series_columns[] = {
     SCOL(axial_strain, COL_F64),
     SCOL(differential_stress, COL_F64),
     SCOL(sea_level, COL_F64),
+    SCOL_OPTIONAL(left_wall_force_x, COL_F64),
+    SCOL_OPTIONAL(left_wall_force_y, COL_F64),
+    SCOL_OPTIONAL(right_wall_force_x, COL_F64),
+    SCOL_OPTIONAL(right_wall_force_y, COL_F64),
 };
 #undef SCOL
+#undef SCOL_OPTIONAL
 static_assert(sizeof h5i_series_columns / sizeof h5i_series_columns[0] == N_SERIES,
               "N_SERIES (h5_internal.h) is the length of the table");
 

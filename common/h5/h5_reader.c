@@ -505,6 +505,11 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
     for (; opened < N_SERIES; opened++) {
         char name[64];
         snprintf(name, sizeof name, "series/%s", h5i_series_columns[opened].name);
+        if (h5i_series_columns[opened].optional && H5Lexists(r->file, name, H5P_DEFAULT) <= 0) {
+            ds[opened] = -1; /* a file from before the column existed: NaN below */
+            dims[opened] = 0;
+            continue;
+        }
         ds[opened] = H5Dopen2(r->file, name, H5P_DEFAULT);
         if (ds[opened] >= 0 && r->swmr)
             H5Drefresh(ds[opened]);
@@ -535,7 +540,7 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
     if (st == CDEM_OK) {
         len = dims[0];
         for (size_t c = 1; c < N_SERIES; c++) {
-            if (dims[c] == len)
+            if (dims[c] == len || ds[c] < 0)
                 continue;
             /* A writer killed inside a flush may leave columns of different lengths: keep
              * the common part. A closed file must be consistent. */
@@ -562,6 +567,12 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
     /* Pass 2: read the columns into the samples. */
     for (size_t c = 0; st == CDEM_OK && c < N_SERIES && len > 0; c++) {
         const series_column *sc = &h5i_series_columns[c];
+        if (ds[c] < 0) { /* absent optional column (float64): not measured */
+            const double nan = NAN;
+            for (hsize_t i = 0; i < len; i++)
+                memcpy((char *)&out[i] + sc->offset, &nan, 8);
+            continue;
+        }
         hid_t mt = sc->type == COL_I64 ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
         if (read_rows_retrying(r, ds[c], mt, len, col) < 0) {
             st = H5FAIL(err, CDEM_ERR_FORMAT,

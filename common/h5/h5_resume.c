@@ -65,6 +65,10 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     char name[64];
     for (size_t c = 0; c < N_SERIES; c++) {
         snprintf(name, sizeof name, "series/%s", h5i_series_columns[c].name);
+        if (h5i_series_columns[c].optional && H5Lexists(w->file, name, H5P_DEFAULT) <= 0) {
+            w->series[c] = -1; /* written before the column existed: it stays without it */
+            continue;
+        }
         if ((w->series[c] = H5Dopen2(w->file, name, H5P_DEFAULT)) < 0)
             return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing", w->path, name);
     }
@@ -129,6 +133,8 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     /* Series samples to keep: the leading ones with step <= keep_step. */
     hsize_t slen = h5i_extent_of(w->series[0]);
     for (size_t c = 1; c < N_SERIES; c++) {
+        if (w->series[c] < 0)
+            continue;
         hsize_t e = h5i_extent_of(w->series[c]);
         slen = e < slen ? e : slen;
     }
@@ -150,7 +156,7 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         ok = ok && H5Dset_extent(w->data[k], h5i_element_fields[k].optional ? &w->stress_len
                                                                             : &w->data_len) >= 0;
     for (size_t c = 0; c < N_SERIES; c++)
-        ok = ok && H5Dset_extent(w->series[c], &w->series_len) >= 0;
+        ok = ok && (w->series[c] < 0 || H5Dset_extent(w->series[c], &w->series_len) >= 0);
     ok = ok && H5Dset_extent(w->index, &w->index_len) >= 0;
     if (!ok)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot truncate the datasets to increment %d", w->path,

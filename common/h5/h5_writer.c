@@ -98,6 +98,8 @@ static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
         return CDEM_OK;
     for (size_t c = 0; c < N_SERIES; c++) {
         const series_column *col = &h5i_series_columns[c];
+        if (w->series[c] < 0 && col->optional)
+            continue; /* a resumed file from before the column existed: it stays without */
         for (size_t i = 0; i < w->nbuf; i++) {
             const char *src = (const char *)&w->buf[i] + col->offset;
             memcpy((char *)w->column + i * 8, src, 8);
