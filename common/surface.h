@@ -3,7 +3,7 @@
  * Column c covers x0 + c w <= x < x0 + (c + 1) w; an element belongs to the column that
  * holds its centre. A column's surface element is its free (non-wall, finite, r > 0)
  * element with the highest top (y + radius). Used by the repose and wedge measurements
- * (analysis/repose.c, analysis/wedge.c), which choose x0, w and the column count.
+ * (analysis/measure/repose.c, analysis/measure/wedge.c), which choose x0, w and the column count.
  * Ownership: the caller owns the state and the output array. Thread safety: pure
  * functions, no allocation. Units: m. */
 #ifndef CDEM_SURFACE_H

@@ -45,19 +45,19 @@ GROUPS = [  # (title, source files, what to do)
      "process\" names the run writing the file: wait for it, stop it or write elsewhere. An "
      "existing output is replaced only with `--force`, and a file that is not a cdem run file "
      "never."),
-    ("cdem2D import", ["analysis/cdem2d.c"],
+    ("cdem2D import", ["analysis/input/cdem2d.c"],
      "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
      "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "
      "(modelforces_N.txt); docs/formats-text.md."),
-    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/cmd_basic.c",
-      "analysis/analysis.c", "analysis/strain.c",
-      "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "analysis/cellgrid.c",
-      "analysis/biaxial.c", "analysis/repose.c", "analysis/mohr.c", "analysis/qexport.c", "analysis/sspx.c"],
+    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/cli/cmd_basic.c",
+      "analysis/measure/analysis.c", "analysis/measure/strain.c",
+      "analysis/measure/axes.c", "analysis/measure/colorlimits.c", "analysis/measure/quantity.c", "analysis/cellgrid.c",
+      "analysis/export/biaxial.c", "analysis/measure/repose.c", "analysis/measure/mohr.c", "analysis/export/qexport.c", "analysis/export/sspx.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
      "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "
      "runs at two or more different confining pressures; repose needs a repose run."),
-    ("Pictures, plots and GIFs", ["analysis/render.c", "analysis/cmd_render.c", "analysis/plot.c",
-      "analysis/cmd_plot.c", "analysis/gif.c", "analysis/colormap.c"],
+    ("Pictures, plots and GIFs", ["analysis/draw/render.c", "analysis/cli/cmd_render.c", "analysis/draw/plot.c",
+      "analysis/cli/cmd_plot.c", "analysis/draw/gif.c", "analysis/draw/colormap.c"],
      "Check the output name's extension (.png, .pdf, .svg; .gif for --gif), that the output "
      "directory exists and is writable, the option values (sizes, colours #RRGGBB, zoom "
      "window, ranges MIN,MAX) and, for plot-series, the column names (`h5ls RUN.h5/series`)."),

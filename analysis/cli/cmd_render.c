@@ -4,6 +4,7 @@
 #include "cmd_render.h"
 
 #include "analysis.h"
+#include "run_file.h"
 #include "gif.h"
 #include "outfile.h"
 #include "render.h"

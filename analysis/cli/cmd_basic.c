@@ -5,6 +5,7 @@
 #include "cmd_basic.h"
 
 #include "analysis.h"
+#include "run_file.h"
 #include "biaxial.h"
 #include "cmd_plot.h"
 #include "cdem2d.h"

@@ -2,6 +2,7 @@
 #include "cmd_faults.h"
 
 #include "analysis.h"
+#include "run_file.h"
 #include "faults.h"
 #include "outfile.h"
 #include "quantity.h"
@@ -29,7 +30,7 @@ const cdem_cli_help cdem_cmd_faults_help = {
     .about = "Fault zones picked from a strain field: the free elements' values are binned on "
              "a square grid, runs of cells at or above the threshold in each row are linked "
              "from the top down into zones, and a line through each zone gives its dip and "
-             "dip direction (analysis/faults.h, docs/analysis.md \"Faults\"). CSV, one row "
+             "dip direction (analysis/measure/faults.h, docs/analysis.md \"Faults\"). CSV, one row "
              "per zone ordered by x at its top: zone, x_top, y_top, x_bottom, y_bottom (m), "
              "dip (degrees), dips (left or right), rows, mean and max value. A summary line "
              "goes to standard error.",

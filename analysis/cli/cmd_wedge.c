@@ -2,6 +2,7 @@
 #include "cmd_wedge.h"
 
 #include "analysis.h"
+#include "run_file.h"
 #include "csvtable.h"
 #include "plot.h"
 #include "render.h"

@@ -676,7 +676,7 @@ const cdem_cli_help cdem_cmd_voids_help = {
     .about = "Open space a rock mass should not hold, in one increment: the steepest surface "
              "slope over a horizontal window (cliffs, chasm walls), voids (closed-off room for "
              "the largest element: cavities under arches, gaps behind rigid blocks) and the "
-             "deepest open fissure (analysis/voids.h, docs/analysis.md).",
+             "deepest open fissure (analysis/measure/voids.h, docs/analysis.md).",
     .options = voids_options,
 };
 
