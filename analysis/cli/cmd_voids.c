@@ -32,8 +32,6 @@ int cdem_cmd_plot_voids(int argc, char **argv) {
         return rc;
     if (a.n_files != 1)
         return cdem_cmd_usage(&help, "need exactly one run file (RUN.h5)");
-    if (a.out)
-        return cdem_cmd_usage(&help, "prints numbers only (no -o)");
     cdem_error err;
     cdem_h5_reader *r;
     cdem_state s = {0};
