@@ -26,22 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The whole file at path (malloc'd, NUL-terminated), or NULL. */
-static char *slurp(const char *path) {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
-    if (s) {
-        size_t got = fread(s, 1, (size_t)n, f);
-        s[got] = '\0';
-    }
-    fclose(f);
-    return s;
-}
+#include "scratch.h"
 
 /* Appends text to the growing corpus *all (length *len). */
 static void append(char **all, size_t *len, const char *text) {
@@ -57,7 +42,7 @@ static void append(char **all, size_t *len, const char *text) {
 
 /* Appends the ```sh blocks of the page at path. */
 static void append_sh_blocks(char **all, size_t *len, const char *path) {
-    char *page = slurp(path);
+    char *page = scratch_read_file(path);
     assert_non_null(page);
     for (char *s = strstr(page, "```sh\n"); s; s = strstr(s, "```sh\n")) {
         s += 6;
@@ -85,7 +70,7 @@ static char *exercise_corpus(void) {
         for (size_t i = 0; i < g.gl_pathc; i++) {
             if (strstr(g.gl_pathv[i], "test_registry.c"))
                 continue; /* this file names nothing for real */
-            char *text = slurp(g.gl_pathv[i]);
+            char *text = scratch_read_file(g.gl_pathv[i]);
             if (text)
                 append(&all, &len, text);
             free(text);
@@ -160,7 +145,7 @@ static int check_names(const char *const *names, size_t n, int commands, const c
 
 static void test_registry_commands_documented_and_tested(void **state) {
     (void)state;
-    char *doc = slurp("docs/analysis.md");
+    char *doc = scratch_read_file("docs/analysis.md");
     assert_non_null(doc);
     char *corpus = exercise_corpus();
     size_t n;
@@ -186,7 +171,7 @@ static void test_registry_commands_documented_and_tested(void **state) {
 
 static void test_registry_quantities_documented_and_tested(void **state) {
     (void)state;
-    char *doc = slurp("docs/analysis.md");
+    char *doc = scratch_read_file("docs/analysis.md");
     assert_non_null(doc);
     char *corpus = exercise_corpus();
     size_t n;

@@ -26,10 +26,8 @@ static int cmd_compute(const cdem_cmd_options *o) {
         return cdem_cmd_usage(o->help, "--format h5 needs -o OUT.h5");
     cdem_error err;
     const cdem_quantity *q;
-    if (cdem_quantity_find(o->quantity, &q, &err) != CDEM_OK)
-        return cdem_cmd_fail(NULL, NULL, &err);
     cdem_analysis *a;
-    int rc = cdem_cmd_open_run(o, &a);
+    int rc = cdem_cmd_open_run_quantity(o, &q, &a);
     if (rc)
         return rc;
     size_t first, last;
@@ -123,12 +121,8 @@ static const cdem_cli_help help = {
     .options = compute_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_compute);
-}
-
-const cdem_command cdem_command_compute = {
-    "compute", "per-element values of a quantity (CSV id,x,y,value, or HDF5)", &help, run};
+CDEM_SIMPLE_COMMAND(compute, "compute",
+                    "per-element values of a quantity (CSV id,x,y,value, or HDF5)", 1, cmd_compute);
 
 int cdem_cmd_compute_file_first(int argc, char **argv) {
     return cdem_cmd_options_run(argc, argv, 0, &help, 1, cmd_compute);

@@ -85,9 +85,5 @@ static const cdem_cli_help help = {
     .options = element_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_element);
-}
-
-const cdem_command cdem_command_element = {
-    "element", "coordinates and every applicable value of one element", &help, run};
+CDEM_SIMPLE_COMMAND(element, "element", "coordinates and every applicable value of one element", 1,
+                    cmd_element);

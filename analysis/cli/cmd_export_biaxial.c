@@ -42,10 +42,6 @@ static const cdem_cli_help help = {
     .options = biaxial_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_export_biaxial);
-}
-
-const cdem_command cdem_command_export_biaxial = {
-    "export-biaxial", "biaxial test series: time step, axial strain, differential stress", &help,
-    run};
+CDEM_SIMPLE_COMMAND(export_biaxial, "export-biaxial",
+                    "biaxial test series: time step, axial strain, differential stress", 1,
+                    cmd_export_biaxial);

@@ -51,9 +51,5 @@ static const cdem_cli_help help = {
     .options = sspx_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 2, cmd_export_sspx);
-}
-
-const cdem_command cdem_command_export_sspx = {"export-sspx", "one SSPX text file per increment",
-                                               &help, run};
+CDEM_SIMPLE_COMMAND(export_sspx, "export-sspx", "one SSPX text file per increment", 2,
+                    cmd_export_sspx);

@@ -29,9 +29,5 @@ static const cdem_cli_help help = {
     .options = import_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_import_cdem2d);
-}
-
-const cdem_command cdem_command_import_cdem2d = {
-    "import-cdem2d", "convert a cdem2D simulation folder into a cdem file", &help, run};
+CDEM_SIMPLE_COMMAND(import_cdem2d, "import-cdem2d",
+                    "convert a cdem2D simulation folder into a cdem file", 1, cmd_import_cdem2d);

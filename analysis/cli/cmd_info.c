@@ -188,9 +188,4 @@ static const cdem_cli_help help = {
     .options = info_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_info);
-}
-
-const cdem_command cdem_command_info = {"info", "summary, stop reason and the list of increments",
-                                        &help, run};
+CDEM_SIMPLE_COMMAND(info, "info", "summary, stop reason and the list of increments", 1, cmd_info);

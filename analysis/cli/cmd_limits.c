@@ -12,10 +12,8 @@ static int cmd_limits(const cdem_cmd_options *o) {
         return cdem_cmd_usage(o->help, "limits needs --increment K and --quantity NAME");
     cdem_error err;
     const cdem_quantity *q;
-    if (cdem_quantity_find(o->quantity, &q, &err) != CDEM_OK)
-        return cdem_cmd_fail(NULL, NULL, &err);
     cdem_analysis *a;
-    int rc = cdem_cmd_open_run(o, &a);
+    int rc = cdem_cmd_open_run_quantity(o, &q, &a);
     if (rc)
         return rc;
     size_t k;
@@ -48,9 +46,5 @@ static const cdem_cli_help help = {
     .options = limits_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_limits);
-}
-
-const cdem_command cdem_command_limits = {
-    "limits", "colour-bar limits of a quantity at an increment", &help, run};
+CDEM_SIMPLE_COMMAND(limits, "limits", "colour-bar limits of a quantity at an increment", 1,
+                    cmd_limits);

@@ -33,8 +33,21 @@ typedef struct {
 int cdem_cmd_options_run(int argc, char **argv, int first, const cdem_cli_help *h, int positionals,
                          int (*fn)(const cdem_cmd_options *));
 
+/* The end of a simple command's file cmd_ID.c, after its function FN and its help `help`:
+ * the handler and the command's row (commands.h) for the subcommand WORD. POSITIONALS as
+ * for cdem_cmd_options_run. */
+#define CDEM_SIMPLE_COMMAND(ID, WORD, SUMMARY, POSITIONALS, FN)                                    \
+    static int run(int argc, char **argv) {                                                        \
+        return cdem_cmd_options_run(argc, argv, 1, &help, POSITIONALS, FN);                        \
+    }                                                                                              \
+    const cdem_command cdem_command_##ID = {WORD, SUMMARY, &help, run}
+
 /* Opens o->file as an analysis context (*a, closed by the caller); 0, or the exit status
  * of the usage error or failure it printed. */
 int cdem_cmd_open_run(const cdem_cmd_options *o, cdem_analysis **a);
+
+/* The quantity o->quantity (*q) and then, as cdem_cmd_open_run, the run (*a). */
+int cdem_cmd_open_run_quantity(const cdem_cmd_options *o, const cdem_quantity **q,
+                               cdem_analysis **a);
 
 #endif

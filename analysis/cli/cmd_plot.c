@@ -159,9 +159,20 @@ cdem_status cdem_cmd_plot_read_series(const char *path, cdem_series_sample **smp
     return st;
 }
 
-cdem_status cdem_cmd_plot_load_increment(cdem_h5_reader *r, const char *which, cdem_state *s,
+int cdem_cmd_plot_parse_one(int argc, char **argv, cdem_plot_args *a) {
+    const int rc = cdem_cmd_plot_parse(argc, argv, a);
+    if (rc == 0 && a->n_files != 1)
+        return cdem_cmd_usage(a->help, "need exactly one run file (RUN.h5)");
+    return rc;
+}
+
+cdem_status cdem_cmd_plot_open_increment(const cdem_plot_args *a, cdem_h5_reader **r, cdem_state *s,
                                          cdem_increment_info *info, cdem_error *err) {
+    cdem_h5_reader *opened = NULL;
+    *r = NULL;
+    CDEM_TRY(cdem_h5_reader_open(a->files[0], &opened, err));
+    *r = opened;
     size_t idx;
-    CDEM_TRY(cdem_h5_reader_find_increment(r, which ? which : "last", &idx, err));
-    return cdem_h5_reader_load_increment(r, idx, s, info, err);
+    CDEM_TRY(cdem_h5_reader_find_increment(*r, a->increment ? a->increment : "last", &idx, err));
+    return cdem_h5_reader_load_increment(*r, idx, s, info, err);
 }

@@ -57,8 +57,12 @@ int cdem_cmd_plot_parse(int argc, char **argv, cdem_plot_args *a);
 cdem_status cdem_cmd_plot_read_series(const char *path, cdem_series_sample **smp, size_t *n,
                                       cdem_error *err);
 
-/* Loads the increment `which` (K, last, equil, first; NULL = last) of an open run into s. */
-cdem_status cdem_cmd_plot_load_increment(cdem_h5_reader *r, const char *which, cdem_state *s,
+/* cdem_cmd_plot_parse for a command of exactly one run file. */
+int cdem_cmd_plot_parse_one(int argc, char **argv, cdem_plot_args *a);
+
+/* Opens the run a->files[0] (*r, closed by the caller; NULL when it cannot be opened) and
+ * loads its increment a->increment (K, last, equil, first; NULL = last) into s. */
+cdem_status cdem_cmd_plot_open_increment(const cdem_plot_args *a, cdem_h5_reader **r, cdem_state *s,
                                          cdem_increment_info *info, cdem_error *err);
 
 /* The commands, also called directly by the tests. */

@@ -26,9 +26,5 @@ static const cdem_cli_help help = {
     .options = quantities_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_quantities);
-}
-
-const cdem_command cdem_command_quantities = {
-    "quantities", "list every quantity name with unit and colour scale", &help, run};
+CDEM_SIMPLE_COMMAND(quantities, "quantities", "list every quantity name with unit and colour scale",
+                    1, cmd_quantities);

@@ -69,11 +69,9 @@ static cdem_status repose_figure(const cdem_plot_args *a, const cdem_state *s, i
 
 int cdem_cmd_plot_repose(int argc, char **argv) {
     cdem_plot_args a = {.cmd = "repose", .help = &help};
-    int rc = cdem_cmd_plot_parse(argc, argv, &a);
+    int rc = cdem_cmd_plot_parse_one(argc, argv, &a);
     if (rc)
         return rc;
-    if (a.n_files != 1)
-        return cdem_cmd_usage(&help, "need exactly one run file (RUN.h5)");
     cdem_error err;
     cdem_render_format fmt;
     if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
@@ -82,9 +80,7 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
     cdem_state s = {0};
     cdem_increment_info info;
     cdem_repose_result res;
-    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
-        return cdem_cmd_fail(a.cmd, NULL, &err);
-    cdem_status st = cdem_cmd_plot_load_increment(r, a.increment, &s, &info, &err);
+    cdem_status st = cdem_cmd_plot_open_increment(&a, &r, &s, &info, &err);
     cdem_params prm;
     if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &err) == CDEM_OK &&
         prm.mode != CDEM_MODE_REPOSE)

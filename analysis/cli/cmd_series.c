@@ -71,8 +71,4 @@ static const cdem_cli_help help = {
     .options = series_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_series);
-}
-
-const cdem_command cdem_command_series = {"series", "the time series as CSV", &help, run};
+CDEM_SIMPLE_COMMAND(series, "series", "the time series as CSV", 1, cmd_series);

@@ -80,25 +80,13 @@ const char *cdem_cmd_base_name(const char *path) {
 cdem_status cdem_cmd_output_open(cdem_cmd_output *o, const char *path, cdem_error *err) {
     o->f = stdout;
     o->of.active = 0;
-    if (!path)
-        return CDEM_OK;
-    CDEM_TRY(cdem_outfile_begin(&o->of, path, err));
-    if (!(o->f = fopen(o->of.tmp, "w"))) {
-        cdem_status st =
-            CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s", o->of.tmp, strerror(errno));
-        return cdem_outfile_end(&o->of, st, err);
-    }
-    return CDEM_OK;
+    return path ? cdem_outfile_open_text(&o->of, path, &o->f, err) : CDEM_OK;
 }
 
 cdem_status cdem_cmd_output_close(cdem_cmd_output *o, cdem_status st, cdem_error *err) {
-    const char *name = o->of.active ? o->of.tmp : "stdout";
+    if (o->of.active) /* the file: closed, renamed or removed */
+        return cdem_outfile_close_text(&o->of, o->f, st, err);
     if (st == CDEM_OK && ferror(o->f))
-        st = CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", name);
-    if (o->f && o->f != stdout && fclose(o->f) != 0 && st == CDEM_OK)
-        st = CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", name);
-    o->f = NULL;
-    if (o->of.active)
-        st = cdem_outfile_end(&o->of, st, err);
+        st = CDEM_FAIL(err, CDEM_ERR_IO, "error writing stdout");
     return st;
 }

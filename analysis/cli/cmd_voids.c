@@ -27,19 +27,15 @@ static const cdem_cli_help help = {
 
 int cdem_cmd_plot_voids(int argc, char **argv) {
     cdem_plot_args a = {.cmd = "voids", .help = &help};
-    int rc = cdem_cmd_plot_parse(argc, argv, &a);
+    int rc = cdem_cmd_plot_parse_one(argc, argv, &a);
     if (rc)
         return rc;
-    if (a.n_files != 1)
-        return cdem_cmd_usage(&help, "need exactly one run file (RUN.h5)");
     cdem_error err;
     cdem_h5_reader *r;
     cdem_state s = {0};
     cdem_increment_info info;
     cdem_voids_result res;
-    if (cdem_h5_reader_open(a.files[0], &r, &err) != CDEM_OK)
-        return cdem_cmd_fail(a.cmd, NULL, &err);
-    cdem_status st = cdem_cmd_plot_load_increment(r, a.increment, &s, &info, &err);
+    cdem_status st = cdem_cmd_plot_open_increment(&a, &r, &s, &info, &err);
     if (st == CDEM_OK)
         st = cdem_voids_measure(&s, a.window > 0.0 ? a.window : 1000.0, &res, &err);
     if (st == CDEM_OK) {

@@ -66,9 +66,6 @@ static const cdem_cli_help help = {
     .options = xdmf_options,
 };
 
-static int run(int argc, char **argv) {
-    return cdem_cmd_options_run(argc, argv, 1, &help, 1, cmd_xdmf);
-}
-
-const cdem_command cdem_command_xdmf = {
-    "xdmf", "(re)write the XDMF sidecar of a run or compute file for ParaView", &help, run};
+CDEM_SIMPLE_COMMAND(xdmf, "xdmf",
+                    "(re)write the XDMF sidecar of a run or compute file for ParaView", 1,
+                    cmd_xdmf);

@@ -5,8 +5,9 @@
  * man page (scripts/help2roff.py) and the bash completion (scripts/help2completion.py);
  * tests/test_help.c and tests/test_registry.c walk it.
  * A new subcommand is one new file, cli/cmd_NAME.c, defining its row
- * `const cdem_command cdem_command_NAME`, plus one line X(NAME) in CDEM_STRAIN_COMMANDS
- * (commands.c); docs/analysis.md lists it (tests/test_registry.c checks that).
+ * `const cdem_command cdem_command_NAME` (CDEM_SIMPLE_COMMAND, cmd_options.h, for one that
+ * takes the common options), plus one line X(NAME) in CDEM_STRAIN_COMMANDS (commands.c);
+ * docs/analysis.md lists it and a test runs it (tests/test_registry.c checks both).
  * Ownership: static const data. Thread safety: pure. */
 #ifndef CDEM_COMMANDS_H
 #define CDEM_COMMANDS_H
