@@ -12,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---------------------------------------------------------------- compute */
 static int cmd_compute(const cdem_cmd_options *o) {
     if (!o->increment)
         return cdem_cmd_usage(o->help, "compute needs --increment K|last|equil|first|all");

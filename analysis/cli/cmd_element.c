@@ -9,7 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-/* ---------------------------------------------------------------- element */
 static int cmd_element(const cdem_cmd_options *o) {
     if (!o->increment || !o->element)
         return cdem_cmd_usage(o->help, "element needs --increment K and --element ID");

@@ -7,7 +7,6 @@
 
 #include <stdio.h>
 
-/* ---------------------------------------------------------------- exports */
 static int cmd_export_sspx(const cdem_cmd_options *o) {
     if (!o->increments)
         return cdem_cmd_usage(o->help,

@@ -14,7 +14,6 @@ static const char *phase_name(int phase) {
                                              : "unknown";
 }
 
-/* ---------------------------------------------------------------- info */
 /* info on a file without increments yet (a run that has just started, or was killed
  * before its first increment): the stored texts and "increments: 0". -1 when it has some. */
 static int info_without_increments(const char *path) {

@@ -6,7 +6,6 @@
 
 #include <stdio.h>
 
-/* ---------------------------------------------------------------- limits */
 static int cmd_limits(const cdem_cmd_options *o) {
     if (!o->increment || !o->quantity)
         return cdem_cmd_usage(o->help, "limits needs --increment K and --quantity NAME");

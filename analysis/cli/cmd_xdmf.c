@@ -8,7 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-/* ---------------------------------------------------------------- xdmf */
 /* 1 when path is a compute --format h5 file (root attribute "quantity"), 0 otherwise. */
 static int is_quantity_file(const char *path) {
     int yes = 0;
