@@ -44,9 +44,8 @@ CDEM_CFLAGS += -DCDEM_VERSION='"$(VERSION)"'
 # folder of its path. (A header in the same folder as its includer is found without -I,
 # which is the same rule: a layer always sees itself.)
 # The analysis is layered again by its second folder (docs/analysis.md, "Source files"):
-# measure/ sees only itself (and analysis/, the grid), input/ and export/ see measure/,
-# draw/ sees only itself, and cli/ sees them all. A file directly in analysis/ (the
-# grid) sees only common.
+# measure/ sees only itself, input/ and export/ see measure/, draw/ sees only itself, and
+# cli/ sees them all (each also sees common/).
 INC_common   := -Icommon
 INC_solver   := -Icommon -Isolver
 INC_analysis := -Icommon -Ianalysis
@@ -145,7 +144,7 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
 	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
 
 format:
-	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*.[ch] analysis/*/*.[ch] tests/*.[ch] 2>/dev/null || true
+	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*/*.[ch] tests/*.[ch] 2>/dev/null || true
 
 clean:
 	rm -rf build build-asan build-fuzz

@@ -64,8 +64,7 @@ static cdem_status setup(bench *b, double width, double height, int half, cdem_e
     CDEM_TRY(cdem_bc_init(&b->bc, &b->p, &b->m, &b->s, err));
     CDEM_TRY(cdem_integrator_init(&b->it, &b->p, &b->m, err));
     cdem_integrator_enable_escape(&b->it);
-    b->it.boundary_forces = 0; /* as cdem_run between time-series samples */
-    b->it.unstable_guard = 1;  /* as cdem_run */
+    b->it.unstable_guard = 1; /* as cdem_run */
     return CDEM_OK;
 }
 

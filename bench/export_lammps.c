@@ -135,7 +135,6 @@ int main(int argc, char **argv) {
         goto done;
     }
     cdem_integrator_enable_escape(&it);
-    it.boundary_forces = 0;
     it.unstable_guard = 1;                                                     /* as cdem-run */
     const long equil = argc > 7 && argv[7][0] ? atol(argv[7]) : m.equil_steps; /* "": model */
     double t0 = now_s();
@@ -174,7 +173,7 @@ int main(int argc, char **argv) {
             "variable mu_wall equal %.17g\nvariable gvisc equal %.17g\nvariable grav equal %.17g\n"
             "variable dt equal %.17g\nvariable skin equal %.17g\n",
             it.law.kn, it.law.ks, it.law.friction[CDEM_CLASS_ELEMENT],
-            it.law.friction[CDEM_CLASS_WALL], it.damping, it.gravity, it.dt, it.nb.skin);
+            it.law.friction[CDEM_CLASS_WALL], it.damping, it.loads.gravity, it.dt, it.nb.skin);
     fclose(f);
 
     double ke, mass;
@@ -191,7 +190,7 @@ int main(int argc, char **argv) {
         }
     free_stats(&s, &ke, &mass, &nfree);
     printf("CDEM_PHYS steps %ld ke %.6g builds %ld removed %ld\n", nphys, ke, it.nb.n_builds - b0,
-           it.n_removed);
+           it.removal.n_removed);
     snprintf(path, sizeof path, "%s/cdem_phys.dump", dir);
     if (write_dump(path, &s)) {
         fprintf(stderr, "export_lammps: cannot write %s\n", path);

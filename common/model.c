@@ -109,10 +109,13 @@ cdem_status cdem_model_derive(const cdem_params *p, cdem_model *m, cdem_error *e
     m->n_increments_equil = (int)n_equil;
     m->n_increments_total = (int)(n_equil + n_after);
 
+    /* the boundary's displacement; both detachment walls move, so twice the shortening */
+    const double n_moving =
+        p->mode == CDEM_MODE_DETACHMENT && p->detachment_walls == CDEM_WALLS_BOTH ? 2.0 : 1.0;
     m->total_displacement =
         p->mode == CDEM_MODE_REPOSE
             ? 0.0
-            : (double)(m->total_steps - m->equil_steps) * m->displacement_per_step;
+            : n_moving * (double)(m->total_steps - m->equil_steps) * m->displacement_per_step;
     m->sediment_interval = 30.0 * p->display_interval;
     m->sediment_steps = lround(m->sediment_interval / m->displacement_per_step);
     m->settling_steps = lround(0.2 * p->equilibration / m->dt);

@@ -166,7 +166,7 @@ static const cdem_param_def param_table[] = {
     {"boundary", "vertical_sense", CDEM_PTYPE_ENUM, P_OFF(vertical_sense), 0, "", "caldera", 0, 0, 0, 0, vert_words,
      "two vertical faults: caldera (block down, extension) or piston (block up, compression)"},
     {"boundary", "detachment_walls", CDEM_PTYPE_ENUM, P_OFF(detachment_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
-     "detachment: right wall moving, or both walls moving inward (half speed each)"},
+     "detachment: right wall moving, or both walls moving inward (each at the boundary speed)"},
     {"boundary", "repose_walls", CDEM_PTYPE_ENUM, P_OFF(repose_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
      "repose-collapse: right wall removed, or both, after equilibration"},
     {"boundary", "confining_pressure", CDEM_PTYPE_DOUBLE, P_OFF(confining_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,

@@ -38,7 +38,8 @@ GROUPS = [  # (title, source files, what to do)
      "the directory cdem-run runs in."),
     ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
       "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
-      "solver/run.c", "solver/sediment.c", "solver/integrate.c", "solver/contact.c", "solver/neighbour.c",
+      "solver/run.c", "solver/run_output.c", "solver/run_progress.c", "solver/run_ckpt.c", "solver/sediment.c",
+      "solver/integrate.c", "solver/force.c", "solver/loads.c", "solver/removal.c", "solver/contact.c", "solver/neighbour.c",
       "solver/assembly.c", "solver/stress.c"],
      "Combinations the mode cannot build are refused before the run (change the named key); "
      "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
@@ -62,7 +63,7 @@ GROUPS = [  # (title, source files, what to do)
     ("Analysis (compute, element, limits, strain, stress, axes)", [
       *(f for f in sources("analysis/cli/cmd_*.c") if f not in PICTURE_COMMANDS),
       *sources("analysis/measure/*.c"),
-      *sources("analysis/export/*.c"), "analysis/cellgrid.c"],
+      *sources("analysis/export/*.c"), "common/grid.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
      "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "
      "runs at two or more different confining pressures; repose needs a repose run."),

@@ -7,11 +7,15 @@
  * disc, or falls again when it passes the equator of the disc it rolls on. Stops are exact
  * tangencies, so the packing has no overlap. A disc whose lowest point rests above the
  * assembly height is discarded; filling stops after a run of consecutive discards (the
- * region below the height is then saturated). The cell grid (cells of 2 x max radius, one
- * linked list per cell, plus the highest centre per grid column) makes every drop O(1), so
- * building N discs is O(N). Everything lives in a `packer` context local to the call.
+ * region below the height is then saturated). The cell grid (common/grid.h: cells of 2 x max
+ * radius, one linked list per cell as the discs arrive one by one, plus the highest centre
+ * per grid column) makes every drop O(1), so building N discs is O(N). Everything lives in
+ * a `packer` context local to the call.
  */
 #include "assembly.h"
+
+#include "grid.h"
+#include "surface.h"
 
 #include <gsl/gsl_rng.h>
 
@@ -52,8 +56,8 @@ static const int bag_counts[CDEM_NUM_RADII] = {4, 3, 2, 1};
 typedef struct {
     double w, h;       /* box: inner width and assembly height, m, > 0 */
     double rmax;       /* largest radius, m */
-    double cell;       /* grid cell size, m, 2 x rmax */
-    int ncols, nrows;  /* grid size, >= 1 */
+    cdem_grid grid;    /* cells of 2 x rmax from the origin (common/grid.h) */
+    int ncols, nrows;  /* grid.nx, grid.ny as int, >= 1 */
     int *head;         /* [ncols * nrows] first disc of each cell, -1 if empty */
     int *next;         /* [cap] next disc of the same cell, -1 at the end */
     double *coltop;    /* [ncols] highest centre y of any disc in the grid column, m (-1 empty) */
@@ -65,14 +69,13 @@ typedef struct {
 
 typedef enum { ROLL_STOP, ROLL_FALL, ROLL_HIT } roll_event;
 
+/* The grid column of x and row of y, clamped into the grid. */
 static int col_of(const packer *pk, double x) {
-    int c = (int)floor(x / pk->cell);
-    return c < 0 ? 0 : (c >= pk->ncols ? pk->ncols - 1 : c);
+    return (int)cdem_grid_col(&pk->grid, x);
 }
 
 static int row_of(const packer *pk, double y) {
-    int r = (int)floor(y / pk->cell);
-    return r < 0 ? 0 : (r >= pk->nrows ? pk->nrows - 1 : r);
+    return (int)cdem_grid_row(&pk->grid, y);
 }
 
 static void packer_free(packer *pk) {
@@ -116,7 +119,7 @@ static double fall(const packer *pk, double x, double y_from, double r, long exc
         return best;
     }
     for (int row = row_of(pk, fmin(y_from, top)); row >= 0; row--) {
-        if ((row + 1) * pk->cell + r + pk->rmax < best)
+        if ((row + 1) * pk->grid.cell + r + pk->rmax < best)
             break; /* no disc of this row or below can be met higher */
         for (int c = c0; c <= c1; c++) {
             for (int k = pk->head[row * pk->ncols + c]; k >= 0; k = pk->next[k]) {
@@ -439,9 +442,11 @@ static cdem_status packer_alloc(packer *pk, double w, double h, double rmin, dou
     pk->w = w;
     pk->h = h;
     pk->rmax = rmax;
-    pk->cell = 2.0 * rmax;
-    pk->ncols = (int)ceil(w / pk->cell) + 1;
-    pk->nrows = (int)ceil((h + 2.0 * rmax) / pk->cell) + 2;
+    const double cell = 2.0 * rmax;
+    pk->ncols = (int)ceil(w / cell) + 1;
+    pk->nrows = (int)ceil((h + 2.0 * rmax) / cell) + 2;
+    pk->grid = (cdem_grid){
+        .x0 = 0.0, .y0 = 0.0, .cell = cell, .nx = (size_t)pk->ncols, .ny = (size_t)pk->nrows};
     pk->cap = (long)(0.9069 * w * (h + 2.0 * rmax) / (M_PI * rmin * rmin)) + 16;
     size_t ncell = (size_t)pk->ncols * (size_t)pk->nrows;
     pk->head = malloc(ncell * sizeof *pk->head);
@@ -560,20 +565,23 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
         info->base_spacing =
             (pk->w + 2.0 * rw) / (double)(base_disc_count(pk->w, rw, base_spacing_of(p)) - 1);
         info->area_fraction = area / (pk->w * pk->h);
-        /* top profile per grid column */
+        /* top profile: the surface (common/surface.h) in the grid's columns */
+        size_t *col_top = malloc(pk->grid.nx * sizeof *col_top);
+        if (!col_top)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for %zu surface columns",
+                             pk->grid.nx);
+        cdem_surface_columns(s, &pk->grid, CDEM_SURFACE_BY_TOP, -INFINITY, INFINITY, col_top);
         double sum = 0.0, top_max = 0.0;
         int used = 0;
-        for (int c = 0; c < pk->ncols; c++) {
-            double top = -1.0;
-            for (int row = 0; row < pk->nrows; row++)
-                for (int k = pk->head[row * pk->ncols + c]; k >= 0; k = pk->next[k])
-                    top = fmax(top, pk->y[k] + pk->r[k]);
-            if (top > 0.0) {
-                sum += top;
-                used++;
-                top_max = fmax(top_max, top);
-            }
+        for (size_t c = 0; c < pk->grid.nx; c++) {
+            if (col_top[c] == SIZE_MAX)
+                continue;
+            const double top = s->y[col_top[c]] + s->radius[col_top[c]];
+            sum += top;
+            used++;
+            top_max = fmax(top_max, top);
         }
+        free(col_top);
         info->top_mean = used ? sum / used : 0.0;
         info->top_max = top_max;
     }

@@ -2,13 +2,14 @@
  *
  * detachment_walls = right: the right lateral wall moves left (-x) by the step's boundary
  * increment du; = both: the left wall moves right and the right wall moves left, each by
- * du / 2 (half the boundary speed), so the model shortens by du per step in both cases.
- * The base (lowest row of wall elements) never moves; its contacts with elements are
- * wall-class contacts (material.wall_*), like every wall contact. The moving walls slide
- * over the base (boundary-boundary pairs never interact). Net displacement
- * (docs/solver.md): the total shortening of the model (k du after k steps) for both
- * choices, as version 2.6 of the original program reports it, so increments come every
- * display interval of total shortening as in every other mode. Units: m, s. */
+ * du (each wall at the boundary speed, as in the original program), so the model shortens
+ * by 2 du per step. The base (lowest row of wall elements) never moves; its contacts with
+ * elements are wall-class contacts (material.wall_*), like every wall contact. The moving
+ * walls slide over the base (boundary-boundary pairs never interact). Net displacement
+ * (docs/solver.md): the total shortening of the model, k du after k steps for "right" and
+ * 2 k du (the sum of both walls' displacements) for "both", the value version 2.6 of the
+ * original program "fixed" for this case. Increments come every display interval of
+ * boundary (each wall's) displacement, as in every other mode. Units: m, s. */
 #include "bc.h"
 #include "parallel.h"
 #include "checkpoint.h"
@@ -61,9 +62,7 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
     detach_ctx *c = vctx;
     if (!(dt > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "detachment: dt = %g s: must be > 0", dt);
-    /* both walls: each at half the boundary speed, the model shortens by du per step */
-    const double step_u = c->walls == CDEM_WALLS_BOTH ? 0.5 * du : du;
-    const double xm = c->x_mid, v = step_u / dt;
+    const double xm = c->x_mid, v = du / dt;
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
@@ -72,12 +71,13 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
         if (fl[i] & CDEM_FLAG_MOVING) {
             /* the right wall moves left, the left wall right: both inward */
             const double sgn = x[i] > xm ? -1.0 : 1.0;
-            x[i] += sgn * step_u;
+            x[i] += sgn * du;
             vxa[i] = sgn * v;
             vya[i] = 0.0;
         }
     }
-    c->net += du; /* total shortening: both walls' displacements together */
+    /* total shortening: both walls' displacements together */
+    c->net += (c->walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * du;
     return CDEM_OK;
 }
 
@@ -90,9 +90,9 @@ static void detach_view(const void *vctx, FILE *out) {
     if (c->walls == CDEM_WALLS_BOTH)
         fprintf(out,
                 "Boundary mode: detachment, both lateral walls move inward over the fixed base "
-                "at half the boundary speed each (%ld left + %ld right wall elements); net "
-                "displacement = total shortening (sum of both walls), one display interval "
-                "of it between increments.\n",
+                "at the boundary speed each (%ld left + %ld right wall elements); net "
+                "displacement = total shortening (sum of both walls), an increment every "
+                "display interval of each wall's displacement.\n",
                 c->n_left, c->n_right);
     else
         fprintf(out,

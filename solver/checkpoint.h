@@ -49,10 +49,11 @@ cdem_status cdem_ckpt_check_f64(const cdem_snapshot *s, const char *prefix, cons
 
 /* The element state: every array (id, x, y, vx, vy, fx, fy, radius, mass, layer, flags, born
  * and, when has_stress, sxx, syy, sxy) plus n, next_id and has_stress, under "state.".
- * boundary_forces = 0 (the last step did not sum the forces on boundary elements, so theirs
- * are left over from an earlier step, and how old depends on the thread count): their fx, fy
- * are stored as 0. They are read only on steps that sum them again, so results are the same,
- * and the checkpoint is the same for any thread count. */
+ * boundary_forces = 0 (the last step was not a sample step): the fx, fy of boundary elements
+ * are stored as 0. They are read only on sample steps, after the step's force pass has
+ * summed them again, so results are the same. (The force pass once summed them on sample
+ * steps only, when the stored ones were stale; it sums them on every step now, and the zeros
+ * stay so that checkpoints keep their contents.) */
 cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_snapshot *s,
                                 cdem_error *err);
 /* Replaces the contents of st (initialised) with the stored state (grown as needed; the

@@ -1,15 +1,15 @@
 /* neighbour: see neighbour.h. A build is: (1) save the histories of the current pairs by id
  * key, (2) drop removed elements, (3) maybe permute the state into cell order, (4) bin the
- * elements into cells (counting sort, so each cell lists ascending indices), (5) for each
- * element i in index order scan the 3 x 3 cells around it for j > i within reach + skin,
- * (6) restore histories through the index map, (7) build the CSR. Step (5) is threaded
- * above par_min elements (contiguous element ranges per thread, buffers appended in thread
- * order); everything else is serial and ordered, so the list is the same for any thread
- * count. */
+ * elements into cells (common/grid.h: counting sort, each cell lists ascending indices), (5) for
+ * each element i in index order scan the 3 x 3 cells around it for j > i within reach + skin, (6)
+ * restore histories through the index map, (7) build the CSR. Step (5) is threaded above par_min
+ * elements (contiguous element ranges per thread, buffers appended in thread order); everything
+ * else is serial and ordered, so the list is the same for any thread count. */
 #include "neighbour.h"
 
 #include "checkpoint.h"
 #include "contact.h"
+#include "grid.h"
 #include "parallel.h"
 
 #include <math.h>
@@ -237,32 +237,24 @@ static int buf_grow(cdem_pair_buf *b, size_t want) {
     return 0;
 }
 
-/* Cell grid dimensions of a build. */
-typedef struct {
-    size_t nx, ny; /* cells in x and y */
-} grid;
-
 /* Enumerates the pairs (i, j > i) of the elements lo..hi-1 in index order: into the list
  * (buf NULL; serial) or into buf (one thread's share; err unused, buf->failed on NOMEM). */
-static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const grid *g, size_t lo,
+static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem_grid *g, size_t lo,
                              size_t hi, cdem_pair_buf *buf, cdem_error *err) {
     const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
     const uint32_t *restrict fl = s->flags;
     const int32_t *restrict cell_start = nb->cell_start, *restrict cell_items = nb->cell_items;
     const double rf = nb->reach_factor, skin = nb->skin;
-    const size_t nx = g->nx, ny = g->ny;
+    const size_t nx = g->nx;
     for (size_t i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_FOOTWALL)
             continue;
-        const size_t ci = (size_t)nb->cell_of[i];
-        const size_t cx = ci % nx, cy = ci / nx;
-        const size_t x_lo = cx > 0 ? cx - 1 : 0, x_hi = cx + 1 < nx ? cx + 1 : cx;
-        const size_t y_lo = cy > 0 ? cy - 1 : 0, y_hi = cy + 1 < ny ? cy + 1 : cy;
+        const cdem_grid_box b = cdem_grid_around(g, (size_t)nb->cell_of[i]);
         const double xi = x[i], yi = y[i], ri = rad[i];
         const uint32_t fi = fl[i];
-        for (size_t yy = y_lo; yy <= y_hi; yy++) {
+        for (size_t yy = b.y_lo; yy <= b.y_hi; yy++) {
             /* the cells of one row are contiguous in cell_items */
-            const int32_t k0 = cell_start[yy * nx + x_lo], k1 = cell_start[yy * nx + x_hi + 1];
+            const int32_t k0 = cell_start[yy * nx + b.x_lo], k1 = cell_start[yy * nx + b.x_hi + 1];
             for (int32_t k = k0; k < k1; k++) {
                 const size_t j = (size_t)cell_items[k];
                 if (j <= i)
@@ -337,50 +329,31 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     if (n == 0) {
         xmin = xmax = ymin = ymax = 0.0;
     }
-    double cs = 2.0 * rmax * nb->reach_factor + nb->skin;
-    size_t nx = (size_t)((xmax - xmin) / cs) + 1, ny = (size_t)((ymax - ymin) / cs) + 1;
-    while ((double)nx * (double)ny > 4.0 * (double)n + 64.0) {
-        /* a stray element far away: coarser cells keep the grid O(n) */
-        cs *= 2.0;
-        nx = (size_t)((xmax - xmin) / cs) + 1;
-        ny = (size_t)((ymax - ymin) / cs) + 1;
-    }
-    const size_t ncells = nx * ny;
+    /* cells of at least the largest reach + skin: every partner is in the 3 x 3 block */
+    cdem_grid g;
+    cdem_grid_fit(&g, xmin, xmax, ymin, ymax, 2.0 * rmax * nb->reach_factor + nb->skin,
+                  4.0 * (double)n + 64.0);
+    const size_t ncells = g.nx * g.ny;
     if (2 * ncells + 1 > nb->ccap) {
         size_t c = next_cap(nb->ccap, 2 * ncells + 1);
         CDEM_TRY(grow((void **)&nb->cell_start, sizeof(int32_t), c, err));
         nb->ccap = c;
     }
-    const double inv = 1.0 / cs;
-    for (size_t i = 0; i < n; i++) {
-        size_t cx = (size_t)((s->x[i] - xmin) * inv), cy = (size_t)((s->y[i] - ymin) * inv);
-        if (cx >= nx)
-            cx = nx - 1;
-        if (cy >= ny)
-            cy = ny - 1;
-        nb->cell_of[i] = (int32_t)(cy * nx + cx);
-    }
+    for (size_t i = 0; i < n; i++)
+        nb->cell_of[i] = (int32_t)cdem_grid_cell(&g, s->x[i], s->y[i]);
     int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
     if (do_sort && n > 1) {
         /* stable counting sort by (boundary element?, cell): free elements first in cell
          * order, then the boundary elements in cell order, so the loops over elements see
-         * long runs of one kind (predictable branches); new index k holds old index perm[k] */
-        const size_t nkeys = 2 * ncells;
-        int32_t *cnt = nb->cell_start;
-        memset(cnt, 0, (nkeys + 1) * sizeof(int32_t));
-        for (size_t i = 0; i < n; i++) {
-            const size_t key =
-                (size_t)nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? ncells : 0);
-            cnt[key + 1]++;
-        }
-        for (size_t c = 0; c < nkeys; c++)
-            cnt[c + 1] += cnt[c];
+         * long runs of one kind (predictable branches); new index k holds old index perm[k].
+         * The keys live in scratch, the sorted indices in cell_items (both free here). */
+        int32_t *key = (int32_t *)nb->scratch;
+        for (size_t i = 0; i < n; i++)
+            key[i] = nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? (int32_t)ncells : 0);
+        cdem_grid_sort(key, n, 2 * ncells, nb->cell_start, nb->cell_items);
         size_t *perm = nb->perm;
-        for (size_t i = 0; i < n; i++) {
-            const size_t key =
-                (size_t)nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? ncells : 0);
-            perm[cnt[key]++] = i;
-        }
+        for (size_t k = 0; k < n; k++)
+            perm[k] = (size_t)nb->cell_items[k];
         permute_state(nb, s);
         {
             /* oldmap follows: the element at new index k came from compacted index perm[k] */
@@ -400,26 +373,11 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         }
         nb->n_sorts++;
     }
-    /* counting sort by cell */
-    memset(nb->cell_start, 0, (ncells + 1) * sizeof(int32_t));
-    for (size_t i = 0; i < n; i++)
-        nb->cell_start[nb->cell_of[i] + 1]++;
-    for (size_t c = 0; c < ncells; c++)
-        nb->cell_start[c + 1] += nb->cell_start[c];
-    /* cell_items: element indices in cell order (ascending index within a cell) */
-    {
-        for (size_t i = 0; i < n; i++) {
-            int32_t c = nb->cell_of[i];
-            nb->cell_items[nb->cell_start[c]++] = (int32_t)i;
-        }
-        for (size_t c = ncells; c > 0; c--)
-            nb->cell_start[c] = nb->cell_start[c - 1];
-        nb->cell_start[0] = 0;
-    }
+    /* counting sort by cell: cell_items lists each cell's elements in ascending index */
+    cdem_grid_sort(nb->cell_of, n, ncells, nb->cell_start, nb->cell_items);
 
     /* enumerate pairs: element i in index order, j > i in the 3 x 3 cells around it */
     nb->np = 0;
-    const grid g = {.nx = nx, .ny = ny};
     int nthr = omp_get_max_threads();
     if (nthr > CDEM_NB_MAX_THREADS)
         nthr = CDEM_NB_MAX_THREADS;

@@ -6,6 +6,8 @@
 #include "sediment.h"
 
 #include "checkpoint.h"
+#include "grid.h"
+#include "surface.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -59,6 +61,7 @@ void cdem_sediment_free(cdem_sediment *sd) {
         gsl_rng_free(sd->rng);
     free(sd->col_start);
     free(sd->col_items);
+    free(sd->col_of);
     free(sd->col_head);
     free(sd->next_new);
     memset(sd, 0, sizeof *sd);
@@ -70,10 +73,7 @@ void cdem_sediment_free(cdem_sediment *sd) {
 void cdem_sediment_begin(cdem_sediment *sd, const cdem_state *s) {
     if (!sd->enabled)
         return;
-    double top = -INFINITY;
-    for (size_t i = 0; i < s->n; i++)
-        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY))
-            top = fmax(top, s->y[i] + s->radius[i]);
+    const double top = cdem_surface_top(s);
     sd->ymax0 = isfinite(top) ? top : NAN;
 }
 
@@ -143,6 +143,7 @@ cdem_status cdem_sediment_deposit(cdem_sediment *sd, cdem_state *s, double sea_l
                          "sediment: free elements span %g m = %g columns of %g m: too wide",
                          hi - lo, span, w);
     const size_t ncol = (size_t)span + 1;
+    const cdem_grid cols = {.x0 = gx0, .y0 = 0.0, .cell = w, .nx = ncol, .ny = 1};
     const size_t n0 = s->n;
     if (ncol + 1 > sd->colcap) {
         const size_t c = ncol + 1 + ncol / 2 + 16;
@@ -156,32 +157,18 @@ cdem_status cdem_sediment_deposit(cdem_sediment *sd, cdem_state *s, double sea_l
         sd->colcap = c;
     }
     CDEM_TRY(grow_i32(&sd->col_items, &sd->itemcap, n0 + 1, err));
+    CDEM_TRY(grow_i32(&sd->col_of, &sd->keycap, n0 + 1, err));
     /* CSR of the elements present (display-only footwall elements never touch anything) */
-    memset(sd->col_start, 0, (ncol + 1) * sizeof *sd->col_start);
     for (size_t i = 0; i < n0; i++) {
-        if (s->flags[i] & CDEM_FLAG_FOOTWALL)
-            continue;
-        const double c = (s->x[i] - gx0) / w;
-        if (c < 0.0 || c >= (double)ncol)
-            continue;
-        sd->col_start[(size_t)c + 1]++;
+        size_t c = 0;
+        sd->col_of[i] =
+            !(s->flags[i] & CDEM_FLAG_FOOTWALL) && cdem_grid_col_inside(&cols, s->x[i], &c)
+                ? (int32_t)c
+                : -1;
     }
-    for (size_t c = 0; c < ncol; c++) {
-        sd->col_start[c + 1] += sd->col_start[c];
+    cdem_grid_sort(sd->col_of, n0, ncol, sd->col_start, sd->col_items);
+    for (size_t c = 0; c < ncol; c++)
         sd->col_head[c] = -1;
-    }
-    for (size_t i = 0; i < n0; i++) {
-        if (s->flags[i] & CDEM_FLAG_FOOTWALL)
-            continue;
-        const double c = (s->x[i] - gx0) / w;
-        if (c < 0.0 || c >= (double)ncol)
-            continue;
-        /* col_start[c] serves as the fill cursor of column c, shifted back below */
-        sd->col_items[sd->col_start[(size_t)c]++] = (int32_t)i;
-    }
-    for (size_t c = ncol; c > 0; c--) /* undo the cursor shift */
-        sd->col_start[c] = sd->col_start[c - 1];
-    sd->col_start[0] = 0;
 
     const long max_fail = 8 * (long)ncol + 64;
     const long max_attempts = 400 * (long)ncol + 4096;
@@ -196,14 +183,10 @@ cdem_status cdem_sediment_deposit(cdem_sediment *sd, cdem_state *s, double sea_l
         }
         const double x = lo + r + u * (hi - lo - 2.0 * r);
         const double reach_max = r + rmax;
-        long c0 = (long)floor((x - reach_max - gx0) / w),
-             c1 = (long)floor((x + reach_max - gx0) / w);
-        if (c0 < 0)
-            c0 = 0;
-        if (c1 >= (long)ncol)
-            c1 = (long)ncol - 1;
+        size_t c0 = 1, c1 = 0; /* an empty range when the reach misses the grid */
+        cdem_grid_col_range(&cols, x - reach_max, x + reach_max, &c0, &c1);
         double best = -INFINITY;
-        for (long c = c0; c <= c1; c++) {
+        for (size_t c = c0; c <= c1; c++) {
             for (int32_t a = sd->col_start[c]; a < sd->col_start[c + 1]; a++) {
                 const int32_t j = sd->col_items[a];
                 const double dx = s->x[j] - x, R = r + s->radius[j];
@@ -227,11 +210,7 @@ cdem_status cdem_sediment_deposit(cdem_sediment *sd, cdem_state *s, double sea_l
                                    &idx, err));
         const size_t q = idx - n0;
         CDEM_TRY(grow_i32(&sd->next_new, &sd->newcap, q + 1, err));
-        long c = (long)floor((x - gx0) / w);
-        if (c < 0)
-            c = 0;
-        if (c >= (long)ncol)
-            c = (long)ncol - 1;
+        const size_t c = cdem_grid_col(&cols, x);
         sd->next_new[q] = sd->col_head[c];
         sd->col_head[c] = (int32_t)q;
         count++;

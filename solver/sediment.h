@@ -44,13 +44,15 @@ typedef struct {
     long settle_end;               /* last settling step of the last deposit (-1: none) */
     int32_t settling_layer;        /* layer of the deposit settling now, 0: none */
     long n_deposited;              /* elements deposited in the whole run */
-    /* scratch of a deposit (column grid of width 2 x max radius) */
+    /* scratch of a deposit (column grid of width 2 x max radius, common/grid.h) */
+    int32_t *col_of;    /* column of each element present (-1: left out) */
     int32_t *col_start; /* CSR start of each column, ncol + 1 */
     int32_t *col_items; /* element indices by column */
     int32_t *col_head;  /* first new disc of each column (-1: none) */
     int32_t *next_new;  /* next new disc in the same column, by (index - n0) */
     size_t colcap;      /* capacity of col_start/col_head (columns + 1) */
     size_t itemcap;     /* capacity of col_items */
+    size_t keycap;      /* capacity of col_of */
     size_t newcap;      /* capacity of next_new */
 } cdem_sediment;
 

@@ -148,7 +148,7 @@ __attribute__((unused)) static void fx_run(cdem_params p, long k, fx_result *out
         if (j == k / 2)
             out->net_mid = cdem_bc_net_displacement(&bc);
     }
-    out->removed = it.n_removed;
+    out->removed = it.removal.n_removed;
     out->net_end = cdem_bc_net_displacement(&bc);
     cdem_integrator_free(&it);
     cdem_bc_free(&bc);

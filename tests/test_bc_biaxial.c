@@ -70,7 +70,7 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
     assert_int_equal(
         cdem_state_append(&s, -1, 30 * r, 40 * m.max_radius, r, 1.0, 1, 0, 0, NULL, &err), CDEM_OK);
     /* ramp at step 0 of 100 steps of equilibration: no force yet, but the edges are found */
-    assert_int_equal(cdem_integrator_set_confining(&it, PRESSURE, 100, &err), CDEM_OK);
+    assert_int_equal(cdem_loads_set_confining(&it.loads, PRESSURE, 100, it.step, &err), CDEM_OK);
     assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
     /* the list may re-sort the state: find the elements by position */
     size_t il = SIZE_MAX, ir = SIZE_MAX, ic = SIZE_MAX, iu = SIZE_MAX;
@@ -85,17 +85,17 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
             ic = i;
     }
     assert_true(il < s.n && ir < s.n && ic < s.n && iu < s.n);
-    assert_int_equal(it.n_edge, 3);
+    assert_int_equal(it.loads.n_edge, 3);
     assert_true(s.flags[il] & CDEM_FLAG_BIAXIAL_EDGE);
     assert_true(s.flags[ir] & CDEM_FLAG_BIAXIAL_EDGE);
     assert_true(s.flags[iu] & CDEM_FLAG_BIAXIAL_EDGE);
     assert_false(s.flags[ic] & CDEM_FLAG_BIAXIAL_EDGE);
     assert_near(s.fx[il], 0.0, 0.0);
     /* full pressure (equilibration over) */
-    assert_int_equal(cdem_integrator_set_confining(&it, PRESSURE, 0, &err), CDEM_OK);
+    assert_int_equal(cdem_loads_set_confining(&it.loads, PRESSURE, 0, it.step, &err), CDEM_OK);
     assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
-    const double f = PRESSURE * it.column_width;
-    assert_near(it.column_width, 2.0 * it.max_radius, 1e-12);
+    const double f = PRESSURE * it.loads.column_width;
+    assert_near(it.loads.column_width, 2.0 * it.removal.max_radius, 1e-12);
     assert_near(s.fx[il], f, 1e-9 * f);
     assert_near(s.fx[ir], -f, 1e-9 * f);
     assert_near(s.fx[ic], 0.0, 0.0);
@@ -103,9 +103,9 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
     assert_near(s.fx[iu], f, 1e-9 * f);
     assert_near(s.fy[il], 0.0, 0.0); /* gravity off in the biaxial test */
     /* a negative or NaN pressure is refused with the key */
-    assert_int_equal(cdem_integrator_set_confining(&it, -1.0, 0, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_loads_set_confining(&it.loads, -1.0, 0, it.step, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "boundary.confining_pressure = -1"));
-    assert_int_equal(cdem_integrator_set_confining(&it, NAN, 0, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_loads_set_confining(&it.loads, NAN, 0, it.step, &err), CDEM_ERR_RANGE);
     cdem_integrator_free(&it);
     cdem_state_free(&s);
 }
@@ -137,7 +137,8 @@ static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
     assert_true(cdem_bc_moves_in_equilibration(&bc));
     cdem_integrator it;
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
-    assert_int_equal(cdem_integrator_set_confining(&it, PRESSURE, m.equil_steps, &err), CDEM_OK);
+    assert_int_equal(cdem_loads_set_confining(&it.loads, PRESSURE, m.equil_steps, it.step, &err),
+                     CDEM_OK);
     double top0 = -INFINITY;
     for (size_t i = 0; i < s.n; i++)
         if ((s.flags[i] & CDEM_FLAG_MOVING) && s.y[i] > rw)
@@ -347,14 +348,14 @@ static void test_bc_biaxial_end_to_end(void **st) {
         }
     cdem_integrator it;
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
-    const double band = it.column_width;
+    const double band = it.loads.column_width;
     const double height = yhi - ylo;
     assert_true(fabs((double)left * PRESSURE * band - PRESSURE * height) <= PRESSURE * band);
     assert_true(fabs((double)right * PRESSURE * band - PRESSURE * height) <= PRESSURE * band);
     /* the search on the final positions finds the stored edges again (deterministic run;
      * elements moved less than the skin since the last rebuild) */
-    assert_int_equal(cdem_integrator_find_edges(&it, &s1, &err), CDEM_OK);
-    assert_int_equal(it.n_edge, left + right);
+    assert_int_equal(cdem_loads_find_edges(&it.loads, &s1, &err), CDEM_OK);
+    assert_int_equal(it.loads.n_edge, left + right);
     cdem_integrator_free(&it);
 
     /* time series: strain = closure / h0 at every sample; differential stress 0 at the first

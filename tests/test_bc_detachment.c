@@ -1,8 +1,8 @@
 /* Tests of solver/bc_detachment: the right wall moves inward by exactly k x
- * displacement_per_step ("right"), or both lateral walls by half of it each ("both"); the
- * base never moves; the net displacement is the total shortening k x displacement_per_step
- * in both cases, so increments come every display interval of it; base contacts are
- * wall-class contacts; errors/view. */
+ * displacement_per_step ("right"), or both lateral walls by that much each ("both"); the
+ * base never moves; the net displacement is the total shortening (k or 2 k x
+ * displacement_per_step); increments come every display interval of each wall's
+ * displacement; base contacts are wall-class contacts; errors/view. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -23,8 +23,8 @@ static void check_kinematics(cdem_walls_choice walls) {
     p.detachment_walls = walls;
     fx_result r;
     fx_run(p, K, &r);
-    const double u = (double)K * DPS;                        /* total shortening */
-    const double w = walls == CDEM_WALLS_BOTH ? 0.5 * u : u; /* each moving wall */
+    const double w = (double)K * DPS;                        /* each moving wall */
+    const double u = walls == CDEM_WALLS_BOTH ? 2.0 * w : w; /* total shortening */
     long n_left = 0, n_right = 0, n_base = 0;
     for (size_t i = 0; i < r.s0.n; i++) {
         const uint32_t f = r.s0.flags[i];
@@ -38,10 +38,10 @@ static void check_kinematics(cdem_walls_choice walls) {
             assert_true(dx == 0.0);
             assert_true(!(f & CDEM_FLAG_MOVING));
             n_base++;
-        } else if (r.s0.x[i] == WIDTH) { /* right wall: left by u */
+        } else if (r.s0.x[i] == WIDTH) { /* right wall: left by w */
             assert_float_equal(dx, -w, 1e-9 * u);
             n_right++;
-        } else { /* left wall: right by u with "both", else still */
+        } else { /* left wall: right by w with "both", else still */
             assert_float_equal(dx, walls == CDEM_WALLS_BOTH ? w : 0.0, 1e-9 * u);
             assert_int_equal((f & CDEM_FLAG_MOVING) != 0, walls == CDEM_WALLS_BOTH);
             n_left++;
@@ -51,7 +51,7 @@ static void check_kinematics(cdem_walls_choice walls) {
     assert_int_equal(n_right, 15);
     assert_int_equal(n_left, 15);
     /* net = total shortening = the sum of the walls' inward displacements */
-    assert_float_equal(r.net_mid, (double)(K / 2) * DPS, 1e-9);
+    assert_float_equal(r.net_mid, 0.5 * u, 1e-9);
     assert_float_equal(r.net_end, u, 1e-9);
     assert_float_equal(r.net_end, (walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * w, 1e-9);
     assert_int_equal(r.removed, 0);
@@ -110,9 +110,9 @@ static void test_bc_detachment_errors_and_view(void **st) {
 }
 
 /* Both wall choices run through cdem_run on a small default model; the file reports the
- * total shortening (the sum of both walls' displacements for "both"), and the deformation
- * increments are one display interval of it apart for both choices (manual v2.6; before,
- * "both" wrote one every 2 x display interval). */
+ * total shortening (the sum of both walls' displacements for "both", manual v2.6), and the
+ * deformation increments are one display interval of boundary (each wall's) displacement
+ * apart for both choices: 2 x display interval of shortening for "both". */
 static void test_bc_detachment_cdem_run(void **st) {
     (void)st;
     cdem_params p;
@@ -126,7 +126,8 @@ static void test_bc_detachment_cdem_run(void **st) {
         const char *name = k == 0 ? "test_bc_detachment_run_right" : "test_bc_detachment_run_both";
         fx_cdem_run(p, name, 300, &last, &m);
         assert_int_equal(last.step, m.equil_steps + 300);
-        assert_float_equal(last.net_displacement, 300.0 * m.displacement_per_step, 1e-9);
+        const double walls = k == 0 ? 1.0 : 2.0; /* moving walls */
+        assert_float_equal(last.net_displacement, walls * 300.0 * m.displacement_per_step, 1e-9);
         char path[1024], file[256];
         snprintf(file, sizeof file, "%s.h5", name); /* the file fx_cdem_run wrote */
         scratch_path(path, sizeof path, file);
@@ -141,13 +142,14 @@ static void test_bc_detachment_cdem_run(void **st) {
             assert_int_equal(cdem_h5_reader_increment_info(r, i, &inf, &err), CDEM_OK);
             if (inf.step <= m.equil_steps)
                 continue;
-            /* every full deformation increment adds one display interval of net
+            /* every full deformation increment adds one display interval of each wall's
              * displacement (to within one step's rounding); the last may be shorter */
             if (inf.step < last.step)
-                assert_float_equal(inf.net_displacement - prev, p.display_interval,
-                                   m.displacement_per_step);
+                assert_float_equal(inf.net_displacement - prev, walls * p.display_interval,
+                                   walls * m.displacement_per_step);
             assert_float_equal(inf.net_displacement,
-                               (double)(inf.step - m.equil_steps) * m.displacement_per_step, 1e-9);
+                               walls * (double)(inf.step - m.equil_steps) * m.displacement_per_step,
+                               1e-9);
             prev = inf.net_displacement;
             deform++;
         }

@@ -65,7 +65,7 @@ static void run_fault(cdem_params p, long steps, run_result *out) {
             out->net_mid = cdem_bc_net_displacement(&bc);
     }
     out->steps = steps;
-    out->removed = it.n_removed;
+    out->removed = it.removal.n_removed;
     out->net_end = cdem_bc_net_displacement(&bc);
     cdem_integrator_free(&it);
     cdem_bc_free(&bc);

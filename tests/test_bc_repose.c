@@ -96,8 +96,8 @@ static void check_removal(cdem_walls_choice walls) {
     assert_int_equal(cohesive, made - with_removed);
     const size_t expect = walls == CDEM_WALLS_BOTH ? 30 : 15;
     assert_int_equal(nrem, expect);
-    assert_int_equal(it.n_removed_last, expect);
-    assert_int_equal(it.n_removed, 0); /* not counted as escapes */
+    assert_int_equal(it.removal.n_removed_last, expect);
+    assert_int_equal(it.removal.n_removed, 0); /* not counted as escapes */
     assert_int_equal(s.n, n0 - expect);
     assert_int_equal(count_lateral(&s, WIDTH), 0);
     assert_int_equal(count_lateral(&s, 0.0), walls == CDEM_WALLS_BOTH ? 0 : 15);
@@ -105,8 +105,8 @@ static void check_removal(cdem_walls_choice walls) {
     for (size_t k = 0; k < nr; k++) {
         assert_true(fx_find(&s, right_ids[k]) == SIZE_MAX);
         int found = 0;
-        for (size_t q = 0; q < it.n_removed_last; q++)
-            found |= it.removed_ids[q] == right_ids[k];
+        for (size_t q = 0; q < it.removal.n_removed_last; q++)
+            found |= it.removal.removed_ids[q] == right_ids[k];
         assert_true(found);
     }
     /* deformation: no boundary moves, net 0 */
@@ -177,15 +177,15 @@ static void test_bc_repose_escape_beyond_base(void **st) {
         CDEM_OK);
     const size_t n0 = s.n;
     assert_int_equal(cdem_integrator_step(&it, &s, &bc, 1, m.displacement_per_step, &err), CDEM_OK);
-    assert_int_equal(it.n_removed, 3);
-    assert_int_equal(it.n_removed_last, 3);
+    assert_int_equal(it.removal.n_removed, 3);
+    assert_int_equal(it.removal.n_removed_last, 3);
     assert_int_equal(s.n, n0 - 3);
     assert_true(fx_find(&s, id_right) == SIZE_MAX);
     assert_true(fx_find(&s, id_left) == SIZE_MAX);
     assert_true(fx_find(&s, id_below) == SIZE_MAX);
     assert_true(fx_find(&s, id_inside) != SIZE_MAX);
-    assert_float_equal(it.escape_xmin, 0.0, 1e-12); /* the base ends */
-    assert_float_equal(it.escape_xmax, WIDTH, 1e-12);
+    assert_float_equal(it.removal.escape_xmin, 0.0, 1e-12); /* the base ends */
+    assert_float_equal(it.removal.escape_xmax, WIDTH, 1e-12);
     cdem_integrator_free(&it);
     cdem_bc_free(&bc);
     cdem_state_free(&s);

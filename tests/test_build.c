@@ -85,10 +85,6 @@ static void test_build_layer_include_paths(void **state) {
         {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis"}},
         /* the analysis's own layers (Makefile): measure/ sees none of the others, draw/
          * only itself, input/ and export/ the measures, cli/ everything of the analysis */
-        {"analysis/cellgrid.o",
-         "analysis/cellgrid.c",
-         {"-Icommon", "-Ianalysis"},
-         {"-Isolver", "-Ianalysis/measure"}},
         {"analysis/measure/strain.o",
          "analysis/measure/strain.c",
          {"-Icommon", "-Ianalysis", "-Ianalysis/measure"},

@@ -312,7 +312,7 @@ static void test_heterogeneity_overburden_surface(void **st) {
                      CDEM_OK);
     cdem_integrator it;
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
-    assert_int_equal(cdem_integrator_set_overburden(&it, pressure, &err), CDEM_OK);
+    assert_int_equal(cdem_loads_set_overburden(&it.loads, pressure, &err), CDEM_OK);
     assert_int_equal(cdem_integrator_prime(&it, &s, &err), CDEM_OK);
     const double w = 2.0 * 125.0, width = 150.0 * 19 + 2.0 * r;
     double total = 0.0;
@@ -329,7 +329,7 @@ static void test_heterogeneity_overburden_surface(void **st) {
         assert_float_equal(s.fx[i], 0.0, 1e-9);
         total += s.fy[i] * !(s.flags[i] & CDEM_FLAG_WALL);
     }
-    assert_int_equal(surface, it.n_surface);
+    assert_int_equal(surface, it.loads.n_surface);
     assert_true(fabs(-total - pressure * width) <= pressure * w);
     /* the surface is found again: raise one element of row 1 above the top row */
     size_t lifted = SIZE_MAX;
@@ -338,14 +338,14 @@ static void test_heterogeneity_overburden_surface(void **st) {
             lifted = i;
     assert_true(lifted != SIZE_MAX);
     s.y[lifted] = 1000.0;
-    assert_int_equal(cdem_integrator_find_surface(&it, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_loads_find_surface(&it.loads, &s, &err), CDEM_OK);
     assert_true(s.flags[lifted] & CDEM_FLAG_SURFACE);
     for (size_t i = 0; i < s.n; i++)
         if ((s.flags[i] & CDEM_FLAG_SURFACE) && i != lifted)
             assert_float_equal(s.y[i], 450.0, 1e-9);
-    assert_int_equal(it.n_surface, surface);
+    assert_int_equal(it.loads.n_surface, surface);
     /* a negative pressure is refused by name */
-    assert_int_equal(cdem_integrator_set_overburden(&it, -1.0, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_loads_set_overburden(&it.loads, -1.0, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "overburden_pressure = -1"));
     cdem_integrator_free(&it);
     cdem_state_free(&s);
@@ -377,14 +377,14 @@ static void test_heterogeneity_erosion_removes_above(void **st) {
     assert_int_equal(cdem_integrator_erode(&it, &s, 450.0, &count, &err), CDEM_OK);
     /* above 450: 500, 600, 700, 800, 900 and element 501 -> 6; the wall stays */
     assert_int_equal(count, 6);
-    assert_int_equal((long)it.n_removed_last, 6);
+    assert_int_equal((long)it.removal.n_removed_last, 6);
     assert_int_equal(s.n, n0 - 6);
     /* ids are assigned from 0 in append order: 5..9 are the elements at y = 500..900 */
     const int32_t expect_ids[6] = {5, 6, 7, 8, 9, 501};
     for (int e = 0; e < 6; e++) {
         int found = 0;
-        for (size_t k = 0; k < it.n_removed_last; k++)
-            found += it.removed_ids[k] == expect_ids[e];
+        for (size_t k = 0; k < it.removal.n_removed_last; k++)
+            found += it.removal.removed_ids[k] == expect_ids[e];
         assert_int_equal(found, 1);
     }
     int wall_kept = 0;

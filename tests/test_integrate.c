@@ -350,12 +350,12 @@ static void test_integrate_nan_and_escape(void **st) {
     long removed_steps = 0;
     for (int step = 0; step < 50; step++) {
         assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
-        if (it.n_removed_last) {
-            assert_int_equal(it.removed_ids[0], 777);
+        if (it.removal.n_removed_last) {
+            assert_int_equal(it.removal.removed_ids[0], 777);
             removed_steps++;
         }
     }
-    assert_int_equal(it.n_removed, 1);
+    assert_int_equal(it.removal.n_removed, 1);
     assert_int_equal(removed_steps, 1);
     assert_int_equal(s.n, n0 - 1);
     for (size_t i = 0; i < s.n; i++)

@@ -1,7 +1,9 @@
 /* common/surface: which element is the free surface of each vertical column. Known answers
- * on a hand-made state: the highest top (y + radius) wins, not the highest centre; walls,
- * fault elements, non-finite positions and zero radii are never surface; the x window and
- * the column range leave elements out; empty columns say SIZE_MAX. */
+ * on a hand-made state: by top the highest top (y + radius) wins, not the highest centre;
+ * by centre (the solver's overburden) the highest centre; ties go to the lowest index;
+ * walls, fault elements, non-finite positions and zero radii are never surface; the x
+ * window and the column range leave elements out; empty columns say SIZE_MAX; the surface
+ * height is the highest free top. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -91,10 +93,53 @@ static void test_surface_column_tops(void **state) {
     cdem_state_free(&s);
 }
 
+static void test_surface_by_centre(void **state) {
+    (void)state;
+    cdem_state s;
+    make_state(&s);
+    size_t top[4];
+    const cdem_grid cols = {.x0 = 0.0, .y0 = 0.0, .cell = 10.0, .nx = 4, .ny = 1};
+    cdem_surface_columns(&s, &cols, CDEM_SURFACE_BY_CENTRE, -INFINITY, INFINITY, top);
+    assert_int_equal(top[0], E_HIGH_SMALL); /* centre 7 above centre 5 */
+    assert_int_equal(top[1], E_FREE1);
+    assert_int_equal(top[2], SIZE_MAX);
+    assert_int_equal(top[3], E_COL3);
+    cdem_surface_columns(&s, &cols, CDEM_SURFACE_BY_TOP, -INFINITY, INFINITY, top);
+    assert_int_equal(top[0], E_LOW_BIG); /* the same as cdem_surface_column_tops */
+    /* a tie: a copy of E_COL3 appended later does not take its column */
+    cdem_error err;
+    size_t idx = 0;
+    assert_int_equal(cdem_state_append(&s, -1, 36.0, 1.0, 0.5, 1.0, 1, 0, 0, &idx, &err), CDEM_OK);
+    cdem_surface_columns(&s, &cols, CDEM_SURFACE_BY_CENTRE, -INFINITY, INFINITY, top);
+    assert_int_equal(top[3], E_COL3);
+    cdem_surface_columns(&s, &cols, CDEM_SURFACE_BY_TOP, -INFINITY, INFINITY, top);
+    assert_int_equal(top[3], E_COL3);
+    cdem_state_free(&s);
+}
+
+static void test_surface_top(void **state) {
+    (void)state;
+    cdem_state s;
+    make_state(&s);
+    /* E_LEFT and E_OUTSIDE (centre 99, radius 1) are free: top 100; the wall and the fault
+     * element above them do not count */
+    assert_true(cdem_surface_top(&s) == 100.0);
+    cdem_state_free(&s);
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&s, 1, 0, &err), CDEM_OK);
+    assert_true(cdem_surface_top(&s) == -INFINITY); /* no elements */
+    assert_int_equal(
+        cdem_state_append(&s, -1, 0.0, 500.0, 1.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err), CDEM_OK);
+    assert_true(cdem_surface_top(&s) == -INFINITY); /* only a wall */
+    cdem_state_free(&s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_surface_is_free),
         cmocka_unit_test(test_surface_column_tops),
+        cmocka_unit_test(test_surface_by_centre),
+        cmocka_unit_test(test_surface_top),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

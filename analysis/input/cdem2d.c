@@ -3,7 +3,7 @@
  * kept (one state) for id matching. */
 #include "cdem2d.h"
 
-#include "cellgrid.h"
+#include "grid.h"
 #include "params.h"
 
 #include <ctype.h>
@@ -301,8 +301,8 @@ static cdem_status assign_ids(const cdem_state *prev, cdem_state *cur, int32_t *
     for (size_t i = 0; i < prev->n; i++)
         rmax = fmax(rmax, prev->radius[i]);
     const double tol = 2.0 * (rmax > 0.0 ? rmax : 1.0);
-    cdem_cellgrid g;
-    CDEM_TRY(cdem_cellgrid_build(&g, prev->x, prev->y, prev->n, NULL, tol, err));
+    cdem_grid_index g;
+    CDEM_TRY(cdem_grid_index_build(&g, prev->x, prev->y, prev->n, NULL, tol, err));
     size_t *best = malloc((cur->n ? cur->n : 1) * sizeof *best);
     double *bestd = malloc((cur->n ? cur->n : 1) * sizeof *bestd);
     size_t *owner = malloc((prev->n ? prev->n : 1) * sizeof *owner);
@@ -312,7 +312,7 @@ static cdem_status assign_ids(const cdem_state *prev, cdem_state *cur, int32_t *
         free(bestd);
         free(owner);
         free(ownd);
-        cdem_cellgrid_free(&g);
+        cdem_grid_index_free(&g);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "cdem2D import: out of memory matching %zu elements",
                          cur->n);
     }
@@ -323,14 +323,14 @@ static cdem_status assign_ids(const cdem_state *prev, cdem_state *cur, int32_t *
     for (size_t j = 0; j < cur->n; j++) {
         best[j] = SIZE_MAX;
         bestd[j] = INFINITY;
-        size_t ix0, ix1, iy0, iy1;
-        if (!cdem_cellgrid_range(&g, cur->x[j], cur->y[j], tol, &ix0, &ix1, &iy0, &iy1))
+        cdem_grid_box box;
+        if (!cdem_grid_index_range(&g, cur->x[j], cur->y[j], tol, &box))
             continue;
-        for (size_t cy = iy0; cy <= iy1; cy++)
-            for (size_t cx = ix0; cx <= ix1; cx++) {
-                size_t c = cy * g.nx + cx;
-                for (size_t q = g.start[c]; q < g.start[c + 1]; q++) {
-                    size_t k = g.items[q];
+        for (size_t cy = box.y_lo; cy <= box.y_hi; cy++)
+            for (size_t cx = box.x_lo; cx <= box.x_hi; cx++) {
+                size_t c = cy * g.grid.nx + cx;
+                for (int32_t q = g.start[c]; q < g.start[c + 1]; q++) {
+                    size_t k = (size_t)g.items[q];
                     if (prev->layer[k] != cur->layer[j] ||
                         fabs(prev->radius[k] - cur->radius[j]) > 1e-9 * cur->radius[j])
                         continue;
@@ -360,7 +360,7 @@ static cdem_status assign_ids(const cdem_state *prev, cdem_state *cur, int32_t *
     free(bestd);
     free(owner);
     free(ownd);
-    cdem_cellgrid_free(&g);
+    cdem_grid_index_free(&g);
     return CDEM_OK;
 }
 

@@ -2,7 +2,7 @@
  * order, so the output is the same for any thread count. */
 #include "axes.h"
 
-#include "cellgrid.h"
+#include "grid.h"
 #include "strain.h"
 
 #include <math.h>
@@ -77,7 +77,7 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
 
     cdem_id_map ref_map = {0};
     double *ux = NULL, *uy = NULL;
-    cdem_cellgrid grid = {0};
+    cdem_grid_index grid = {0};
     cdem_axes all = {0};
     unsigned char *keep = NULL;
     cdem_status st = alloc_axes(&all, nn, err);
@@ -101,7 +101,7 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
             uy[i] = r == SIZE_MAX ? NAN : ref->y[r];
         }
     }
-    st = cdem_cellgrid_build(&grid, cur->x, cur->y, cur->n, NULL, spacing, err);
+    st = cdem_grid_index_build(&grid, cur->x, cur->y, cur->n, NULL, spacing, err);
     if (st != CDEM_OK)
         goto done;
     const long nnl = (long)nn;
@@ -109,17 +109,17 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
     for (long kk = 0; kk < nnl; kk++) {
         const size_t k = (size_t)kk;
         const double px = xmin + (double)(k % nx) * spacing, py = ymin + (double)(k / nx) * spacing;
-        size_t ix0, ix1, iy0, iy1;
-        if (!cdem_cellgrid_range(&grid, px, py, spacing, &ix0, &ix1, &iy0, &iy1))
+        cdem_grid_box box;
+        if (!cdem_grid_index_range(&grid, px, py, spacing, &box))
             continue;
         double X[64], Y[64], U[64], V[64];
         size_t m = 0, nearest = SIZE_MAX;
         double dnear = INFINITY, s_xx = 0, s_yy = 0, s_xy = 0, mx = 0, my = 0;
-        for (size_t cy = iy0; cy <= iy1; cy++)
-            for (size_t cx = ix0; cx <= ix1; cx++) {
-                const size_t c = cy * grid.nx + cx;
-                for (size_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
-                    const size_t j = grid.items[q];
+        for (size_t cy = box.y_lo; cy <= box.y_hi; cy++)
+            for (size_t cx = box.x_lo; cx <= box.x_hi; cx++) {
+                const size_t c = cy * grid.grid.nx + cx;
+                for (int32_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
+                    const size_t j = (size_t)grid.items[q];
                     const double dx = cur->x[j] - px, dy = cur->y[j] - py, d2 = dx * dx + dy * dy;
                     if (d2 > spacing * spacing)
                         continue;
@@ -204,7 +204,7 @@ done:
     free(keep);
     free(ux);
     free(uy);
-    cdem_cellgrid_free(&grid);
+    cdem_grid_index_free(&grid);
     cdem_id_map_free(&ref_map);
     return st;
 }

@@ -62,14 +62,13 @@ static int cmp_zone(const void *a, const void *b) {
  * over the cells that have a value. */
 static void bin_values(const cdem_state *s, const double *v, double x0, double y0, double h,
                        long nx, long ny, double *sum, double *cnt, double *out) {
+    const cdem_grid g = {.x0 = x0, .y0 = y0, .cell = h, .nx = (size_t)nx, .ny = (size_t)ny};
     for (size_t i = 0; i < s->n; i++) {
         if (!cdem_surface_is_free(s, i) || !isfinite(v[i]))
             continue;
-        long a = (long)floor((s->x[i] - x0) / h), b = (long)floor((s->y[i] - y0) / h);
-        a = a < 0 ? 0 : a >= nx ? nx - 1 : a;
-        b = b < 0 ? 0 : b >= ny ? ny - 1 : b;
-        sum[b * nx + a] += v[i];
-        cnt[b * nx + a] += 1.0;
+        const size_t c = cdem_grid_cell(&g, s->x[i], s->y[i]);
+        sum[c] += v[i];
+        cnt[c] += 1.0;
     }
     for (long c = 0; c < nx * ny; c++)
         sum[c] = cnt[c] > 0.0 ? sum[c] / cnt[c] : NAN;

@@ -7,7 +7,7 @@
  * as det F - 1 = gxx + gyy + gxx gyy - gxy gyx. */
 #include "strain.h"
 
-#include "cellgrid.h"
+#include "grid.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -136,7 +136,7 @@ cdem_status cdem_strain_gradients(const cdem_state *ref, const cdem_state *cur,
     size_t *to_cur = malloc(ref->n * sizeof *to_cur);
     double *ux = malloc(ref->n * sizeof *ux), *uy = malloc(ref->n * sizeof *uy);
     unsigned char *use = malloc(ref->n);
-    cdem_cellgrid grid = {0};
+    cdem_grid_index grid = {0};
     if (!to_cur || !ux || !uy || !use) {
         st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "strain: out of memory for %zu elements", ref->n);
         goto done;
@@ -152,7 +152,7 @@ cdem_status cdem_strain_gradients(const cdem_state *ref, const cdem_state *cur,
         uy[j] = cur->y[c] - ref->y[j];
         use[j] = isfinite(ux[j]) && isfinite(uy[j]);
     }
-    st = cdem_cellgrid_build(&grid, ref->x, ref->y, ref->n, use, radius, err);
+    st = cdem_grid_index_build(&grid, ref->x, ref->y, ref->n, use, radius, err);
     if (st != CDEM_OK)
         goto done;
 
@@ -167,15 +167,15 @@ cdem_status cdem_strain_gradients(const cdem_state *ref, const cdem_state *cur,
         if (r == SIZE_MAX || !use[r])
             continue;
         const double px = ref->x[r], py = ref->y[r];
-        size_t ix0, ix1, iy0, iy1;
-        if (!cdem_cellgrid_range(&grid, px, py, radius, &ix0, &ix1, &iy0, &iy1))
+        cdem_grid_box box;
+        if (!cdem_grid_index_range(&grid, px, py, radius, &box))
             continue;
         double s[S_COUNT] = {0};
-        for (size_t cy = iy0; cy <= iy1; cy++)
-            for (size_t cx = ix0; cx <= ix1; cx++) {
-                const size_t c = cy * grid.nx + cx;
-                for (size_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
-                    const size_t j = grid.items[q];
+        for (size_t cy = box.y_lo; cy <= box.y_hi; cy++)
+            for (size_t cx = box.x_lo; cx <= box.x_hi; cx++) {
+                const size_t c = cy * grid.grid.nx + cx;
+                for (int32_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
+                    const size_t j = (size_t)grid.items[q];
                     const double dx = ref->x[j] - px, dy = ref->y[j] - py;
                     if (dx * dx + dy * dy > r2)
                         continue;
@@ -185,7 +185,7 @@ cdem_status cdem_strain_gradients(const cdem_state *ref, const cdem_state *cur,
         fit_from_sums(s, radius, grad + 4 * i, NULL);
     }
 done:
-    cdem_cellgrid_free(&grid);
+    cdem_grid_index_free(&grid);
     free(to_cur);
     free(ux);
     free(uy);

@@ -161,17 +161,18 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
     cdem_surface_column_tops(cur, r->x_left, r->column_width, nc, -INFINITY, wall, top);
     cdem_surface_column_tops(ref, r->x_left, r->column_width, nc, -INFINITY, r->wall_x0, top0);
     /* mean displacement magnitude of each column's elements present in the reference */
+    const cdem_grid cols = {.x0 = r->x_left, .y0 = 0.0, .cell = r->column_width, .nx = nc, .ny = 1};
     for (size_t i = 0; i < cur->n; i++) {
         if (!cdem_surface_is_free(cur, i) || !(cur->x[i] < wall))
             continue;
-        const double fc = floor((cur->x[i] - r->x_left) / r->column_width);
-        if (!(fc >= 0) || fc >= (double)nc)
+        size_t c = 0;
+        if (!cdem_grid_col_inside(&cols, cur->x[i], &c))
             continue;
         const size_t j = cdem_id_map_find(&map, cur->id[i]);
         if (j == SIZE_MAX)
             continue;
-        usum[(size_t)fc] += hypot(cur->x[i] - ref->x[j], cur->y[i] - ref->y[j]);
-        cnt[(size_t)fc]++;
+        usum[c] += hypot(cur->x[i] - ref->x[j], cur->y[i] - ref->y[j]);
+        cnt[c]++;
     }
     double hmax = -INFINITY;
     size_t front = SIZE_MAX, front_t = SIZE_MAX;

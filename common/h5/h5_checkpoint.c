@@ -7,8 +7,8 @@
  * sequence first and falls back to the other slot when a checksum or the blob fails.
  * A slot holds the blob compressed (h5i_snap_pack); length and checksum in the index are
  * those of the bytes in the slot, so a torn slot is found before anything is inflated. The
- * slots are unfiltered and chunked in CKPT_CHUNK (16 KiB) pieces: a rewrite stays in place
- * (docs/format.md, "Size"), and a slot holds at most 16 KiB more than its checkpoint. */
+ * slots are unfiltered and chunked in CKPT_CHUNK (4 KiB) pieces: a rewrite stays in place
+ * (docs/format.md, "Size"), and a slot holds less than 4 KiB more than its checkpoint. */
 #include "h5_internal.h"
 
 #include <stdio.h>

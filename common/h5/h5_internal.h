@@ -25,16 +25,28 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Compression settings, chosen by measurement (docs/format.md, "Size"): deflate level 4
- * after byte shuffle; levels 6 and 9 saved 0.2 % more for 20-30 % more CPU. Per-increment
- * datasets are one chunk up to CHUNK_ELEMS elements (8192 doubles = 64 KiB). */
-#define DEFLATE_LEVEL   4
-#define CHUNK_ELEMS     8192
-#define SERIES_CHUNK    512
-#define SERIES_BUFFER   256
-#define XMF_EVERY_LIMIT 1000
-#define INDEX_CHUNK     256       /* rows of /increments/index per chunk */
-#define CKPT_CHUNK      (1 << 14) /* bytes of a checkpoint slot per chunk (h5_checkpoint.c) */
+/* Compression settings, chosen by measurement (docs/format.md, "Size"): element data deflate
+ * level 4 after byte shuffle (level 6 saved 0.3 % of the default run's file for 25 % more
+ * writing CPU, level 9 about 0.4 % for 85 %); checkpoints level 6 (h5_ckpt_codec.c: 8 KB less
+ * than level 4 per run for 3 ms per checkpoint; level 9 saved nothing more and took 2.3 times
+ * as long). An increment of the element datasets starts at a chunk boundary and is one chunk
+ * up to CHUNK_ELEMS elements (4096 doubles = 32 KiB): the rows up to the next boundary are
+ * padding, and deflate still spends bytes on zeros (a match per 258 bytes: about 250 bytes for
+ * the 5770 padding rows of a double dataset with 8192-row chunks), so the chunk should be near
+ * the element count; a larger count spans several chunks (each split costs about 70 bytes
+ * per dataset). For the default run (2422 elements) 4096 rows took 143 KB less than 8192
+ * (files written before), a chunk of exactly 2422 rows 78 KB less again; 2048 rows (two
+ * chunks) 80 KB more. The series, index and checkpoint-slot chunks are allocated whole, so
+ * their last chunk is partly empty: 128 samples (1 KiB), 64 index rows (4.75 KiB) and 4 KiB
+ * of slot keep that small (512, 256 and 16 KiB before: 51 KB more in the default run's file). */
+#define DEFLATE_LEVEL      4
+#define CKPT_DEFLATE_LEVEL 6
+#define CHUNK_ELEMS        4096
+#define SERIES_CHUNK       128
+#define SERIES_BUFFER      256
+#define XMF_EVERY_LIMIT    1000
+#define INDEX_CHUNK        64        /* rows of /increments/index per chunk (76 bytes each) */
+#define CKPT_CHUNK         (1 << 12) /* bytes of a checkpoint slot per chunk (h5_checkpoint.c) */
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
 /* Largest element count an increment may have to be loaded (~2 GB of state; cdem-run's
@@ -170,7 +182,8 @@ hid_t h5i_make_compound(const index_member *m, size_t nm, size_t mem_size, int f
 
 const char *h5i_bad_index_row(const index_row *row, const index_row *prev, hsize_t data_ext,
                               hsize_t stress_ext);
-hsize_t h5i_chunk_end(hsize_t rows);
+hsize_t h5i_chunk_end(hsize_t rows, hsize_t chunk_rows);
+hsize_t h5i_chunk_rows_of(hid_t ds);
 
 /* ------------------------------------------------------------------ the writer */
 
@@ -204,6 +217,8 @@ struct cdem_h5_writer {
                                        boundary) */
     hsize_t stress_len;             /* the same in sxx, syy, sxy */
     hsize_t data_ext, stress_ext;   /* current extents of id..born and of sxx, syy, sxy */
+    hsize_t chunk_rows;             /* rows per chunk of the element datasets: CHUNK_ELEMS,
+                                       or what a resumed file has (8192 before) */
     hsize_t index_len;              /* rows in /increments/index */
     int32_t last_number;            /* number of the last increment written (-1: none) */
     int64_t last_step;              /* its step */
@@ -296,10 +311,12 @@ cdem_status h5i_snap_encode(const cdem_snapshot *snap, unsigned char **buf, size
 /* Parses a blob into snap (cleared first). what names the blob in messages. */
 cdem_status h5i_snap_decode(const unsigned char *p, size_t len, cdem_snapshot *snap,
                             const char *what, cdem_error *err);
-/* What a checkpoint slot holds: the blob compressed (deflate), behind its own header. Packs
- * the blob raw[0, raw_len) into *buf (grown, *cap its size; *len the packed length). */
-cdem_status h5i_snap_pack(const unsigned char *raw, size_t raw_len, unsigned char **buf,
-                          size_t *cap, size_t *len, const char *path, cdem_error *err);
+/* What a checkpoint slot holds: the blob compressed (deflate, some arrays byte-transposed
+ * first), behind its own header. Packs the blob blob[0, blob_len) into *buf (grown, *cap its
+ * size; *len the packed length). The blob is used as scratch: its arrays are left
+ * transposed (the writer encodes a new one for every checkpoint). */
+cdem_status h5i_snap_pack(unsigned char *blob, size_t blob_len, unsigned char **buf, size_t *cap,
+                          size_t *len, const char *path, cdem_error *err);
 /* The blob of a slot's bytes p[0, len): *raw points into p for an uncompressed blob (files
  * written before compression) or to a malloc'd copy (*owned = 1, the caller frees it) for a
  * packed one. CDEM_ERR_FORMAT naming what when the bytes are neither. */

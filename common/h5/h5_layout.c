@@ -138,7 +138,19 @@ const char *h5i_bad_index_row(const index_row *row, const index_row *prev, hsize
 /* Each increment starts at a chunk boundary of the element datasets, so every compressed
  * chunk is written once and never rewritten (rewriting a partly filled compressed chunk
  * at every append moves it and, in SWMR mode, leaves the old space unused: the file grew
- * 2.4-fold). The padding rows belong to no increment and compress to almost nothing. */
-hsize_t h5i_chunk_end(hsize_t rows) {
-    return (rows + CHUNK_ELEMS - 1) / CHUNK_ELEMS * CHUNK_ELEMS;
+ * 2.4-fold). The padding rows belong to no increment; they cost little, but not nothing
+ * (CHUNK_ELEMS, h5_internal.h). */
+hsize_t h5i_chunk_end(hsize_t rows, hsize_t chunk_rows) {
+    return (rows + chunk_rows - 1) / chunk_rows * chunk_rows;
+}
+
+/* Rows per chunk of the 1-D chunked dataset ds; 0 when it cannot be read. */
+hsize_t h5i_chunk_rows_of(hid_t ds) {
+    hid_t dcpl = H5Dget_create_plist(ds);
+    hsize_t rows = 0;
+    if (dcpl < 0 || H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_chunk(dcpl, 1, &rows) != 1)
+        rows = 0;
+    if (dcpl >= 0)
+        H5Pclose(dcpl);
+    return rows;
 }

@@ -13,16 +13,18 @@
 #include <sys/statvfs.h>
 
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress) {
-    /* Measured on the default run (docs/format.md): 16.1 bytes per element and increment
-     * without stress, 40.5 with; plus 64 KiB of metadata and 0.5 KB per increment. */
-    double per = with_stress ? 40.5 : 16.1;
+    /* Measured on the default run (docs/format.md): 14.2 bytes per element and increment
+     * without stress, 35.1 with (16.1 and 40.5 with the 8192-row chunks before), rounded up;
+     * plus 64 KiB of metadata and 0.5 KB per increment. */
+    double per = with_stress ? 35.5 : 14.5;
     return 65536.0 + n_increments * (512.0 + n_elements * per);
 }
 
 /* Checkpoint and sidecar sizes for cdem_h5_estimate_run_space, measured on cdem-run files
  * (docs/format.md, "Size"): a checkpoint holds about CKPT_BYTES_PER_ELEMENT bytes per
  * element (state, neighbour list, contact histories) plus the parameter text and the
- * summary, before compression: a bound, compressed it is about half (h5_ckpt_codec.c); a
+ * summary, before compression: a bound (the default run's is 191 bytes per element before
+ * and 101 after compression, h5_ckpt_codec.c; denser packings have more pairs); a
  * sidecar increment is about XMF_BYTES_PER_INCREMENT bytes of XML. */
 #define CKPT_BYTES_FIXED        65536.0
 #define CKPT_BYTES_PER_ELEMENT  400.0

@@ -81,6 +81,12 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         (w->ckpt_data[1] = H5Dopen2(w->file, "checkpoint/slot1", H5P_DEFAULT)) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: a version-2 dataset is missing", w->path);
     w->has_xy = H5Lexists(w->file, "/increments/xy", H5P_DEFAULT) > 0; /* older files lack it */
+    /* appending continues at the file's own chunk boundaries (8192 rows before 4096), so no
+     * compressed chunk is rewritten */
+    w->chunk_rows = h5i_chunk_rows_of(w->data[0]);
+    if (w->chunk_rows == 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/%s is not chunked", w->path,
+                      h5i_element_fields[0].name);
 
     /* Increments to keep: the valid prefix of the index up to keep_inc. */
     hsize_t rows = h5i_extent_of(w->index), data_ext = h5i_extent_of(w->data[0]),
@@ -151,8 +157,8 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
                       (int)keep_inc);
     w->data_ext = w->data_len;
     w->stress_ext = w->stress_len;
-    w->data_len = h5i_chunk_end(w->data_len);
-    w->stress_len = h5i_chunk_end(w->stress_len);
+    w->data_len = h5i_chunk_end(w->data_len, w->chunk_rows);
+    w->stress_len = h5i_chunk_end(w->stress_len, w->chunk_rows);
     /* Checkpoints of dropped increments are invalidated. */
     if (h5i_read_all_rows(w->ckpt_index, w->ckpt_mtype, 2, w->ckpt) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /checkpoint/index", w->path);

@@ -232,11 +232,11 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
     w->index_len++;
     if (n) {
         w->data_ext = w->data_len + n;
-        w->data_len = h5i_chunk_end(w->data_ext);
+        w->data_len = h5i_chunk_end(w->data_ext, w->chunk_rows);
     }
     if (stress) {
         w->stress_ext = w->stress_len + n;
-        w->stress_len = h5i_chunk_end(w->stress_ext);
+        w->stress_len = h5i_chunk_end(w->stress_ext, w->chunk_rows);
     }
     w->last_number = info->number;
     w->last_step = info->step;

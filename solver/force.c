@@ -1,0 +1,494 @@
+/* force: see force.h. One pass: the rebuild test (optional), then the pair loop (chunk_pass)
+ * computes each pair force once into its slot and scatters it to its two elements, then the
+ * elements are finished (second half kick, loads, instability test).
+ * Threads: the elements are cut into one chunk per thread, by estimated work and then by
+ * measured thread times (make_chunks, update_shares); a pair is evaluated by the chunk of
+ * its second element, so a pair whose two elements lie in different chunks (a cross pair)
+ * is evaluated first by the later chunk, which publishes its progress; the earlier chunk
+ * waits only if it reaches a cross pair not yet evaluated. Each element's sum has the same
+ * additions in the same order (ascending pair index) for any cut, so any thread count and
+ * any cut give identical bits, the same as the serial scatter. One parallel region and one
+ * barrier per pass. */
+#include "force.h"
+
+#include <omp.h>
+#include <sched.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cdem_force_free(cdem_force *f) {
+    if (!f)
+        return;
+    free(f->cross);
+    free(f->elem_work);
+    memset(f, 0, sizeof *f);
+}
+
+cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n, cdem_error *err) {
+    if (f->crosscap < nb->pcap) {
+        const size_t c = nb->pcap;
+        int32_t *q = realloc(f->cross, (c ? c : 1) * sizeof *q);
+        if (!q)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu cross pairs)", c);
+        f->cross = q;
+        f->crosscap = c;
+    }
+    if (f->workcap < n) {
+        const size_t c = n + n / 2 + 16;
+        uint32_t *w = realloc(f->elem_work, c * sizeof *w);
+        if (!w)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+        f->elem_work = w;
+        f->workcap = c;
+    }
+    return CDEM_OK;
+}
+
+/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
+ * the common case of a list pair that does not touch is settled here, everything else by
+ * the one contact kernel (contact.h). (A branch-free variant of the granular law,
+ * evaluating every list pair and selecting the result, was measured 40-50 % slower: gcc -O2
+ * still branches and does more work.) */
+static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
+                                   double dy, double dvx, double dvy, const double *restrict Rp,
+                                   const uint8_t *restrict cls, uint8_t *restrict hist,
+                                   double *restrict xs, double *restrict pfx, double *restrict pfy,
+                                   double dt) {
+    const double R = Rp[p];
+    const uint8_t h = hist[p];
+    const double r2 = dx * dx + dy * dy;
+    if (!(h & CDEM_PAIR_BONDED)) {
+        if (r2 >= R * R || r2 <= 0.0) {
+            /* separated: xs != 0 only with h != 0 */
+            pfx[p] = 0.0;
+            pfy[p] = 0.0;
+            if (h) {
+                hist[p] = cdem_contact_separated(h, r2, R);
+                xs[p] = 0.0;
+            }
+            return;
+        }
+        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
+                              &pfy[p]);
+        return;
+    }
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
+}
+
+/* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
+ * kick (when kick), and the total force stored in fx, fy. Boundary elements keep the sum. */
+static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
+                                  const double *restrict kick_finish,
+                                  const uint32_t *restrict flags, double *restrict vxw,
+                                  double *restrict vyw, double *restrict fx, double *restrict fy,
+                                  double hdt, double c, double g, double ob, int kick,
+                                  const double *restrict x, double ef, double exmid) {
+    const uint32_t fl = flags[i];
+    if (fl & CDEM_FLAGS_BOUNDARY) {
+        fx[i] = sx;
+        fy[i] = sy;
+        return;
+    }
+    const double m = mass[i];
+    sy -= m * g + ((fl & CDEM_FLAG_SURFACE) ? ob : 0.0);
+    if (fl & CDEM_FLAG_BIAXIAL_EDGE)
+        sx += x[i] < exmid ? ef : -ef;
+    if (kick) {
+        /* v = (v_half + hdt/m F) / (1 + c hdt/m), with 1 / (m + c hdt) from kick_finish */
+        const double inv = kick_finish ? kick_finish[i] : 1.0 / (m + c * hdt);
+        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
+        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
+    }
+    fx[i] = sx - c * vxw[i];
+    fy[i] = sy - c * vyw[i];
+}
+
+/* Everything the force pass reads or writes, gathered once per step. */
+typedef struct {
+    const cdem_contact_law *law;
+    int kick;
+    double dt, hdt, c, g, ob, ef, exmid;
+    const double *x, *y, *mass, *Rp;
+    const double *kick_finish; /* the stepper's kick factors (cdem_force_step) */
+    const int32_t *pi, *pj, *istart;
+    const uint8_t *cls;
+    const uint32_t *flags;
+    uint8_t *hist;
+    double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
+    const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
+    int nchunk;           /* chunks of this pass */
+    const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
+    cdem_force *f;                                   /* cross_done progress slots */
+    long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
+    double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
+} force_pass;
+
+/* How many cross pairs a chunk evaluates between two publications of its progress: small
+ * enough that an earlier chunk seldom waits, large enough that the shared line is rarely
+ * written. */
+#define CROSS_PUBLISH_EVERY 32
+
+static int32_t cross_progress(const force_pass *fp, int d) {
+    return atomic_load_explicit(&fp->f->cross_done[d].slot, memory_order_acquire);
+}
+
+/* Waits until every chunk after c has evaluated its cross pairs at slots below `slot` (their
+ * slots are read by chunk c) and returns the lowest slot below which all of them are done,
+ * so that the caller need not look again before it. Usually no wait at all: the later
+ * chunks' threads go through their few cross pairs in ascending slot order, ahead of chunk
+ * c's scan through all of its pairs. */
+static int32_t wait_cross(const force_pass *fp, int c, int32_t slot) {
+    int32_t safe = INT32_MAX;
+    for (int d = c + 1; d < fp->nchunk; d++) {
+        int32_t v = cross_progress(fp, d);
+        for (long spins = 0; v < slot; spins++) {
+            if (spins > 1000)
+                sched_yield(); /* the other thread may be descheduled (shared machine) */
+            v = cross_progress(fp, d);
+        }
+        if (v < safe)
+            safe = v;
+    }
+    return safe;
+}
+
+static void publish_cross(const force_pass *fp, int c, int32_t slot) {
+    atomic_store_explicit(&fp->f->cross_done[c].slot, slot, memory_order_release);
+}
+
+/* Evaluates the cross pairs into chunk c (their slots only; no sums), in ascending slot
+ * order, publishing the progress every CROSS_PUBLISH_EVERY pairs. */
+static void cross_eval(const force_pass *fp, int c) {
+    const double *restrict x = fp->x, *restrict y = fp->y;
+    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict list = fp->cross;
+    const int32_t a = fp->cross_start[c], b = fp->cross_start[c + 1];
+    for (int32_t k = a; k < b; k++) {
+        const long p = list[k];
+        const int32_t i = fp->pi[p], j = fp->pj[p];
+        pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                   fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+        if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
+            publish_cross(fp, c, list[k + 1]);
+    }
+    publish_cross(fp, c, INT32_MAX);
+}
+
+/* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
+ * istart[hi]-1). Every element's sum is built in ascending pair order, as one scatter loop
+ * over all pairs would: fx, fy of the chunk start at zero, the cross pairs from earlier
+ * chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then the
+ * chunk's pairs are scattered in order (a pair whose pj lies in a later chunk was evaluated
+ * by that chunk's thread and only adds to its pi here). Then the chunk's elements are
+ * finished. (A loop nested per element, accumulating each pi range in registers and
+ * finishing the element right after it, was measured slower: the short inner loops
+ * mispredict their exits.) */
+static void chunk_pass(force_pass *fp, int chunk) {
+    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
+    const int32_t *restrict list = fp->cross;
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
+    const cdem_contact_law *restrict law = fp->law;
+    const double *restrict x = fp->x, *restrict y = fp->y;
+    double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict pj = fp->pj, *restrict istart = fp->istart;
+    double *restrict fx = fp->fx, *restrict fy = fp->fy;
+    double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+    const double dt = fp->dt;
+    memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
+    memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
+    for (int32_t k = ca; k < cb; k++) {
+        const long p = list[k];
+        fx[pj[p]] -= pfx[p];
+        fy[pj[p]] -= pfy[p];
+    }
+    const int32_t *restrict pi = fp->pi;
+    const long p0 = istart[lo], pe = istart[hi];
+    /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
+    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
+    for (long p = p0; p < pe; p++) {
+        const int32_t i = pi[p], j = pj[p];
+        if (j < hi) {
+            pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                       fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+            fx[j] -= pfx[p];
+            fy[j] -= pfy[p];
+            fx[i] += pfx[p];
+            fy[i] += pfy[p];
+        } else {
+            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
+            if (p >= safe)
+                safe = wait_cross(fp, chunk, (int32_t)p + 1);
+            fx[i] += fp->pfx[p];
+            fy[i] += fp->pfy[p];
+        }
+    }
+    /* the cross pairs out of this chunk read its velocities: kick only after all of them */
+    if (pe > safe)
+        wait_cross(fp, chunk, (int32_t)pe);
+    for (long i = lo; i < hi; i++)
+        finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
+                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
+    fp->unstable[chunk] = -1;
+    if (fp->radius) {
+        /* the run loop's guard (integrate.h): here, while the velocities are in cache */
+        const double *restrict rad = fp->radius;
+        const double dt2 = fp->dt * fp->dt;
+        for (long i = lo; i < hi; i++) {
+            const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
+            if (d2 > rad[i] * rad[i]) {
+                fp->unstable[chunk] = i;
+                break;
+            }
+        }
+    }
+}
+
+/* Relative costs of the work of a step (measured at 9,000 elements: a touching pair's law
+ * ~10 ns, a list pair that does not touch ~3 ns, a free element's drift, rebuild test and
+ * finish ~4 ns, a boundary element's ~1 ns); only their ratios matter. */
+enum { WORK_TOUCH = 10, WORK_APART = 3, WORK_FREE = 4, WORK_BOUNDARY = 1 };
+
+/* Work of element e in a threaded step: its drift and finish, and the pairs whose pj it is
+ * (each pair is evaluated by the chunk of its pj). The touch flags are those of the last
+ * evaluation (carried over by the build). */
+static uint32_t element_work(const cdem_neighbour *nb, const uint32_t *flags, size_t e) {
+    uint32_t w = (flags[e] & CDEM_FLAGS_BOUNDARY) ? WORK_BOUNDARY : WORK_FREE;
+    for (int32_t k = nb->jstart[e]; k < nb->jstart[e + 1]; k++)
+        w += (nb->hist[nb->jslot[k]] & CDEM_PAIR_TOUCH) ? WORK_TOUCH : WORK_APART;
+    return w;
+}
+
+/* The work shares of the next cut: equal for a new chunk count; else each share scaled by
+ * the speed its thread showed since the last cut (share / mean time), so that the times
+ * even out, smoothed (half way) and kept above a tenth of an equal share. */
+static void update_shares(cdem_force *f, int nchunk) {
+    if (f->share_n != nchunk) {
+        f->share_n = nchunk;
+        for (int c = 0; c < nchunk; c++) {
+            f->chunk_share[c] = 1.0 / nchunk;
+            f->chunk_time[c] = 0.0;
+        }
+        return;
+    }
+    double speed[CDEM_MAX_CHUNKS], sum = 0.0;
+    for (int c = 0; c < nchunk; c++) {
+        if (!(f->chunk_time[c] > 0.0))
+            return; /* a chunk without a measurement: keep the shares */
+        speed[c] = f->chunk_share[c] / f->chunk_time[c];
+        sum += speed[c];
+    }
+    double total = 0.0;
+    for (int c = 0; c < nchunk; c++) {
+        double share = 0.5 * (f->chunk_share[c] + speed[c] / sum);
+        if (share < 0.1 / nchunk)
+            share = 0.1 / nchunk;
+        f->chunk_share[c] = share;
+        total += share;
+    }
+    for (int c = 0; c < nchunk; c++) {
+        f->chunk_share[c] /= total;
+        f->chunk_time[c] = 0.0;
+    }
+}
+
+/* Splits the elements into nchunk ranges of about equal work (element_work) and lists the
+ * cross pairs of each chunk. A pair is evaluated by the chunk of its pj: its own pairs and
+ * the cross pairs coming in from earlier chunks, e.g. every element-wall pair goes to the
+ * chunk of the walls, which are sorted to the end; cutting at equal pair counts by pi
+ * instead overloaded that chunk (20 % more pairs at 9,000 elements), and equal pair counts
+ * by pj still left the lower chunk, with more touching pairs and free elements, 10 % more
+ * to do. The cut does not change any result (every element sum has the same additions in
+ * the same order for any cut). Falls back to one chunk when the buffer is too small (never
+ * after a list build: the stepper calls cdem_force_reserve after each). */
+static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t *flags, size_t n,
+                        int nchunk, long par_min) {
+    const size_t np = nb->np;
+    if (nchunk > CDEM_MAX_CHUNKS)
+        nchunk = CDEM_MAX_CHUNKS;
+    if (nchunk < 1 || (size_t)nchunk > n || f->crosscap < np)
+        nchunk = 1;
+    f->nchunk = nchunk;
+    f->chunk_build = nb->n_builds;
+    f->chunk_n = n;
+    f->chunk_elem[0] = 0;
+    if (nchunk > 1) {
+        update_shares(f, nchunk);
+        /* each element's work once (in parallel when there is room to keep it), then the
+         * running sum */
+        uint32_t *restrict work = f->workcap >= n ? f->elem_work : NULL;
+        if (work) {
+#pragma omp parallel for schedule(static) if ((long)n > par_min)
+            for (long e = 0; e < (long)n; e++)
+                work[e] = element_work(nb, flags, (size_t)e);
+        }
+        uint64_t total = 0;
+        for (size_t e = 0; e < n; e++)
+            total += work ? work[e] : element_work(nb, flags, e);
+        /* chunk c starts at the first element with at least the shares of chunks 0..c-1 of
+         * the work before it */
+        double cum = 0.0;
+        uint64_t want[CDEM_MAX_CHUNKS];
+        for (int c = 1; c < nchunk; c++) {
+            cum += f->chunk_share[c - 1];
+            want[c] = (uint64_t)(cum * (double)total);
+        }
+        uint64_t before = 0;
+        int c = 1;
+        for (size_t e = 0; e < n && c < nchunk; e++) {
+            while (c < nchunk && before >= want[c])
+                f->chunk_elem[c++] = (int32_t)e;
+            before += work ? work[e] : element_work(nb, flags, e);
+        }
+        while (c < nchunk)
+            f->chunk_elem[c++] = (int32_t)n;
+    }
+    f->chunk_elem[nchunk] = (int32_t)n;
+    for (int c = 0; c <= nchunk; c++)
+        f->cross_start[c] = 0;
+    if (nchunk == 1)
+        return;
+    /* count, then fill, the cross pairs by the chunk of pj (ascending slots in each) */
+    for (int pass = 0; pass < 2; pass++) {
+        int32_t cursor[CDEM_MAX_CHUNKS + 1];
+        for (int c = 0; c <= nchunk; c++)
+            cursor[c] = f->cross_start[c];
+        for (int ci = 0; ci < nchunk; ci++) {
+            const int32_t end = f->chunk_elem[ci + 1];
+            for (int32_t p = nb->istart[f->chunk_elem[ci]]; p < nb->istart[end]; p++) {
+                const int32_t j = nb->pj[p];
+                if (j < end)
+                    continue;
+                int cj = ci + 1;
+                while (j >= f->chunk_elem[cj + 1])
+                    cj++;
+                if (pass == 0)
+                    cursor[cj + 1]++;
+                else
+                    f->cross[cursor[cj]++] = p;
+            }
+        }
+        if (pass == 0)
+            for (int c = 0; c < nchunk; c++)
+                f->cross_start[c + 1] = f->cross_start[c] + cursor[c + 1];
+    }
+}
+
+int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n) {
+    const long np = (long)nb->np;
+    const int want = (np > par_min || n > par_min) ? omp_get_max_threads() : 1;
+    return want < 1 ? 1 : (want > CDEM_MAX_CHUNKS ? CDEM_MAX_CHUNKS : want);
+}
+
+const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour *nb, size_t n,
+                                      int nchunk) {
+    const int current =
+        nchunk > 1 && f->nchunk == nchunk && f->chunk_n == n && f->chunk_build == nb->n_builds;
+    return current ? f->chunk_elem : NULL;
+}
+
+/* The pass (force.h): the parallel driver of chunk_pass; see the top of this file. */
+int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
+                    long *unstable) {
+    cdem_contact_law lawc; /* the law of this step, a local copy: provably not aliased by stores */
+    cdem_contact_law_phase(in->law, in->equilibrating, &lawc);
+    const int kick = in->kick, check_moved = in->check_moved;
+    const long n = (long)s->n;
+    force_pass fp = {
+        .law = &lawc,
+        .kick = kick,
+        .dt = in->dt,
+        .hdt = 0.5 * in->dt,
+        .c = in->damping,
+        .g = in->loads.gravity,
+        .ob = in->loads.surface_force,
+        .ef = in->loads.edge_force,
+        .exmid = in->loads.edge_x_mid,
+        .x = s->x,
+        .y = s->y,
+        .mass = s->mass,
+        .kick_finish = in->kick_finish,
+        .Rp = nb->R,
+        .pi = nb->pi,
+        .pj = nb->pj,
+        .istart = nb->istart,
+        .cls = nb->cls,
+        .flags = s->flags,
+        .hist = nb->hist,
+        .xs = nb->xs,
+        .pfx = nb->pfx,
+        .pfy = nb->pfy,
+        .fx = s->fx,
+        .fy = s->fy,
+        .vx = s->vx,
+        .vy = s->vy,
+    };
+    const int nch = cdem_force_chunks_wanted(nb, in->par_min, n);
+    if (f->nchunk != nch || f->chunk_build != nb->n_builds || f->chunk_n != (size_t)n)
+        make_chunks(f, nb, s->flags, (size_t)n, nch, in->par_min);
+    const int nchunk = f->nchunk;
+    fp.nchunk = nchunk;
+    fp.chunk_elem = f->chunk_elem;
+    fp.cross_start = f->cross_start;
+    fp.cross = f->cross;
+    fp.f = f;
+    fp.radius = in->unstable_test ? s->radius : NULL;
+    if (nchunk == 1) {
+        if (check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
+            return 1;
+        chunk_pass(&fp, 0);
+    } else {
+        for (int c = 0; c < nchunk; c++)
+            atomic_store_explicit(&f->cross_done[c].slot, 0, memory_order_relaxed); /* nothing
+                                                evaluated yet: reset before every pass */
+        int moved = 0;
+        for (int c = 0; c < nchunk; c++)
+            fp.seconds[c] = -1.0; /* no time: a thread that did not run */
+#pragma omp parallel num_threads(nchunk)
+        {
+            const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+            int go = 1;
+            if (check_moved) {
+                int mine = 0;
+                for (int c = t; c < nchunk; c += nt)
+                    mine |= cdem_neighbour_moved(nb, s, (size_t)fp.chunk_elem[c],
+                                                 (size_t)fp.chunk_elem[c + 1]);
+                if (mine) {
+#pragma omp atomic write
+                    moved = 1;
+                }
+#pragma omp barrier
+                int any;
+#pragma omp atomic read
+                any = moved;
+                go = !any;
+            }
+            /* each thread first evaluates the cross pairs into its chunks, then runs them */
+            if (go) {
+                const double t0 = omp_get_wtime();
+                for (int c = t; c < nchunk; c += nt)
+                    cross_eval(&fp, c);
+                for (int c = t; c < nchunk; c += nt)
+                    chunk_pass(&fp, c);
+                fp.seconds[t] = omp_get_wtime() - t0; /* for the load balance */
+                if (nt != nchunk)
+                    fp.seconds[t] = -1.0;
+            }
+        }
+        if (moved)
+            return 1;
+        /* running means of the chunks' times (one chunk per thread), for the next cut */
+        for (int c = 0; c < nchunk; c++) {
+            const double sec = fp.seconds[c];
+            if (!(sec >= 0.0))
+                continue;
+            f->chunk_time[c] = f->chunk_time[c] > 0.0 ? 0.9 * f->chunk_time[c] + 0.1 * sec : sec;
+        }
+    }
+    *unstable = -1;
+    for (int c = 0; c < nchunk; c++)
+        if (fp.unstable[c] >= 0) {
+            *unstable = fp.unstable[c]; /* the lowest index: chunks are in order */
+            break;
+        }
+    return 0;
+}
