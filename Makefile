@@ -1,5 +1,6 @@
 # cdem-c build. Plain GNU Make + pkg-config. Every .c file in common/, solver/ and
-# analysis/ is picked up automatically, so adding a module never edits this file.
+# analysis/ (and its subfolders) is picked up automatically, so adding a module never
+# edits this file.
 #   make            build cdem-run and cdem-strain (build/)
 #   make test       build and run every cmocka test (tests/test_*.c)
 #   make asan       the same tests under address + undefined sanitizers (build-asan/)
@@ -42,16 +43,26 @@ CDEM_CFLAGS += -DCDEM_VERSION='"$(VERSION)"'
 # format in common/). Tests and fuzz harnesses see every layer. A file's layer is the first
 # folder of its path. (A header in the same folder as its includer is found without -I,
 # which is the same rule: a layer always sees itself.)
+# The analysis is layered again by its second folder (docs/analysis.md, "Source files"):
+# measure/ sees only itself, input/ and export/ see measure/, draw/ sees only itself, and
+# cli/ sees them all (each also sees common/).
 INC_common   := -Icommon
 INC_solver   := -Icommon -Isolver
 INC_analysis := -Icommon -Ianalysis
-INC_tests    := -Icommon -Isolver -Ianalysis
-layer_inc = $(INC_$(firstword $(subst /, ,$(1))))
+INC_analysis_measure := $(INC_analysis) -Ianalysis/measure
+INC_analysis_input   := $(INC_analysis_measure) -Ianalysis/input
+INC_analysis_export  := $(INC_analysis_measure) -Ianalysis/export
+INC_analysis_draw    := $(INC_analysis) -Ianalysis/draw
+INC_analysis_cli     := $(INC_analysis) -Ianalysis/measure -Ianalysis/input -Ianalysis/export \
+                        -Ianalysis/draw -Ianalysis/cli
+INC_tests    := -Icommon -Isolver $(filter-out -Icommon,$(INC_analysis_cli))
+path_words = $(subst /, ,$(1))
+layer_inc = $(or $(INC_$(word 1,$(call path_words,$(1)))_$(word 2,$(call path_words,$(1)))),$(INC_$(word 1,$(call path_words,$(1)))))
 compile_flags = $(CDEM_CFLAGS) $(1) $(PKG_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 
 COMMON_SRC   := $(wildcard common/*.c common/h5/*.c)
 SOLVER_SRC   := $(filter-out solver/main.c,$(wildcard solver/*.c))
-ANALYSIS_SRC := $(filter-out analysis/main.c,$(wildcard analysis/*.c))
+ANALYSIS_SRC := $(filter-out analysis/cli/main.c,$(wildcard analysis/*.c analysis/*/*.c))
 TEST_SRC     := $(wildcard tests/test_*.c)
 
 COMMON_OBJ   := $(COMMON_SRC:%.c=$(BUILD)/%.o)
@@ -65,7 +76,7 @@ LIBANALYSIS := $(BUILD)/libcdemanalysis.a
 LIBS        := $(LIBANALYSIS) $(LIBSOLVER) $(LIBCOMMON)
 
 .PHONY: all test asan validate bench deps demo clean format tests-build fuzz fuzz-build fuzz-bins
-PROGRAMS := $(if $(wildcard solver/main.c),$(BUILD)/cdem-run) $(if $(wildcard analysis/main.c),$(BUILD)/cdem-strain)
+PROGRAMS := $(if $(wildcard solver/main.c),$(BUILD)/cdem-run) $(if $(wildcard analysis/cli/main.c),$(BUILD)/cdem-strain)
 all: $(PROGRAMS)
 
 deps:
@@ -88,7 +99,7 @@ $(LIBANALYSIS): $(ANALYSIS_OBJ)
 # cdem-strain links no solver code: the analysis reads runs through common/'s file format
 $(BUILD)/cdem-run: $(BUILD)/solver/main.o $(LIBSOLVER) $(LIBCOMMON)
 	$(CC) $(call compile_flags,) $(LDFLAGS) -o $@ $^ $(LDLIBS)
-$(BUILD)/cdem-strain: $(BUILD)/analysis/main.o $(LIBANALYSIS) $(LIBCOMMON)
+$(BUILD)/cdem-strain: $(BUILD)/analysis/cli/main.o $(LIBANALYSIS) $(LIBCOMMON)
 	$(CC) $(call compile_flags,) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/tests/%: tests/%.c $(LIBS)
@@ -133,7 +144,7 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
 	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
 
 format:
-	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*.[ch] tests/*.[ch] 2>/dev/null || true
+	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*/*.[ch] tests/*.[ch] 2>/dev/null || true
 
 clean:
 	rm -rf build build-asan build-fuzz

@@ -115,3 +115,19 @@ cdem_status cdem_outfile_end(cdem_outfile *o, cdem_status st, cdem_error *err) {
     o->active = 0;
     return CDEM_OK;
 }
+
+cdem_status cdem_outfile_open_text(cdem_outfile *o, const char *path, FILE **f, cdem_error *err) {
+    *f = NULL;
+    CDEM_TRY(cdem_outfile_begin(o, path, err));
+    if (!(*f = fopen(o->tmp, "w")))
+        return cdem_outfile_end(
+            o, CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s", o->tmp, strerror(errno)), err);
+    return CDEM_OK;
+}
+
+cdem_status cdem_outfile_close_text(cdem_outfile *o, FILE *f, cdem_status st, cdem_error *err) {
+    const int bad = ferror(f);
+    if ((fclose(f) != 0 || bad) && st == CDEM_OK)
+        st = CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", o->tmp);
+    return cdem_outfile_end(o, st, err);
+}

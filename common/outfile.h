@@ -11,6 +11,8 @@
 
 #include "cdem_error.h"
 
+#include <stdio.h>
+
 #define CDEM_OUTFILE_PATH_MAX 4096
 
 typedef struct {
@@ -33,6 +35,14 @@ cdem_status cdem_outfile_end(cdem_outfile *o, cdem_status st, cdem_error *err);
  * of files (SSPX export, picture albums). An existing folder is fine; an existing file of
  * that name, or a parent that cannot be created, fails with CDEM_ERR_IO naming it. */
 cdem_status cdem_outfile_make_dirs(const char *dir, cdem_error *err);
+
+/* A text output through o: cdem_outfile_begin, then o->tmp opened for writing into *f.
+ * On failure (the message names o->tmp) nothing is left behind and *f is NULL. */
+cdem_status cdem_outfile_open_text(cdem_outfile *o, const char *path, FILE **f, cdem_error *err);
+
+/* Closes f (from cdem_outfile_open_text) and ends the write as cdem_outfile_end does; a
+ * write error (ferror or fclose) turns CDEM_OK into CDEM_ERR_IO naming o->tmp. */
+cdem_status cdem_outfile_close_text(cdem_outfile *o, FILE *f, cdem_status st, cdem_error *err);
 
 /* Removes o->tmp if the write is still active; o may be NULL. */
 void cdem_outfile_discard(cdem_outfile *o);

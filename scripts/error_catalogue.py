@@ -12,8 +12,18 @@ import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 
+
+
+def sources(pattern):
+    """The source files matching pattern (relative to the repository root), sorted."""
+    return sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, pattern)))
+
+
 # The run file's implementation, one file per concept (common/h5/h5_internal.h)
-H5_SOURCES = sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "common/h5/*.c")))
+H5_SOURCES = sources("common/h5/*.c")
+# The subcommands that draw (their messages are in the pictures group)
+PICTURE_COMMANDS = ["analysis/cli/cmd_render.c", "analysis/cli/cmd_plot.c",
+                    "analysis/cli/cmd_plot_series.c", "analysis/cli/cmd_plot_csv.c"]
 
 GROUPS = [  # (title, source files, what to do)
     ("Parameter files and -s overrides", ["common/params.c", "common/model.c", "common/summary.c"],
@@ -46,19 +56,19 @@ GROUPS = [  # (title, source files, what to do)
      "process\" names the run writing the file: wait for it, stop it or write elsewhere. An "
      "existing output is replaced only with `--force`, and a file that is not a cdem run file "
      "never."),
-    ("cdem2D import", ["analysis/cdem2d.c"],
+    ("cdem2D import", ["analysis/input/cdem2d.c"],
      "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
      "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "
      "(modelforces_N.txt); docs/formats-text.md."),
-    ("Analysis (compute, element, limits, strain, stress, axes)", ["analysis/cmd_basic.c",
-      "analysis/analysis.c", "analysis/strain.c",
-      "analysis/axes.c", "analysis/colorlimits.c", "analysis/quantity.c", "common/grid.c",
-      "analysis/biaxial.c", "analysis/repose.c", "analysis/mohr.c", "analysis/qexport.c", "analysis/sspx.c"],
+    ("Analysis (compute, element, limits, strain, stress, axes)", [
+      *(f for f in sources("analysis/cli/cmd_*.c") if f not in PICTURE_COMMANDS),
+      *sources("analysis/measure/*.c"),
+      *sources("analysis/export/*.c"), "common/grid.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
      "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "
      "runs at two or more different confining pressures; repose needs a repose run."),
-    ("Pictures, plots and GIFs", ["analysis/render.c", "analysis/cmd_render.c", "analysis/plot.c",
-      "analysis/cmd_plot.c", "analysis/gif.c", "analysis/colormap.c"],
+    ("Pictures, plots and GIFs", [
+      *sources("analysis/draw/*.c"), *PICTURE_COMMANDS],
      "Check the output name's extension (.png, .pdf, .svg; .gif for --gif), that the output "
      "directory exists and is writable, the option values (sizes, colours #RRGGBB, zoom "
      "window, ranges MIN,MAX) and, for plot-series, the column names (`h5ls RUN.h5/series`)."),
@@ -129,7 +139,9 @@ def show(fmt):
 
 def main():
     files = sorted(glob.glob(os.path.join(ROOT, d, "*.c"))
-                   for d in ("common", "common/h5", "solver", "analysis"))
+                   for d in ("common", "common/h5", "solver", "analysis", "analysis/cli",
+                             "analysis/input", "analysis/measure", "analysis/draw",
+                             "analysis/export"))
     files = [f for group in files for f in group]
     rows = {}
     for path in files:

@@ -70,4 +70,24 @@ __attribute__((unused)) static int scratch_teardown(void **state) {
     return rc;
 }
 
+/* The whole file at path (malloc'd, NUL-terminated; the caller frees it), or NULL when it
+ * cannot be read. For the tests that read sources and pages. */
+__attribute__((unused)) static char *scratch_read_file(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+    }
+    if (buf)
+        buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
 #endif

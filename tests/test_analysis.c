@@ -379,10 +379,64 @@ static void test_analysis_vectors_and_axes(void **state) {
     cdem_axes_free(&ax);
 }
 
+/* The quantities not checked above, on the same simple shear: with F = [1 g; 0 1] the
+ * principal stretches are S1 = sqrt(1 + g^2/4) + g/2 and S3 = sqrt(1 + g^2/4) - g/2
+ * (S1 S3 = det F = 1: no dilation), S1 at 0.5 atan2(2 g, g^2) from +x. */
+static void test_analysis_remaining_quantities(void **state) {
+    fixture *f = *state;
+    static const struct {
+        const char *name;
+        size_t k;     /* increment */
+        int kind;     /* 0: S1 - 1, 1: 1 - S3, 2: zero, 3: S1 direction, 4: |u| = |ux| */
+        double gamma; /* the shear of the pair (for cum-: of each of its k - EQUIL pairs) */
+        double times; /* how many pairs add up (1 but for cum-) */
+    } cases[] = {
+        {"incr-e1", 10, 0, 5 * DGAMMA, 1},        {"incr-e3", 10, 1, 5 * DGAMMA, 1},
+        {"incr-disp-y", 10, 2, 5 * DGAMMA, 1},    {"total-e3", 11, 1, 8 * DGAMMA, 1},
+        {"total-dilation", 11, 2, 8 * DGAMMA, 1}, {"total-s1-direction", 11, 3, 8 * DGAMMA, 1},
+        {"cum-e3", 11, 1, DGAMMA, 11 - EQUIL},    {"total-disp-mag", 11, 4, 8 * DGAMMA, 1},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        cdem_error err;
+        const cdem_state *s;
+        double *v, *ux = NULL;
+        const double g = cases[c].gamma, r = sqrt(1.0 + g * g / 4.0);
+        double want = 0.0;
+        if (cases[c].kind == 0)
+            want = cases[c].times * (r + g / 2 - 1.0);
+        else if (cases[c].kind == 1)
+            want = cases[c].times * (1.0 - (r - g / 2));
+        else if (cases[c].kind == 3)
+            want = 0.5 * atan2(2 * g, g * g) * 180 / M_PI;
+        if (cases[c].kind == 4) {
+            assert_int_equal(
+                cdem_analysis_values(f->a, cases[c].k, Q("total-disp-x"), &s, &ux, &err), CDEM_OK);
+        }
+        assert_int_equal(cdem_analysis_values(f->a, cases[c].k, Q(cases[c].name), &s, &v, &err),
+                         CDEM_OK);
+        size_t checked = 0;
+        for (size_t i = 0; i < s->n; i++) {
+            if ((s->flags[i] & CDEM_FLAGS_BOUNDARY) || (s->flags[i] & CDEM_FLAG_GROWTH) ||
+                s->id[i] == LONE)
+                continue;
+            if (cases[c].kind == 4)
+                want = fabs(ux[i]);
+            if (fabs(v[i] - want) > 1e-8)
+                fail_msg("%s of element %d: %.17g, want %.17g", cases[c].name, (int)s->id[i], v[i],
+                         want);
+            checked++;
+        }
+        assert_true(checked > 150);
+        free(v);
+        free(ux);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_analysis_total_and_incremental_rules, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_cumulative_sums_pairs, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_analysis_remaining_quantities, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_cumulative_reuses_pairs, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_limits_per_quantity, setup, teardown),
         cmocka_unit_test_setup_teardown(test_analysis_stress_and_errors, setup, teardown),

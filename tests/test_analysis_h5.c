@@ -11,6 +11,7 @@
 #include "analysis.h"
 #include "analysis_fixtures.h"
 #include "cdem2d.h"
+#include "run_file.h"
 #include "cmd_render.h"
 #include "scratch.h"
 

@@ -1,7 +1,8 @@
 /* The Makefile's promises (issue 20, item 8), checked on `make -n -B` (the commands make
  * would run; nothing is compiled): a user's CFLAGS are appended to the project's flags,
  * never replace them; each layer compiles with the include paths of the layers it may use
- * (common: itself; solver and analysis: common and themselves); cdem-strain links no
+ * (common: itself; solver and analysis: common and themselves; inside the analysis,
+ * measure/ < input/, export/ < cli/ and draw/ < cli/); cdem-strain links no
  * solver code. Runs make from the repository root into a scratch BUILD. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -78,22 +79,43 @@ static void test_build_layer_include_paths(void **state) {
     (void)state;
     static const struct {
         const char *object, *source;
-        const char *allowed[2], *forbidden[2];
+        const char *allowed[3], *forbidden[4];
     } layers[] = {
-        {"common/state.o", "common/state.c", {"-Icommon", NULL}, {"-Isolver", "-Ianalysis"}},
-        {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis", NULL}},
-        {"analysis/render.o", "analysis/render.c", {"-Icommon", "-Ianalysis"}, {"-Isolver", NULL}},
+        {"common/state.o", "common/state.c", {"-Icommon"}, {"-Isolver", "-Ianalysis"}},
+        {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis"}},
+        /* the analysis's own layers (Makefile): measure/ sees none of the others, draw/
+         * only itself, input/ and export/ the measures, cli/ everything of the analysis */
+        {"analysis/measure/strain.o",
+         "analysis/measure/strain.c",
+         {"-Icommon", "-Ianalysis", "-Ianalysis/measure"},
+         {"-Isolver", "-Ianalysis/input", "-Ianalysis/draw", "-Ianalysis/cli"}},
+        {"analysis/draw/render.o",
+         "analysis/draw/render.c",
+         {"-Icommon", "-Ianalysis", "-Ianalysis/draw"},
+         {"-Isolver", "-Ianalysis/measure", "-Ianalysis/input", "-Ianalysis/cli"}},
+        {"analysis/export/sspx.o",
+         "analysis/export/sspx.c",
+         {"-Icommon", "-Ianalysis/measure", "-Ianalysis/export"},
+         {"-Isolver", "-Ianalysis/input", "-Ianalysis/draw", "-Ianalysis/cli"}},
+        {"analysis/input/cdem2d.o",
+         "analysis/input/cdem2d.c",
+         {"-Icommon", "-Ianalysis/measure", "-Ianalysis/input"},
+         {"-Isolver", "-Ianalysis/export", "-Ianalysis/draw", "-Ianalysis/cli"}},
+        {"analysis/cli/main.o",
+         "analysis/cli/main.c",
+         {"-Ianalysis/measure", "-Ianalysis/draw"},
+         {"-Isolver"}},
     };
     char line[4096];
     for (size_t i = 0; i < sizeof layers / sizeof layers[0]; i++) {
         command_for(layers[i].object, "", layers[i].source, line, sizeof line);
-        for (size_t k = 0; k < 2; k++) {
+        for (size_t k = 0; k < 3; k++)
             if (layers[i].allowed[k] && !has_word(line, layers[i].allowed[k]))
                 fail_msg("%s compiles without %s: %s", layers[i].source, layers[i].allowed[k],
                          line);
+        for (size_t k = 0; k < 4; k++)
             if (layers[i].forbidden[k] && has_word(line, layers[i].forbidden[k]))
                 fail_msg("%s compiles with %s: %s", layers[i].source, layers[i].forbidden[k], line);
-        }
     }
 }
 

@@ -15,7 +15,6 @@
 
 #include "analysis.h"
 #include "assert_near.h"
-#include "cmd_wedge.h"
 #include "csvtable.h"
 #include "h5format.h"
 #include "params.h"

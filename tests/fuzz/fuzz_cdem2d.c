@@ -1,4 +1,4 @@
-/* fuzz_cdem2d: the cdem2D folder importer (analysis/cdem2d.c). The input is split into the
+/* fuzz_cdem2d: the cdem2D folder importer (analysis/input/cdem2d.c). The input is split into the
  * files of a temporary folder: each line "== NAME" starts a file NAME (characters outside
  * [A-Za-z0-9_.-] dropped, at most 80, "." and ".." ignored), whose content runs to the next
  * such line; an input with no "== " line is the single file modelresults_0.txt. So the

@@ -38,9 +38,6 @@ typedef struct {
     cdem_h5_reader *(*reader)(void *ctx); /* the file reader, or NULL (may be NULL) */
 } cdem_analysis_source;
 
-/* Opens a cdem file (analysis_h5.c). */
-cdem_status cdem_analysis_open(const char *path, cdem_analysis **out, cdem_error *err);
-
 /* Builds a context over any source; params (copied) gives total_strain_max. */
 cdem_status cdem_analysis_open_source(const cdem_analysis_source *src, void *ctx,
                                       const cdem_params *params, cdem_analysis **out,
@@ -55,7 +52,8 @@ cdem_status cdem_analysis_open_states(const cdem_state *states, const cdem_incre
 void cdem_analysis_close(cdem_analysis *a);
 
 /* Names the run in messages that concern the whole run ("RUN.h5: increment 3 does not
- * exist"); cdem_analysis_open sets the file's path. name is copied; NULL clears it. */
+ * exist"); cdem_analysis_open (input/run_file.h) sets the file's path. name is copied; NULL clears
+ * it. */
 void cdem_analysis_set_name(cdem_analysis *a, const char *name);
 
 size_t cdem_analysis_count(const cdem_analysis *a);

@@ -11,18 +11,12 @@
 
 cdem_status cdem_sspx_write(const char *path, const cdem_state *s, cdem_error *err) {
     cdem_outfile of; /* written to path.tmp, renamed on success */
-    CDEM_TRY(cdem_outfile_begin(&of, path, err));
-    FILE *f = fopen(of.tmp, "w");
-    if (!f)
-        return cdem_outfile_end(
-            &of, CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: %s", of.tmp, strerror(errno)), err);
+    FILE *f;
+    CDEM_TRY(cdem_outfile_open_text(&of, path, &f, err));
     for (size_t i = 0; i < s->n; i++)
         fprintf(f, "%d %.6f %.6f %.6f %d\n", (int)s->id[i], s->x[i], s->y[i], s->radius[i],
                 (int)s->layer[i]);
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad)
-        return cdem_outfile_end(&of, CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", of.tmp), err);
-    return cdem_outfile_end(&of, CDEM_OK, err);
+    return cdem_outfile_close_text(&of, f, CDEM_OK, err);
 }
 
 cdem_status cdem_sspx_read(const char *path, cdem_state *s, cdem_error *err) {

@@ -3,7 +3,11 @@
  * and last increments' boxes) so pictures and animation frames line up. */
 #include "cmd_render.h"
 
+#include "cmd_support.h"
+#include "commands.h"
+
 #include "analysis.h"
+#include "run_file.h"
 #include "gif.h"
 #include "outfile.h"
 #include "render.h"
@@ -37,15 +41,6 @@ typedef struct {
     cdem_render_options ro; /* drawing options */
     cdem_gif_options go;    /* GIF options */
 } render_args;
-
-/* Prints err, naming the run file (path, may be NULL) when the message does not. */
-static int fail(const char *path, const cdem_error *err) {
-    if (path && err->msg[0] && !strstr(err->msg, path))
-        fprintf(stderr, "cdem-strain render: %s: %s\n", path, err->msg);
-    else
-        fprintf(stderr, "cdem-strain render: %s\n", err->msg);
-    return 1;
-}
 
 /* The help of render (cli_help.h): --help, the usage errors, the man page and the bash
  * completion come from it; tests/test_help.c checks that parse_args accepts every option. */
@@ -98,7 +93,7 @@ static const cdem_cli_option render_options[] = {
     {"--interval", "SECONDS", "with --follow: seconds between checks (default 2)"},
     {NULL, NULL, NULL}};
 
-const cdem_cli_help cdem_cmd_render_help = {
+static const cdem_cli_help help = {
     .program = "cdem-strain render",
     .forms = render_forms,
     .about = "Pictures of increments (PNG, PDF, SVG), albums and animated GIFs. Every picture "
@@ -108,28 +103,7 @@ const cdem_cli_help cdem_cmd_render_help = {
 };
 
 static int usage(const char *what) {
-    cdem_cli_usage_print(stderr, &cdem_cmd_render_help, what);
-    return 2;
-}
-
-static int parse_double(const char *text, double *out) {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (errno || end == text || *end || !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
-}
-
-static int parse_int(const char *text, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(text, &end, 10);
-    if (errno || end == text || *end || v < -2147483647L || v > 2147483647L)
-        return 0;
-    *out = (int)v;
-    return 1;
+    return cdem_cmd_usage(&help, what);
 }
 
 static int parse_args(int argc, char **argv, render_args *a) {
@@ -144,50 +118,40 @@ static int parse_args(int argc, char **argv, render_args *a) {
     cdem_error err;
     cdem_error_clear(&err);
     for (int i = 1; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEED_VALUE()                                                                               \
-    do {                                                                                           \
-        if (!next) {                                                                               \
-            char m_[128];                                                                          \
-            snprintf(m_, sizeof m_, "%s needs a value", arg);                                      \
-            return usage(m_);                                                                      \
-        }                                                                                          \
-        i++;                                                                                       \
-    } while (0)
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            cdem_cli_help_print(stdout, &cdem_cmd_render_help);
-            return 3; /* help shown: exit 0 after the caller sees 3 */
-        } else if (!strcmp(arg, "--increment") || !strcmp(arg, "--increments")) {
-            NEED_VALUE();
+        const cdem_cli_option *o;
+        const char *next;
+        const cdem_cmd_arg kind = cdem_cmd_next_arg(&help, argc, argv, &i, &o, &next);
+        if (kind == CDEM_CMD_ARG_USAGE)
+            return CDEM_EXIT_USAGE;
+        if (kind == CDEM_CMD_ARG_POSITIONAL) {
+            if (a->path) {
+                char m[160];
+                snprintf(m, sizeof m, "unexpected argument '%s'", argv[i]);
+                return usage(m);
+            }
+            a->path = argv[i];
+        } else if (cdem_cli_option_is(o, "--increment")) {
             a->increment = next;
-        } else if (!strcmp(arg, "--color") || !strcmp(arg, "--colour")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--color")) {
             a->quantity = next;
-        } else if (!strcmp(arg, "-o") || !strcmp(arg, "--output")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "-o")) {
             a->output = next;
-        } else if (!strcmp(arg, "--gif")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--gif")) {
             a->gif = next;
-        } else if (!strcmp(arg, "--prefix")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--prefix")) {
             a->prefix = next;
-        } else if (!strcmp(arg, "--format")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--format")) {
             if (strcmp(next, "png") && strcmp(next, "pdf") && strcmp(next, "svg"))
                 return usage("--format must be png, pdf or svg");
             a->format = next;
-        } else if (!strcmp(arg, "--vectors")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--vectors")) {
             if (!strcmp(next, "incr"))
                 a->vectors = 1;
             else if (!strcmp(next, "total"))
                 a->vectors = 2;
             else
                 return usage("--vectors must be incr or total");
-        } else if (!strcmp(arg, "--axes")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--axes")) {
             if (!strcmp(next, "incr-strain"))
                 a->axes = CDEM_AXES_INCR_STRAIN;
             else if (!strcmp(next, "total-strain"))
@@ -196,37 +160,32 @@ static int parse_args(int argc, char **argv, render_args *a) {
                 a->axes = CDEM_AXES_STRESS;
             else
                 return usage("--axes must be incr-strain, total-strain or stress");
-        } else if (!strcmp(arg, "--shear-axes")) {
+        } else if (cdem_cli_option_is(o, "--shear-axes")) {
             a->axes_shear = 1;
-        } else if (!strcmp(arg, "--above-tenth-max")) {
+        } else if (cdem_cli_option_is(o, "--above-tenth-max")) {
             a->above_tenth = 1;
-        } else if (!strcmp(arg, "--no-fill")) {
+        } else if (cdem_cli_option_is(o, "--no-fill")) {
             a->ro.show_fill = 0;
-        } else if (!strcmp(arg, "--no-colours") || !strcmp(arg, "--no-colors")) {
+        } else if (cdem_cli_option_is(o, "--no-colours")) {
             a->ro.show_colours = 0;
-        } else if (!strcmp(arg, "--no-scale-bar")) {
+        } else if (cdem_cli_option_is(o, "--no-scale-bar")) {
             a->ro.show_scale_bar = 0;
-        } else if (!strcmp(arg, "--no-colour-bar") || !strcmp(arg, "--no-color-bar")) {
+        } else if (cdem_cli_option_is(o, "--no-colour-bar")) {
             a->ro.show_colour_bar = 0;
-        } else if (!strcmp(arg, "--no-label")) {
+        } else if (cdem_cli_option_is(o, "--no-label")) {
             a->ro.show_label = 0;
-        } else if (!strcmp(arg, "--width")) {
-            NEED_VALUE();
-            if (!parse_int(next, &a->ro.width) || a->ro.width < 16 ||
-                a->ro.width > CDEM_RENDER_MAX_SIZE)
+        } else if (cdem_cli_option_is(o, "--width")) {
+            if (!cdem_cmd_parse_int(next, 16, CDEM_RENDER_MAX_SIZE, &a->ro.width))
                 return usage("--width must be a whole number from 16 to 20000");
-        } else if (!strcmp(arg, "--height")) {
-            NEED_VALUE();
-            if (!parse_int(next, &a->ro.height) || a->ro.height < 16 ||
-                a->ro.height > CDEM_RENDER_MAX_SIZE)
+        } else if (cdem_cli_option_is(o, "--height")) {
+            if (!cdem_cmd_parse_int(next, 16, CDEM_RENDER_MAX_SIZE, &a->ro.height))
                 return usage("--height must be a whole number from 16 to 20000");
-        } else if (!strcmp(arg, "--zoom")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--zoom")) {
             char buf[256];
             snprintf(buf, sizeof buf, "%s", next);
             char *save = NULL, *tok = strtok_r(buf, ",", &save);
             int k = 0;
-            while (tok && k < 4 && parse_double(tok, &a->zoom[k])) {
+            while (tok && k < 4 && cdem_cmd_parse_number(tok, &a->zoom[k])) {
                 k++;
                 tok = strtok_r(NULL, ",", &save);
             }
@@ -234,17 +193,14 @@ static int parse_args(int argc, char **argv, render_args *a) {
                 return usage("--zoom must be XMIN,XMAX,YMIN,YMAX in metres with XMIN < XMAX "
                              "and YMIN < YMAX");
             a->zoom_given = 1;
-        } else if (!strcmp(arg, "--highlight")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--highlight")) {
             if (sscanf(next, "%d-%d", &a->ro.highlight_first, &a->ro.highlight_last) != 2 ||
                 a->ro.highlight_first < 1 || a->ro.highlight_last < a->ro.highlight_first)
                 return usage("--highlight must be FIRST-LAST layers, e.g. 5-8");
-        } else if (!strcmp(arg, "--color-walls") || !strcmp(arg, "--colour-walls")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--color-walls")) {
             if (cdem_render_parse_colour(next, &a->ro.wall, &err) != CDEM_OK)
                 return usage(err.msg);
-        } else if (!strcmp(arg, "--color-layers") || !strcmp(arg, "--colour-layers")) {
-            NEED_VALUE();
+        } else if (cdem_cli_option_is(o, "--color-layers")) {
             char buf[64];
             snprintf(buf, sizeof buf, "%s", next);
             char *comma = strchr(buf, ',');
@@ -254,36 +210,23 @@ static int parse_args(int argc, char **argv, render_args *a) {
             if (cdem_render_parse_colour(buf, &a->ro.pregrowth[0], &err) != CDEM_OK ||
                 cdem_render_parse_colour(comma + 1, &a->ro.pregrowth[1], &err) != CDEM_OK)
                 return usage(err.msg);
-        } else if (!strcmp(arg, "--backward")) {
+        } else if (cdem_cli_option_is(o, "--backward")) {
             a->go.order = CDEM_GIF_BACKWARD;
-        } else if (!strcmp(arg, "--odd")) {
+        } else if (cdem_cli_option_is(o, "--odd")) {
             a->go.selection = CDEM_GIF_ODD;
-        } else if (!strcmp(arg, "--gif-scale")) {
-            NEED_VALUE();
-            if (!parse_double(next, &a->go.scale) || a->go.scale < 0.05 || a->go.scale > 1)
+        } else if (cdem_cli_option_is(o, "--gif-scale")) {
+            if (!cdem_cmd_parse_number(next, &a->go.scale) || a->go.scale < 0.05 || a->go.scale > 1)
                 return usage("--gif-scale must be between 0.05 and 1");
-        } else if (!strcmp(arg, "--delay")) {
-            NEED_VALUE();
-            if (!parse_int(next, &a->go.delay_cs) || a->go.delay_cs < 1 || a->go.delay_cs > 65535)
+        } else if (cdem_cli_option_is(o, "--delay")) {
+            if (!cdem_cmd_parse_int(next, 1, 65535, &a->go.delay_cs))
                 return usage("--delay must be 1 to 65535 hundredths of a second");
-        } else if (!strcmp(arg, "--follow")) {
+        } else if (cdem_cli_option_is(o, "--follow")) {
             a->follow = 1;
-        } else if (!strcmp(arg, "--interval")) {
-            NEED_VALUE();
-            if (!parse_double(next, &a->interval) || !(a->interval > 0.0) || a->interval > 86400.0)
+        } else if (cdem_cli_option_is(o, "--interval")) {
+            if (!cdem_cmd_parse_number(next, &a->interval) || !(a->interval > 0.0) ||
+                a->interval > 86400.0)
                 return usage("--interval: expected seconds > 0 (at most 86400)");
-        } else if (arg[0] == '-' && arg[1]) {
-            char m[160];
-            snprintf(m, sizeof m, "unknown option '%s'", arg);
-            return usage(m);
-        } else if (!a->path) {
-            a->path = arg;
-        } else {
-            char m[160];
-            snprintf(m, sizeof m, "unexpected argument '%s'", arg);
-            return usage(m);
         }
-#undef NEED_VALUE
     }
     if (!a->path)
         return usage("no run file given");
@@ -442,16 +385,16 @@ static int run_render(const render_args *a) {
     cdem_analysis *an = NULL;
     const cdem_quantity *q = NULL;
     if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
-        return fail(NULL, &err);
+        return cdem_cmd_fail("render", NULL, &err);
     if (cdem_analysis_open(a->path, &an, &err) != CDEM_OK)
-        return fail(a->path, &err);
+        return cdem_cmd_fail("render", a->path, &err);
     int rc = 0;
     size_t n = cdem_analysis_count(an);
     cdem_render_options o = a->ro;
     o.growth1_layers = cdem_analysis_params(an)->growth_sequence1_layers;
     if (n == 0) {
         CDEM_FAIL(&err, CDEM_ERR_NOTFOUND, "%s: the file has no increments", a->path);
-        rc = fail(a->path, &err);
+        rc = cdem_cmd_fail("render", a->path, &err);
         goto done;
     }
     int series = a->gif || !strcmp(a->increment, "all");
@@ -460,7 +403,7 @@ static int run_render(const render_args *a) {
     } else if (series) {
         double box[4];
         if (series_box(an, o.margin, box, &err) != CDEM_OK) {
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
             goto done;
         }
         set_zoom(&o, box);
@@ -472,13 +415,13 @@ static int run_render(const render_args *a) {
         if (build_scene(an, 0, a, q, &d, &err) != CDEM_OK ||
             (!height && cdem_render_auto_height(&d.sc, &o, &height, &err) != CDEM_OK)) {
             scene_free(&d);
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
             goto done;
         }
         scene_free(&d);
         gif_ctx g = {an, a, q, &o};
         if (cdem_gif_write(a->gif, n, o.width, height, gif_frame, &g, &a->go, &err) != CDEM_OK) {
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
             goto done;
         }
         printf("%s: %zu increments\n", a->gif, cdem_gif_frame_order(n, &a->go, NULL));
@@ -487,7 +430,7 @@ static int run_render(const render_args *a) {
         goto done;
     if (!strcmp(a->increment, "all")) {
         if (cdem_outfile_make_dirs(a->output, &err) != CDEM_OK) {
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
             goto done;
         }
         /* numbers zero-padded to the width of the largest, so the files sort in increment
@@ -498,7 +441,7 @@ static int run_render(const render_args *a) {
             snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
                      (int)cdem_analysis_info(an, i)->number, a->format);
             if (render_one(an, i, a, q, &o, path, &err) != CDEM_OK) {
-                rc = fail(a->path, &err);
+                rc = cdem_cmd_fail("render", a->path, &err);
                 /* no partial series that looks complete: remove this run's pictures */
                 for (size_t j = 0; j < i; j++) {
                     snprintf(path, sizeof path, "%s/%s%0*d.%s", a->output, a->prefix, width,
@@ -513,7 +456,7 @@ static int run_render(const render_args *a) {
         size_t index;
         if (cdem_analysis_find(an, a->increment, &index, &err) != CDEM_OK ||
             render_one(an, index, a, q, &o, a->output, &err) != CDEM_OK)
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
         else
             printf("%s\n", a->output);
     }
@@ -576,7 +519,7 @@ static int run_follow(const render_args *a) {
     cdem_error_clear(&err);
     const cdem_quantity *q = NULL;
     if (a->quantity && cdem_quantity_find(a->quantity, &q, &err) != CDEM_OK)
-        return fail(NULL, &err);
+        return cdem_cmd_fail("render", NULL, &err);
     sigset_t set;
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
@@ -588,7 +531,7 @@ static int run_follow(const render_args *a) {
     for (double waited = 0.0; cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK;
          waited += a->interval) {
         if (err.code != CDEM_ERR_NOTFOUND || waited >= 60.0)
-            return fail(a->path, &err);
+            return cdem_cmd_fail("render", a->path, &err);
         if (wait_for_stop(&set, a->interval))
             return 0;
     }
@@ -602,7 +545,7 @@ static int run_follow(const render_args *a) {
             last.number != shown) {
             int32_t number = -1;
             if (follow_render(a, q, &number, &err) != CDEM_OK) {
-                rc = fail(a->path, &err);
+                rc = cdem_cmd_fail("render", a->path, &err);
                 break;
             }
             if (number >= 0 && number != shown) {
@@ -638,7 +581,7 @@ static int run_follow(const render_args *a) {
         cdem_h5_reader_close(r);
         r = NULL;
         if (cdem_h5_reader_open(a->path, &r, &err) != CDEM_OK) {
-            rc = fail(a->path, &err);
+            rc = cdem_cmd_fail("render", a->path, &err);
             break;
         }
     }
@@ -646,12 +589,13 @@ static int run_follow(const render_args *a) {
     return rc;
 }
 
-int cdem_cmd_render(int argc, char **argv) {
+static int run(int argc, char **argv) {
     render_args a;
     int rc = parse_args(argc, argv, &a);
-    if (rc == 3)
-        return 0;
     if (rc != 0)
         return rc;
     return a.follow ? run_follow(&a) : run_render(&a);
 }
+
+const cdem_command cdem_command_render = {
+    "render", "pictures of increments (PNG, PDF, SVG), albums and animated GIFs", &help, run};

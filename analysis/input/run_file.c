@@ -1,6 +1,5 @@
-/* analysis_h5: the file-backed source of the analysis context (analysis.h), kept apart from
- * analysis.c so that code using in-memory states does not link the HDF5 reader. */
-#include "analysis.h"
+/* run_file: see run_file.h. */
+#include "run_file.h"
 
 #include <stdlib.h>
 

@@ -105,6 +105,16 @@ static void clearance(const uint8_t *g, long nx, long ny, float *d, uint8_t *nea
         }
 }
 
+/* The k-th (0..3: left, right, below, above) 4-neighbour of cell c of an nx x ny raster:
+ * 1 with its index in *cb, or 0 when it lies outside the raster. */
+static int neighbour4(long c, int k, long nx, long ny, long *cb) {
+    const long i = c % nx + (k == 1) - (k == 0), j = c / nx + (k == 3) - (k == 2);
+    if (i < 0 || i >= nx || j < 0 || j >= ny)
+        return 0;
+    *cb = j * nx + i;
+    return 1;
+}
+
 /* Marks with bit `mark` every cell a probe of clearance >= `need` (cells) reaches from the
  * top row through cells of clearance >= need. */
 static void reach_from_sky(const float *d, uint8_t *m, uint8_t mark, long nx, long ny, float need,
@@ -119,13 +129,10 @@ static void reach_from_sky(const float *d, uint8_t *m, uint8_t mark, long nx, lo
     }
     while (sp > 0) {
         const long c = stack[--sp];
-        const long i = c % nx, j = c / nx;
-        const long nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
         for (int k = 0; k < 4; k++) {
-            const long a = nb[k][0], b = nb[k][1];
-            if (a < 0 || a >= nx || b < 0 || b >= ny)
+            long cb;
+            if (!neighbour4(c, k, nx, ny, &cb))
                 continue;
-            const long cb = b * nx + a;
             if ((m[cb] & mark) || !(d[cb] >= need))
                 continue;
             m[cb] |= mark;
@@ -147,18 +154,16 @@ static long region(uint8_t *m, const uint8_t *near, uint8_t want_set, uint8_t ma
     stack[sp++] = c0;
     while (sp > 0) {
         const long c = stack[--sp];
-        const long i = c % nx, j = c / nx;
+        const long j = c / nx;
         n++;
         nfree += near[c] == CELL_FREE;
         nbound += near[c] == CELL_BOUNDARY;
         *jlo = j < *jlo ? j : *jlo;
         *jhi = j > *jhi ? j : *jhi;
-        const long nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
         for (int k = 0; k < 4; k++) {
-            const long a = nb[k][0], b = nb[k][1];
-            if (a < 0 || a >= nx || b < 0 || b >= ny)
+            long cb;
+            if (!neighbour4(c, k, nx, ny, &cb))
                 continue;
-            const long cb = b * nx + a;
             if ((m[cb] & mark) || (m[cb] & want_set) != want_set)
                 continue;
             m[cb] |= mark;

@@ -1,16 +1,18 @@
-/* cmd_faults: see cmd_faults.h. */
-#include "cmd_faults.h"
-
+/* cmd_faults: the faults subcommand of cdem-strain:
+ *   faults RUN.h5 [--increment K|last|equil|first] [--quantity NAME] [--threshold V]
+ *                 [--bin M] [--min-rows N] [-o OUT.csv]
+ *       fault zones picked from a strain field (measure/faults.h): one CSV row per zone
+ *       with where it reaches up and down, its dip and dip direction; a summary on stderr. */
 #include "analysis.h"
+#include "cmd_support.h"
+#include "commands.h"
 #include "faults.h"
-#include "outfile.h"
 #include "quantity.h"
+#include "run_file.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
 static const char synopsis[] = "RUN.h5 [--increment K|last|equil|first] [--quantity NAME] "
                                "[--threshold V] [--bin M] [--min-rows N] [-o OUT.csv]";
@@ -23,13 +25,13 @@ static const cdem_cli_option options[] = {
     {"--min-rows", "N", "cells of height a zone must span, >= 2 (default 4)"},
     {"-o, --output", "OUT.csv", "output file (default: standard output)"},
     {NULL, NULL, NULL}};
-const cdem_cli_help cdem_cmd_faults_help = {
+static const cdem_cli_help help = {
     .program = "cdem-strain faults",
     .forms = forms,
     .about = "Fault zones picked from a strain field: the free elements' values are binned on "
              "a square grid, runs of cells at or above the threshold in each row are linked "
              "from the top down into zones, and a line through each zone gives its dip and "
-             "dip direction (analysis/faults.h, docs/analysis.md \"Faults\"). CSV, one row "
+             "dip direction (analysis/measure/faults.h, docs/analysis.md \"Faults\"). CSV, one row "
              "per zone ordered by x at its top: zone, x_top, y_top, x_bottom, y_bottom (m), "
              "dip (degrees), dips (left or right), rows, mean and max value. A summary line "
              "goes to standard error.",
@@ -37,32 +39,6 @@ const cdem_cli_help cdem_cmd_faults_help = {
     .notes = "A thrust verges away from its dip direction: with the right wall pushing, "
              "forward-verging thrusts dip right.",
 };
-
-static int usage(const char *what) {
-    cdem_cli_usage_print(stderr, &cdem_cmd_faults_help, what);
-    return 2;
-}
-
-static int fail(const char *file, const cdem_error *err) {
-    const char *m = err->msg[0] ? err->msg : "unknown error";
-    if (!strncmp(m, "faults: ", 8))
-        m += 8;
-    if (file && !strstr(m, file))
-        fprintf(stderr, "cdem-strain faults: %s: %s\n", file, m);
-    else
-        fprintf(stderr, "cdem-strain faults: %s\n", m);
-    return 1;
-}
-
-static int parse_number(const char *text, double *out) {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (errno || end == text || *end || !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
-}
 
 static cdem_status write_csv(FILE *f, const cdem_faults_result *r, cdem_error *err) {
     fprintf(f, "zone,x_top,y_top,x_bottom,y_bottom,dip,dips,rows,mean,max\n");
@@ -77,38 +53,21 @@ static cdem_status write_csv(FILE *f, const cdem_faults_result *r, cdem_error *e
     return CDEM_OK;
 }
 
-int cdem_cmd_faults(int argc, char **argv) {
+static int run(int argc, char **argv) {
     const char *file = NULL, *out = NULL, *inc = "last", *qname = "total-max-shear";
     cdem_faults_options o;
     cdem_faults_default_options(&o);
     for (int i = 1; i < argc; i++) {
-        if (cdem_cli_wants_help(argc, argv, i, &cdem_cmd_faults_help) == i) {
-            cdem_cli_help_print(stdout, &cdem_cmd_faults_help);
-            return 0;
-        }
-        const char *val = NULL;
-        const cdem_cli_option *opt =
-            argv[i][0] == '-' && argv[i][1]
-                ? cdem_cli_find_option(&cdem_cmd_faults_help, argv[i], &val)
-                : NULL;
-        if (argv[i][0] == '-' && argv[i][1] && !opt) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "unknown option '%.100s'", argv[i]);
-            return usage(msg);
-        }
-        if (!opt) {
+        const cdem_cli_option *opt;
+        const char *val;
+        const cdem_cmd_arg kind = cdem_cmd_next_arg(&help, argc, argv, &i, &opt, &val);
+        if (kind == CDEM_CMD_ARG_USAGE)
+            return CDEM_EXIT_USAGE;
+        if (kind == CDEM_CMD_ARG_POSITIONAL) {
             if (file)
-                return usage("need exactly one run file (RUN.h5)");
+                return cdem_cmd_usage(&help, "need exactly one run file (RUN.h5)");
             file = argv[i];
             continue;
-        }
-        if (!val) {
-            if (i + 1 >= argc) {
-                char msg[160];
-                snprintf(msg, sizeof msg, "%.100s needs a value", argv[i]);
-                return usage(msg);
-            }
-            val = argv[++i];
         }
         double x;
         if (cdem_cli_option_is(opt, "--increment"))
@@ -118,28 +77,28 @@ int cdem_cmd_faults(int argc, char **argv) {
         else if (cdem_cli_option_is(opt, "--output"))
             out = val;
         else if (cdem_cli_option_is(opt, "--threshold")) {
-            if (!parse_number(val, &x) || !(x > 0.0))
-                return usage("--threshold must be a number > 0");
+            if (!cdem_cmd_parse_number(val, &x) || !(x > 0.0))
+                return cdem_cmd_usage(&help, "--threshold must be a number > 0");
             o.threshold = x;
         } else if (cdem_cli_option_is(opt, "--bin")) {
-            if (!parse_number(val, &x) || !(x > 0.0))
-                return usage("--bin must be a length in m > 0");
+            if (!cdem_cmd_parse_number(val, &x) || !(x > 0.0))
+                return cdem_cmd_usage(&help, "--bin must be a length in m > 0");
             o.bin = x;
         } else if (cdem_cli_option_is(opt, "--min-rows")) {
-            if (!parse_number(val, &x) || x < 2 || x > 100000 || x != floor(x))
-                return usage("--min-rows must be a whole number >= 2");
+            if (!cdem_cmd_parse_number(val, &x) || x < 2 || x > 100000 || x != floor(x))
+                return cdem_cmd_usage(&help, "--min-rows must be a whole number >= 2");
             o.min_rows = (int)x;
         }
     }
     if (!file)
-        return usage("missing the run file (RUN.h5)");
+        return cdem_cmd_usage(&help, "missing the run file (RUN.h5)");
     cdem_error err;
     const cdem_quantity *q;
     if (cdem_quantity_find(qname, &q, &err) != CDEM_OK)
-        return fail(NULL, &err);
+        return cdem_cmd_fail("faults", NULL, &err);
     cdem_analysis *a;
     if (cdem_analysis_open(file, &a, &err) != CDEM_OK)
-        return fail(NULL, &err);
+        return cdem_cmd_fail("faults", NULL, &err);
     size_t index = 0;
     const cdem_state *s = NULL;
     double *v = NULL;
@@ -149,20 +108,11 @@ int cdem_cmd_faults(int argc, char **argv) {
         st = cdem_analysis_values(a, index, q, &s, &v, &err);
     if (st == CDEM_OK)
         st = cdem_faults_pick(s, v, &o, &res, &err);
-    if (st == CDEM_OK && !out)
-        st = write_csv(stdout, &res, &err);
-    else if (st == CDEM_OK) {
-        /* written to OUT.tmp, renamed on success (outfile.h) */
-        cdem_outfile of;
-        st = cdem_outfile_begin(&of, out, &err);
-        FILE *f = NULL;
-        if (st == CDEM_OK && !(f = fopen(of.tmp, "w")))
-            st = CDEM_FAIL(&err, CDEM_ERR_IO, "cannot create %s: %s", out, strerror(errno));
+    if (st == CDEM_OK) {
+        cdem_cmd_output output;
+        st = cdem_cmd_output_open(&output, out, &err);
         if (st == CDEM_OK)
-            st = write_csv(f, &res, &err);
-        if (f && fclose(f) != 0 && st == CDEM_OK)
-            st = CDEM_FAIL(&err, CDEM_ERR_IO, "error writing %s", out);
-        st = cdem_outfile_end(&of, st, &err);
+            st = cdem_cmd_output_close(&output, write_csv(output.f, &res, &err), &err);
     }
     if (st == CDEM_OK) {
         size_t left = 0;
@@ -177,5 +127,8 @@ int cdem_cmd_faults(int argc, char **argv) {
     cdem_faults_free(&res);
     free(v);
     cdem_analysis_close(a);
-    return st == CDEM_OK ? 0 : fail(file, &err);
+    return st == CDEM_OK ? 0 : cdem_cmd_fail("faults", file, &err);
 }
+
+const cdem_command cdem_command_faults = {
+    "faults", "fault zones from a strain field: position, dip and dip direction", &help, run};

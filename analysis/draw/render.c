@@ -11,15 +11,14 @@
 #include "render.h"
 
 #include "outfile.h"
+#include "raster.h"
 
 #include <cairo-pdf.h>
 #include <cairo-svg.h>
-#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 enum {
     SLOT_WALL = 0,  /* wall, fault, mylar */
@@ -40,162 +39,6 @@ enum {
 };
 
 static const double render_pi = 3.14159265358979323846;
-
-static cdem_rgba rgb(double r, double g, double b) {
-    cdem_rgba c = {r, g, b, 1.0};
-    return c;
-}
-
-void cdem_render_options_default(cdem_render_options *o) {
-    memset(o, 0, sizeof *o);
-    o->width = 1200;
-    o->height = 0;
-    o->margin = 0.02;
-    o->pregrowth_layers = 24;
-    o->band_layers = 1;
-    o->growth1_layers = 10;
-    o->show_fill = 1;
-    o->show_outline = 1;
-    o->show_colours = 1;
-    o->show_vectors = 1;
-    o->show_axes = 1;
-    o->show_scale_bar = 1;
-    o->show_colour_bar = 1;
-    o->show_label = 1;
-    o->font_size = 0.0;
-    o->outline_width = 0.5;
-    o->line_width = 1.0;
-    o->weak_alpha = 0.45;
-    o->background = rgb(1.0, 1.0, 1.0);
-    o->wall = rgb(0.545, 0.353, 0.169);    /* #8b5a2b brown */
-    o->pregrowth[0] = rgb(1.0, 0.85, 0.0); /* #ffd900 yellow */
-    o->pregrowth[1] = rgb(0.85, 0.1, 0.1); /* #d91a1a red */
-    o->growth1[0] = rgb(1.0, 0.95, 0.6);   /* #fff299 pale yellow */
-    o->growth1[1] = rgb(0.85, 0.0, 0.85);  /* #d900d9 magenta */
-    o->growth2[0] = rgb(0.75, 0.95, 1.0);  /* #bff2ff pale cyan */
-    o->growth2[1] = rgb(0.1, 0.35, 0.85);  /* #1a59d9 blue */
-    o->highlight = rgb(0.2, 0.2, 0.2);     /* #333333 dark grey */
-    o->biaxial_edge = rgb(0.0, 0.7, 0.0);  /* #00b300 green */
-    o->footwall = rgb(0.8, 0.8, 0.8);      /* #cccccc light grey */
-    o->undefined = rgb(0.6, 0.6, 0.6);     /* #999999 neutral grey */
-    o->outline = rgb(0.25, 0.25, 0.25);    /* #404040 */
-    o->outline.a = 0.6;
-    o->vector = rgb(0.0, 0.0, 0.0);  /* black */
-    o->axis[0] = rgb(0.0, 0.0, 0.0); /* black */
-    o->axis[1] = rgb(1.0, 1.0, 1.0); /* white */
-    o->text = rgb(0.0, 0.0, 0.0);    /* black */
-}
-
-static unsigned colour_byte(double v) {
-    if (!(v > 0))
-        return 0;
-    if (v >= 1)
-        return 255;
-    return (unsigned)lround(v * 255.0);
-}
-
-void cdem_render_format_colour(const cdem_rgba *c, char buf[10]) {
-    snprintf(buf, 10, "#%02x%02x%02x%02x", colour_byte(c->r), colour_byte(c->g), colour_byte(c->b),
-             colour_byte(c->a));
-}
-
-void cdem_render_options_view(const cdem_render_options *o, FILE *f) {
-    static const char *const colour_names[] = {
-        "background", "wall",      "pregrowth_0", "pregrowth_1",  "growth1_0", "growth1_1",
-        "growth2_0",  "growth2_1", "highlight",   "biaxial_edge", "footwall",  "undefined",
-        "outline",    "vector",    "axis_0",      "axis_1",       "text"};
-    const cdem_rgba *cols[] = {&o->background, &o->wall,         &o->pregrowth[0], &o->pregrowth[1],
-                               &o->growth1[0], &o->growth1[1],   &o->growth2[0],   &o->growth2[1],
-                               &o->highlight,  &o->biaxial_edge, &o->footwall,     &o->undefined,
-                               &o->outline,    &o->vector,       &o->axis[0],      &o->axis[1],
-                               &o->text};
-    fprintf(f, "render.width = %d\n", o->width);
-    fprintf(f, "render.height = %d%s\n", o->height, o->height == 0 ? " (automatic)" : "");
-    if (o->has_zoom)
-        fprintf(f, "render.zoom = %.9g %.9g %.9g %.9g (m: xmin xmax ymin ymax)\n", o->zoom_xmin,
-                o->zoom_xmax, o->zoom_ymin, o->zoom_ymax);
-    else
-        fprintf(f, "render.zoom = fit all elements, margin %g\n", o->margin);
-    fprintf(f, "render.pregrowth_layers = %d\n", o->pregrowth_layers);
-    fprintf(f, "render.band_layers = %d\n", o->band_layers);
-    fprintf(f, "render.growth1_layers = %d\n", o->growth1_layers);
-    if (o->highlight_first > 0)
-        fprintf(f, "render.highlight = %d..%d\n", o->highlight_first, o->highlight_last);
-    else
-        fprintf(f, "render.highlight = none\n");
-    fprintf(f,
-            "render.show = fill %d, outline %d, colours %d, vectors %d, axes %d, scale_bar %d, "
-            "colour_bar %d, label %d\n",
-            o->show_fill, o->show_outline, o->show_colours, o->show_vectors, o->show_axes,
-            o->show_scale_bar, o->show_colour_bar, o->show_label);
-    fprintf(f, "render.font_size = %g%s\n", o->font_size, o->font_size <= 0 ? " (automatic)" : "");
-    fprintf(f, "render.outline_width = %g\n", o->outline_width);
-    fprintf(f, "render.line_width = %g\n", o->line_width);
-    fprintf(f, "render.weak_alpha = %g\n", o->weak_alpha);
-    for (size_t k = 0; k < sizeof cols / sizeof cols[0]; k++) {
-        char buf[10];
-        cdem_render_format_colour(cols[k], buf);
-        fprintf(f, "render.colour.%s = %s\n", colour_names[k], buf);
-    }
-}
-
-static int hex_digit(int c) {
-    if (c >= '0' && c <= '9')
-        return c - '0';
-    c = tolower(c);
-    if (c >= 'a' && c <= 'f')
-        return c - 'a' + 10;
-    return -1;
-}
-
-cdem_status cdem_render_parse_colour(const char *text, cdem_rgba *out, cdem_error *err) {
-    size_t len = text ? strlen(text) : 0;
-    if (!text || text[0] != '#' || (len != 7 && len != 9))
-        return CDEM_FAIL(err, CDEM_ERR_PARSE,
-                         "colour '%s' is not valid: use \"#rrggbb\" or \"#rrggbbaa\" "
-                         "(hexadecimal, e.g. \"#8b5a2b\")",
-                         text ? text : "(null)");
-    double ch[4] = {0, 0, 0, 1.0};
-    for (size_t k = 0; k < (len - 1) / 2; k++) {
-        int hi = hex_digit((unsigned char)text[1 + 2 * k]);
-        int lo = hex_digit((unsigned char)text[2 + 2 * k]);
-        if (hi < 0 || lo < 0)
-            return CDEM_FAIL(err, CDEM_ERR_PARSE,
-                             "colour '%s' is not valid: '%c%c' is not a hexadecimal byte "
-                             "(use \"#rrggbb\" or \"#rrggbbaa\")",
-                             text, text[1 + 2 * k], text[2 + 2 * k]);
-        ch[k] = (hi * 16 + lo) / 255.0;
-    }
-    out->r = ch[0];
-    out->g = ch[1];
-    out->b = ch[2];
-    out->a = ch[3];
-    return CDEM_OK;
-}
-
-cdem_status cdem_render_format_from_path(const char *path, cdem_render_format *fmt,
-                                         cdem_error *err) {
-    const char *dot = path ? strrchr(path, '.') : NULL;
-    const char *slash = path ? strrchr(path, '/') : NULL;
-    if (dot && (!slash || dot > slash)) {
-        if (strcasecmp(dot, ".png") == 0) {
-            *fmt = CDEM_RENDER_PNG;
-            return CDEM_OK;
-        }
-        if (strcasecmp(dot, ".pdf") == 0) {
-            *fmt = CDEM_RENDER_PDF;
-            return CDEM_OK;
-        }
-        if (strcasecmp(dot, ".svg") == 0) {
-            *fmt = CDEM_RENDER_SVG;
-            return CDEM_OK;
-        }
-    }
-    return CDEM_FAIL(err, CDEM_ERR_UNSUPPORTED,
-                     "image file '%s': extension '%s' is not supported: use .png, .pdf or .svg "
-                     "(animated GIF is written by the gif encoder)",
-                     path ? path : "(null)", dot && (!slash || dot > slash) ? dot : "(none)");
-}
 
 static int disc_ok(const cdem_state *s, size_t i) {
     return isfinite(s->x[i]) && isfinite(s->y[i]) && isfinite(s->radius[i]) && s->radius[i] > 0.0;
@@ -492,129 +335,18 @@ static int point_visible(const cdem_render_layout *lay, double x, double y) {
            y <= lay->ymax;
 }
 
-/* Direct rasteriser for image targets. cairo fills and strokes tens of thousands of small
- * circles slowly (each arc becomes Bezier curves, then polygons, then coverage), so on a
- * plain ARGB32/RGB24 image surface with an identity transform the discs are written
- * straight into the pixels: coverage from the distance of the pixel centre to the circle
- * (one-pixel anti-aliasing ramp), blended OVER in premultiplied form, clipped to the plot
- * area. Vector targets (PDF, SVG, recording surfaces) take the cairo path instead. */
-typedef struct {
-    cairo_surface_t *surface; /* the target image surface (borrowed) */
-    unsigned char *data;      /* its pixels */
-    int stride;               /* bytes per row */
-    int opaque;               /* 1: RGB24, alpha byte ignored */
-    int x0, y0, x1, y1;       /* clip rectangle in pixels, half-open */
-} raster_target;
-
-static int raster_target_get(cairo_t *cr, const cdem_render_layout *lay, raster_target *rt) {
-    cairo_surface_t *t = cairo_get_target(cr);
-    if (cairo_surface_get_type(t) != CAIRO_SURFACE_TYPE_IMAGE)
-        return 0;
-    cairo_format_t f = cairo_image_surface_get_format(t);
-    if (f != CAIRO_FORMAT_ARGB32 && f != CAIRO_FORMAT_RGB24)
-        return 0;
-    cairo_matrix_t m;
-    cairo_get_matrix(cr, &m);
-    double dx = 0, dy = 0;
-    cairo_surface_get_device_offset(t, &dx, &dy);
-    if (m.xx != 1 || m.yy != 1 || m.xy != 0 || m.yx != 0 || m.x0 != 0 || m.y0 != 0 || dx != 0 ||
-        dy != 0)
-        return 0;
-    cairo_surface_flush(t);
-    rt->surface = t;
-    rt->data = cairo_image_surface_get_data(t);
-    rt->stride = cairo_image_surface_get_stride(t);
-    rt->opaque = f == CAIRO_FORMAT_RGB24;
-    int w = cairo_image_surface_get_width(t), h = cairo_image_surface_get_height(t);
-    rt->x0 = (int)fmax(0.0, ceil(lay->plot_x - 0.5));
-    rt->y0 = (int)fmax(0.0, ceil(lay->plot_y - 0.5));
-    rt->x1 = (int)fmin((double)w, floor(lay->plot_x + lay->plot_w + 0.5));
-    rt->y1 = (int)fmin((double)h, floor(lay->plot_y + lay->plot_h + 0.5));
-    return rt->data != NULL;
-}
-
-/* floor/ceil result v as an int clamped to lo..hi (NaN gives lo): no overflowing casts for
- * huge coordinates. */
-static int clamp_px(double v, int lo, int hi) {
-    if (!(v > lo))
-        return lo;
-    if (v > hi)
-        return hi;
-    return (int)v;
-}
-
-/* OVER-blends colour c at coverage cov (0..1] into the premultiplied pixel *p. */
-static void blend_pixel(const raster_target *rt, uint32_t *p, const cdem_rgba *c, double cov) {
-    uint32_t v = *p;
-    double sa = c->a * cov, keep = 1.0 - sa;
-    double da = rt->opaque ? 255.0 : (double)(v >> 24);
-    double nr = c->r * sa * 255.0 + ((v >> 16) & 255) * keep;
-    double ng = c->g * sa * 255.0 + ((v >> 8) & 255) * keep;
-    double nb = c->b * sa * 255.0 + (v & 255) * keep;
-    double na = rt->opaque ? 255.0 : 255.0 * sa + da * keep;
-    *p = ((uint32_t)(na + 0.5) << 24) | ((uint32_t)(nr + 0.5) << 16) | ((uint32_t)(ng + 0.5) << 8) |
-         (uint32_t)(nb + 0.5);
-}
-
-/* Anti-aliased segment of the given width (device units), round ends. */
-static void raster_segment(const raster_target *rt, double x0, double y0, double x1, double y1,
-                           double width, const cdem_rgba *c) {
-    double reach = 0.5 * width + 1.0;
-    int px0 = clamp_px(floor(fmin(x0, x1) - reach), rt->x0, rt->x1);
-    int px1 = clamp_px(ceil(fmax(x0, x1) + reach), rt->x0, rt->x1);
-    int py0 = clamp_px(floor(fmin(y0, y1) - reach), rt->y0, rt->y1);
-    int py1 = clamp_px(ceil(fmax(y0, y1) + reach), rt->y0, rt->y1);
-    double vx = x1 - x0, vy = y1 - y0, vv = vx * vx + vy * vy;
-    double half = 0.5 * width;
-    for (int py = py0; py < py1; py++) {
-        uint32_t *row = (uint32_t *)(void *)(rt->data + (size_t)py * rt->stride);
-        double yc = py + 0.5;
-        /* parameter range of the segment within reach of this row, then its x extent */
-        double ta = 0.0, tb = 1.0;
-        if (vy != 0.0) {
-            ta = (yc - reach - y0) / vy;
-            tb = (yc + reach - y0) / vy;
-            if (ta > tb) {
-                double t = ta;
-                ta = tb;
-                tb = t;
-            }
-            ta = fmax(ta, 0.0);
-            tb = fmin(tb, 1.0);
-            if (ta > tb)
-                continue;
-        } else if (fabs(yc - y0) > reach) {
-            continue;
-        }
-        double xa = fmin(x0 + ta * vx, x0 + tb * vx) - reach;
-        double xb = fmax(x0 + ta * vx, x0 + tb * vx) + reach;
-        int qa = clamp_px(floor(xa), px0, px1), qb = clamp_px(ceil(xb), px0, px1);
-        for (int px = qa; px < qb; px++) {
-            double wx = px + 0.5 - x0, wy = yc - y0;
-            double t = vv > 0 ? (wx * vx + wy * vy) / vv : 0.0;
-            t = t < 0 ? 0 : (t > 1 ? 1 : t);
-            double ex = wx - t * vx, ey = wy - t * vy;
-            double d = sqrt(ex * ex + ey * ey);
-            double cov = fmin(width, half + 0.5 - d);
-            if (cov <= 0.0)
-                continue;
-            blend_pixel(rt, row + px, c, cov > 1.0 ? 1.0 : cov);
-        }
-    }
-}
-
 /* Where line segments go: straight into the pixels (rt set) or into a cairo path that
  * line_sink_finish strokes. */
 typedef struct {
-    cairo_t *cr;             /* the context (cairo path) */
-    const raster_target *rt; /* direct target, or NULL */
-    const cdem_rgba *colour; /* line colour */
-    double width;            /* line width, device units */
+    cairo_t *cr;                  /* the context (cairo path) */
+    const cdem_raster_target *rt; /* direct target, or NULL */
+    const cdem_rgba *colour;      /* line colour */
+    double width;                 /* line width, device units */
 } line_sink;
 
 static void line_sink_segment(const line_sink *ls, double x0, double y0, double x1, double y1) {
     if (ls->rt) {
-        raster_segment(ls->rt, x0, y0, x1, y1, ls->width, ls->colour);
+        cdem_raster_segment(ls->rt, x0, y0, x1, y1, ls->width, ls->colour);
     } else {
         cairo_move_to(ls->cr, x0, y0);
         cairo_line_to(ls->cr, x1, y1);
@@ -632,59 +364,7 @@ static void line_sink_finish(const line_sink *ls) {
     cairo_stroke(ls->cr);
 }
 
-/* Disc (ring_width == 0) or ring of that width centred on the circle, model units in. */
-static void raster_disc(const raster_target *rt, const cdem_render_layout *lay, double x, double y,
-                        double radius, const cdem_rgba *c, double ring_width) {
-    double cx, cy;
-    cdem_render_layout_to_device(lay, x, y, &cx, &cy);
-    double r = radius * lay->scale;
-    double reach = r + 0.5 * ring_width + 1.0;
-    int px0 = clamp_px(floor(cx - reach), rt->x0, rt->x1);
-    int px1 = clamp_px(ceil(cx + reach), rt->x0, rt->x1);
-    int py0 = clamp_px(floor(cy - reach), rt->y0, rt->y1);
-    int py1 = clamp_px(ceil(cy + reach), rt->y0, rt->y1);
-    double small = ring_width > 0 ? fmin(1.0, ring_width) : fmin(1.0, 2.0 * r);
-    double half = 0.5 * ring_width;
-    double outer = r + half + 0.5;                       /* coverage is zero beyond */
-    double inner = ring_width > 0 ? r - half - 0.5 : -1; /* ring: zero inside this */
-    for (int py = py0; py < py1; py++) {
-        uint32_t *row = (uint32_t *)(void *)(rt->data + (size_t)py * rt->stride);
-        double ddy = py + 0.5 - cy;
-        if (fabs(ddy) >= outer)
-            continue;
-        double span = sqrt(outer * outer - ddy * ddy);
-        int xa = clamp_px(floor(cx - span - 0.5), px0, px1);
-        int xb = clamp_px(ceil(cx + span + 0.5), px0, px1);
-        int hole_a = xb, hole_b = xb; /* pixels [hole_a, hole_b) lie inside the ring's hole */
-        if (inner > 0 && fabs(ddy) < inner) {
-            double ispan = sqrt(inner * inner - ddy * ddy);
-            hole_a = clamp_px(ceil(cx - ispan + 0.5), xa, xb);
-            hole_b = clamp_px(floor(cx + ispan - 0.5), xa, xb);
-            if (hole_b <= hole_a)
-                hole_a = hole_b = xb; /* empty hole: nothing to skip */
-        }
-        for (int px = xa; px < xb; px++) {
-            if (px == hole_a) {
-                px = hole_b - 1;
-                continue;
-            }
-            double ddx = px + 0.5 - cx;
-            double d = sqrt(ddx * ddx + ddy * ddy);
-            double cov;
-            if (ring_width > 0)
-                cov = fmin(ring_width, half + 0.5 - fabs(d - r));
-            else
-                cov = (r + 0.5 - d) * small;
-            if (cov <= 0.0)
-                continue;
-            if (cov > 1.0)
-                cov = 1.0;
-            blend_pixel(rt, row + px, c, cov);
-        }
-    }
-}
-
-static cdem_status draw_elements(cairo_t *cr, const raster_target *rtp,
+static cdem_status draw_elements(cairo_t *cr, const cdem_raster_target *rtp,
                                  const cdem_render_layout *lay, const cdem_render_scene *sc,
                                  const cdem_render_options *o, cdem_error *err) {
     const cdem_state *s = sc->state;
@@ -741,15 +421,16 @@ static cdem_status draw_elements(cairo_t *cr, const raster_target *rtp,
 
     int outline = o->show_outline || !o->show_fill;
     if (rtp) {
-        const raster_target rt = *rtp;
+        const cdem_raster_target rt = *rtp;
         for (int k = 0; o->show_fill && k < SLOT_N; k++)
             for (size_t j = start[k]; j < start[k + 1]; j++) {
                 size_t i = order[j];
-                raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &pal[k], 0.0);
+                cdem_raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &pal[k], 0.0);
             }
         for (size_t j = 0; outline && j < n_visible; j++) {
             size_t i = order[j];
-            raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &o->outline, o->outline_width);
+            cdem_raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &o->outline,
+                             o->outline_width);
         }
         cairo_surface_mark_dirty(rt.surface);
     } else {
@@ -790,7 +471,7 @@ static cdem_status draw_elements(cairo_t *cr, const raster_target *rtp,
     return CDEM_OK;
 }
 
-static void draw_vectors(cairo_t *cr, const raster_target *rt, const cdem_render_layout *lay,
+static void draw_vectors(cairo_t *cr, const cdem_raster_target *rt, const cdem_render_layout *lay,
                          const cdem_render_scene *sc, const cdem_render_options *o) {
     const cdem_state *s = sc->state;
     double lw = o->line_width;
@@ -818,7 +499,7 @@ static void draw_vectors(cairo_t *cr, const raster_target *rt, const cdem_render
     line_sink_finish(&ls);
 }
 
-static void draw_axes(cairo_t *cr, const raster_target *rt, const cdem_render_layout *lay,
+static void draw_axes(cairo_t *cr, const cdem_raster_target *rt, const cdem_render_layout *lay,
                       const cdem_render_scene *sc, const cdem_render_options *o) {
     double len = sc->axis_length;
     if (!(len > 0)) {
@@ -959,8 +640,8 @@ cdem_status cdem_render_draw(cairo_t *cr, double width, double height, const cde
     cairo_new_path(cr);
     cairo_rectangle(cr, lay.plot_x, lay.plot_y, lay.plot_w, lay.plot_h);
     cairo_clip(cr);
-    raster_target rt;
-    const raster_target *rtp = raster_target_get(cr, &lay, &rt) ? &rt : NULL;
+    cdem_raster_target rt;
+    const cdem_raster_target *rtp = cdem_raster_target_get(cr, &lay, &rt) ? &rt : NULL;
     cdem_status st = draw_elements(cr, rtp, &lay, sc, o, err);
     if (st != CDEM_OK) {
         cairo_restore(cr);

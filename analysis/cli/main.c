@@ -1,12 +1,12 @@
 /* cdem-strain: the command line of the analysis tool.
  *
- * The subcommands are the rows of one table (commands.h): name, entry point, help. main
- * only dispatches: -h/--help anywhere in a command's arguments prints that command's help
+ * The subcommands are the rows of one table (commands.h): name, summary, help, handler.
+ * main only dispatches: -h/--help anywhere in a command's arguments prints that command's help
  * (stdout, exit 0) before its parser runs, so every command answers it the same way; a
  * first argument that is an existing file (not a subcommand) means "compute". Exit status:
  * 0 success, 1 error ("cdem-strain: <message>" on stderr), 2 usage error. Results go to
  * stdout (or -o FILE) so they can be redirected. */
-#include "cmd_basic.h"
+#include "cmd_support.h"
 #include "commands.h"
 #include "threads.h"
 
@@ -18,40 +18,37 @@
 #define CDEM_VERSION "0.0.0"
 #endif
 
-enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2 };
-
 int main(int argc, char **argv) {
     cdem_threads_settle_wait_policy(argv); /* idle threads sleep: threads.h */
     if (argc < 2) {
-        cdem_cli_usage_print(stderr, &cdem_strain_help, "missing command");
-        return EXIT_USAGE;
+        return cdem_cmd_usage(&cdem_strain_help, "missing command");
     }
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
         cdem_commands_print_help(stdout);
-        return EXIT_OK;
+        return CDEM_EXIT_OK;
     }
     if (!strcmp(argv[1], "-V") || !strcmp(argv[1], "--version")) {
         printf("cdem-strain %s\n", CDEM_VERSION);
-        return EXIT_OK;
+        return CDEM_EXIT_OK;
     }
     const cdem_command *c = cdem_command_find(argv[1]);
     if (c) {
         if (cdem_cli_wants_help(argc, argv, 2, c->help)) {
             cdem_cli_help_print(stdout, c->help);
-            return EXIT_OK;
+            return CDEM_EXIT_OK;
         }
         return c->run(argc - 1, argv + 1);
     }
     struct stat sb;
     if (argv[1][0] != '-' && stat(argv[1], &sb) == 0 && S_ISREG(sb.st_mode)) {
-        if (cdem_cli_wants_help(argc, argv, 2, &cdem_cmd_compute_help)) {
-            cdem_cli_help_print(stdout, &cdem_cmd_compute_help);
-            return EXIT_OK;
+        const cdem_cli_help *compute = cdem_command_find("compute")->help;
+        if (cdem_cli_wants_help(argc, argv, 2, compute)) {
+            cdem_cli_help_print(stdout, compute);
+            return CDEM_EXIT_OK;
         }
         return cdem_cmd_compute_file_first(argc - 1, argv + 1);
     }
     char msg[200];
     snprintf(msg, sizeof msg, "unknown command '%.100s' (and not an existing file)", argv[1]);
-    cdem_cli_usage_print(stderr, &cdem_strain_help, msg);
-    return EXIT_USAGE;
+    return cdem_cmd_usage(&cdem_strain_help, msg);
 }

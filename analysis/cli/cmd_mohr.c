@@ -1,0 +1,207 @@
+/* cmd_mohr: `cdem-strain mohr`; its help (below) says what it does. */
+#include "cmd_plot.h"
+#include "cmd_support.h"
+#include "commands.h"
+#include "mohr.h"
+#include "params.h"
+#include "plot.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const mohr_forms[] = {
+    "RUN1.h5 RUN2.h5 ... | --data FILE (columns: sigma3 q, N/m)  [-o OUT.png|.pdf|.svg] "
+    "[--width N] [--height N]",
+    NULL};
+static const cdem_cli_option mohr_options[] = {
+    {"--data", "FILE", "fit peaks measured elsewhere: a text file of columns sigma3 q (N/m)"},
+    {"-o, --output", "OUT.png|.pdf|.svg",
+     "stress-strain curves and Mohr circles with the fitted envelope"},
+    CDEM_PLOT_WIDTH_OPTION,
+    CDEM_PLOT_HEIGHT_OPTION,
+    {NULL, NULL, NULL}};
+static const cdem_cli_help help = {
+    .program = "cdem-strain mohr",
+    .forms = mohr_forms,
+    .about = "Mohr-Coulomb fit of biaxial tests: takes the peak differential stress of each "
+             "run (sigma3 = its confining pressure) and prints the cohesion and friction "
+             "angle with their standard errors (none with exactly two tests). Formulas: "
+             "docs/rendering.md.",
+    .options = mohr_options,
+};
+
+#define MOHR_CIRCLE_POINTS 181
+
+/* Curves and peak values of the biaxial runs (owned arrays). */
+typedef struct {
+    double *sigma3, *q;                  /* per test, N/m */
+    double *strain[CDEM_PLOT_MAX_FILES]; /* axial strain per sample, per run */
+    double *stress[CDEM_PLOT_MAX_FILES]; /* differential stress per sample (MPa), per run */
+    size_t n_samples[CDEM_PLOT_MAX_FILES];
+    size_t n; /* tests */
+} mohr_data;
+
+static void mohr_data_free(mohr_data *d) {
+    free(d->sigma3);
+    free(d->q);
+    for (size_t i = 0; i < CDEM_PLOT_MAX_FILES; i++) {
+        free(d->strain[i]);
+        free(d->stress[i]);
+    }
+}
+
+static cdem_status mohr_read_runs(const cdem_plot_args *a, mohr_data *d, cdem_error *err) {
+    d->sigma3 = malloc(a->n_files * sizeof(double));
+    d->q = malloc(a->n_files * sizeof(double));
+    if (!d->sigma3 || !d->q)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu runs", a->n_files);
+    for (size_t i = 0; i < a->n_files; i++) {
+        cdem_h5_reader *r;
+        CDEM_TRY(cdem_h5_reader_open(a->files[i], &r, err));
+        cdem_params p;
+        cdem_series_sample *smp = NULL;
+        size_t n = 0;
+        cdem_status st = cdem_h5_reader_params(r, &p, err);
+        if (st == CDEM_OK)
+            st = cdem_h5_reader_read_series(r, &smp, &n, err);
+        cdem_h5_reader_close(r);
+        if (st == CDEM_OK && p.mode != CDEM_MODE_BIAXIAL)
+            st = CDEM_FAIL(err, CDEM_ERR_INVALID,
+                           "%s is a '%s' run; mohr needs biaxial test runs (boundary.mode = "
+                           "biaxial)",
+                           a->files[i], cdem_mode_name(p.mode));
+        if (st == CDEM_OK && n == 0)
+            st = CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s has no time-series samples", a->files[i]);
+        if (st == CDEM_OK) {
+            d->strain[i] = malloc(n * sizeof(double));
+            d->stress[i] = malloc(n * sizeof(double));
+            if (!d->strain[i] || !d->stress[i])
+                st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu samples", n);
+        }
+        if (st == CDEM_OK) {
+            double peak = -INFINITY;
+            for (size_t k = 0; k < n; k++) {
+                d->strain[i][k] = smp[k].axial_strain;
+                d->stress[i][k] = smp[k].differential_stress / 1e6;
+                if (isfinite(smp[k].differential_stress))
+                    peak = fmax(peak, smp[k].differential_stress);
+            }
+            d->n_samples[i] = n;
+            d->sigma3[i] = p.confining_pressure;
+            d->q[i] = peak;
+        }
+        free(smp);
+        if (st != CDEM_OK)
+            return st;
+    }
+    d->n = a->n_files;
+    return CDEM_OK;
+}
+
+static cdem_status mohr_figure(const cdem_plot_args *a, const mohr_data *d,
+                               const cdem_mohr_fit *fit, cdem_error *err) {
+    size_t nt = d->n, runs = a->n_files;
+    cdem_plot_series ser[CDEM_PLOT_MAX_FILES + 2];
+    cdem_plot_series circ[CDEM_PLOT_MAX_FILES + 2];
+    memset(ser, 0, sizeof ser);
+    memset(circ, 0, sizeof circ);
+    for (size_t i = 0; i < runs; i++)
+        ser[i] = (cdem_plot_series){.x = d->strain[i],
+                                    .y = d->stress[i],
+                                    .n = d->n_samples[i],
+                                    .label = cdem_cmd_base_name(a->files[i]),
+                                    .line = 1};
+    size_t nc = nt < CDEM_PLOT_MAX_FILES ? nt : CDEM_PLOT_MAX_FILES;
+    double *pts = malloc((2 * nc * MOHR_CIRCLE_POINTS + 4) * sizeof(double));
+    if (!pts)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for the Mohr circles");
+    double smax = 0;
+    for (size_t i = 0; i < nc; i++) {
+        double c = (d->sigma3[i] + 0.5 * d->q[i]) / 1e6, r = 0.5 * d->q[i] / 1e6;
+        double *x = pts + 2 * i * MOHR_CIRCLE_POINTS, *y = x + MOHR_CIRCLE_POINTS;
+        for (int k = 0; k < MOHR_CIRCLE_POINTS; k++) {
+            double t = M_PI * k / (MOHR_CIRCLE_POINTS - 1);
+            x[k] = c + r * cos(t);
+            y[k] = r * sin(t);
+        }
+        smax = fmax(smax, c + r);
+        circ[i] = (cdem_plot_series){
+            .x = x, .y = y, .n = MOHR_CIRCLE_POINTS, .line = 1, .colour = cdem_plot_palette(i)};
+    }
+    double *ex = pts + 2 * nc * MOHR_CIRCLE_POINTS, *ey = ex + 2;
+    ex[0] = 0;
+    ex[1] = smax * 1.05;
+    ey[0] = fit->cohesion / 1e6;
+    ey[1] = ey[0] + ex[1] * tan(fit->friction);
+    char elabel[128];
+    snprintf(elabel, sizeof elabel, "C = %.3g MPa, phi = %.1f deg", fit->cohesion / 1e6,
+             fit->friction * 180 / M_PI);
+    circ[nc] = (cdem_plot_series){
+        .x = ex, .y = ey, .n = 2, .line = 1, .dashed = 1, .label = elabel, .colour = {0, 0, 0, 1}};
+    cdem_plot panels[2] = {
+        {.title = "Biaxial tests",
+         .xlabel = "Axial strain",
+         .ylabel = "Differential stress (MPa)",
+         .series = ser,
+         .n_series = runs},
+        {.title = "Mohr circles at peak stress",
+         .xlabel = "Normal stress (MPa)",
+         .ylabel = "Shear stress (MPa)",
+         .series = circ,
+         .n_series = nc + 1,
+         .equal_aspect = 1,
+         .fix_x = 1,
+         .xmin = 0,
+         .xmax = smax * 1.05,
+         .fix_y = 1,
+         .ymin = 0,
+         .ymax = fmax(ey[1], 0.6 * smax)},
+    };
+    size_t np = runs ? 2 : 1;
+    cdem_status st =
+        cdem_plot_to_file(a->out, runs ? panels : panels + 1, np,
+                          a->width ? a->width : (int)(700 * np), a->height ? a->height : 560, err);
+    free(pts);
+    return st;
+}
+
+int cdem_cmd_plot_mohr(int argc, char **argv) {
+    cdem_plot_args a = {.cmd = "mohr", .help = &help};
+    int rc = cdem_cmd_plot_parse(argc, argv, &a);
+    if (rc)
+        return rc;
+    if (a.data && a.n_files)
+        return cdem_cmd_usage(&help, "give either run files or --data FILE, not both");
+    if (!a.data && a.n_files < 2)
+        return cdem_cmd_usage(&help, "need at least 2 biaxial runs (or --data FILE)");
+    cdem_error err;
+    mohr_data d;
+    memset(&d, 0, sizeof d);
+    cdem_status st = a.data ? cdem_mohr_read_table(a.data, &d.sigma3, &d.q, &d.n, &err)
+                            : mohr_read_runs(&a, &d, &err);
+    cdem_mohr_fit fit;
+    if (st == CDEM_OK)
+        st = cdem_mohr_fit_envelope(d.sigma3, d.q, d.n, &fit, &err);
+    if (st == CDEM_OK) {
+        for (size_t i = 0; i < d.n; i++)
+            printf("test %zu: sigma3 = %.6g MPa, peak q = %.6g MPa, sigma1 = %.6g MPa\n", i + 1,
+                   d.sigma3[i] / 1e6, d.q[i] / 1e6, (d.sigma3[i] + d.q[i]) / 1e6);
+        if (isfinite(fit.cohesion_err))
+            printf("cohesion = %.4g +- %.2g MPa, friction angle = %.2f +- %.2f deg\n",
+                   fit.cohesion / 1e6, fit.cohesion_err / 1e6, fit.friction * 180 / M_PI,
+                   fit.friction_err * 180 / M_PI);
+        else
+            printf("cohesion = %.4g +- n/a MPa, friction angle = %.2f +- n/a deg (2 tests: "
+                   "exact fit, no uncertainty)\n",
+                   fit.cohesion / 1e6, fit.friction * 180 / M_PI);
+    }
+    if (st == CDEM_OK && a.out)
+        st = mohr_figure(&a, &d, &fit, &err);
+    mohr_data_free(&d);
+    return st == CDEM_OK ? 0 : cdem_cmd_fail(a.cmd, NULL, &err);
+}
+
+const cdem_command cdem_command_mohr = {"mohr", "Mohr-Coulomb fit of biaxial tests", &help,
+                                        cdem_cmd_plot_mohr};
