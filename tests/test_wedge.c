@@ -219,6 +219,10 @@ static void test_wedge_forces_mean_and_nearest(void **state) {
         smp[k].boundary_force_y = -1.0 * (k + 1);
         smp[k].base_force_x = -3.0 * (k + 1);
         smp[k].base_force_y = -100.0 * (k + 1);
+        smp[k].left_wall_force_x = -20.0 * (k + 1);
+        smp[k].left_wall_force_y = 2.0 * (k + 1);
+        smp[k].right_wall_force_x = 30.0 * (k + 1);
+        smp[k].right_wall_force_y = NAN; /* a file from before the column */
     }
     cdem_wedge_row row;
     cdem_wedge_forces(smp, 5, 150, 400, &row); /* samples at 200, 300, 400 */
@@ -226,10 +230,16 @@ static void test_wedge_forces_mean_and_nearest(void **state) {
     assert_near(row.wall_force_y, -3.0, 1e-12);
     assert_near(row.base_force_x, -9.0, 1e-12);
     assert_near(row.base_force_y, -300.0, 1e-12);
+    assert_near(row.left_wall_force_x, -60.0, 1e-12);
+    assert_near(row.left_wall_force_y, 6.0, 1e-12);
+    assert_near(row.right_wall_force_x, 90.0, 1e-12);
+    assert_true(isnan(row.right_wall_force_y));
     cdem_wedge_forces(smp, 5, 410, 440, &row); /* none inside: nearest (400) */
     assert_near(row.wall_force_x, 40.0, 1e-12);
+    assert_near(row.right_wall_force_x, 120.0, 1e-12);
     cdem_wedge_forces(smp, 0, 0, 100, &row);
     assert_true(isnan(row.wall_force_x) && isnan(row.base_force_y));
+    assert_true(isnan(row.left_wall_force_x) && isnan(row.right_wall_force_y));
 }
 
 /* The analysis path over in-memory states: rows from the end of equilibration, shortening
@@ -303,7 +313,11 @@ static void test_wedge_csv_round_trip(void **state) {
                                    .base_force_y = -7.7e11,
                                    .front_x = k ? 995.0 : NAN,
                                    .wall_x = 9999.9 - k,
-                                   .n_fitted = (size_t)(3 * k)};
+                                   .n_fitted = (size_t)(3 * k),
+                                   .left_wall_force_x = -6.5e11 * k,
+                                   .left_wall_force_y = 1.25e9,
+                                   .right_wall_force_x = k ? 6.6e11 : NAN,
+                                   .right_wall_force_y = -2.5e9};
     }
     char path[1100];
     snprintf(path, sizeof path, "%s/wedge_rt_%d.csv", scratch_root(), (int)getpid());
@@ -315,7 +329,7 @@ static void test_wedge_csv_round_trip(void **state) {
     cdem_csvtable t;
     assert_int_equal(cdem_csvtable_read(path, &t, &err), CDEM_OK);
     assert_int_equal(t.n_rows, 3);
-    assert_int_equal(t.n_cols, 17);
+    assert_int_equal(t.n_cols, 21);
     static const char *const names[] = {"increment",
                                         "step",
                                         "shortening_m",
@@ -332,19 +346,35 @@ static void test_wedge_csv_round_trip(void **state) {
                                         "base_force_y_N",
                                         "front_x_m",
                                         "wall_x_m",
-                                        "n_fitted"};
+                                        "n_fitted",
+                                        "left_wall_force_x_N",
+                                        "left_wall_force_y_N",
+                                        "right_wall_force_x_N",
+                                        "right_wall_force_y_N"};
     for (int k = 0; k < 3; k++) {
         const cdem_wedge_row *r = &rows[k];
-        const double want[17] = {r->number,           (double)r->step,
-                                 r->shortening,       r->shortening_percent,
-                                 r->height,           r->length,
-                                 r->length_thickened, r->taper_deg,
-                                 r->area_change,      r->area_change_percent,
-                                 r->wall_force_x,     r->wall_force_y,
-                                 r->base_force_x,     r->base_force_y,
-                                 r->front_x,          r->wall_x,
-                                 (double)r->n_fitted};
-        for (int c = 0; c < 17; c++) {
+        const double want[21] = {r->number,
+                                 (double)r->step,
+                                 r->shortening,
+                                 r->shortening_percent,
+                                 r->height,
+                                 r->length,
+                                 r->length_thickened,
+                                 r->taper_deg,
+                                 r->area_change,
+                                 r->area_change_percent,
+                                 r->wall_force_x,
+                                 r->wall_force_y,
+                                 r->base_force_x,
+                                 r->base_force_y,
+                                 r->front_x,
+                                 r->wall_x,
+                                 (double)r->n_fitted,
+                                 r->left_wall_force_x,
+                                 r->left_wall_force_y,
+                                 r->right_wall_force_x,
+                                 r->right_wall_force_y};
+        for (int c = 0; c < 21; c++) {
             size_t col;
             assert_int_equal(cdem_csvtable_find(&t, names[c], path, &col, &err), CDEM_OK);
             const double got = t.values[(size_t)k * t.n_cols + col];

@@ -29,6 +29,10 @@ static const column_def columns[] = {
     {"axial_strain", "Axial strain"},
     {"differential_stress", "Differential stress (N/m)"},
     {"sea_level", "Sea level (m)"},
+    {"left_wall_force_x", "Left wall force x (N)"},
+    {"left_wall_force_y", "Left wall force y (N)"},
+    {"right_wall_force_x", "Right wall force x (N)"},
+    {"right_wall_force_y", "Right wall force y (N)"},
 };
 #define N_COLUMNS (sizeof columns / sizeof columns[0])
 
@@ -60,8 +64,16 @@ static double column_value(const cdem_series_sample *s, size_t c) {
         return s->axial_strain;
     case 12:
         return s->differential_stress;
-    default:
+    case 13:
         return s->sea_level;
+    case 14:
+        return s->left_wall_force_x;
+    case 15:
+        return s->left_wall_force_y;
+    case 16:
+        return s->right_wall_force_x;
+    default:
+        return s->right_wall_force_y;
     }
 }
 

@@ -21,7 +21,8 @@
 /* out[k] = column `name` of samples[k] for k < n (names as in docs/format.md /series:
  * time, step, kinetic_energy, contacts, bonds, n_elements, net_displacement,
  * boundary_force_x, boundary_force_y, base_force_x, base_force_y, axial_strain,
- * differential_stress, sea_level). *label (may be NULL) gets an axis label with unit. */
+ * differential_stress, sea_level, left_wall_force_x, left_wall_force_y, right_wall_force_x,
+ * right_wall_force_y). *label (may be NULL) gets an axis label with unit. */
 cdem_status cdem_cmd_plot_column(const cdem_series_sample *samples, size_t n, const char *name,
                                  double *out, const char **label, cdem_error *err);
 

@@ -56,6 +56,10 @@ static const struct {
     {"wall_force_y_N", "Wall force y (N)"},
     {"base_force_x_N", "Base force x (N)"},
     {"base_force_y_N", "Base force y (N)"},
+    {"left_wall_force_x_N", "Left wall force x (N)"},
+    {"left_wall_force_y_N", "Left wall force y (N)"},
+    {"right_wall_force_x_N", "Right wall force x (N)"},
+    {"right_wall_force_y_N", "Right wall force y (N)"},
 };
 
 static const char *label_of(const char *name) {

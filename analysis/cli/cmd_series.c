@@ -12,7 +12,8 @@
 static const char *const series_names[] = {
     "step", "time", "kinetic_energy", "contacts", "bonds", "n_elements", "net_displacement",
     "boundary_force_x", "boundary_force_y", "base_force_x", "base_force_y", "axial_strain",
-    "differential_stress", "sea_level"};
+    "differential_stress", "sea_level", "left_wall_force_x", "left_wall_force_y",
+    "right_wall_force_x", "right_wall_force_y"};
 /* clang-format on */
 #define N_SERIES_NAMES (sizeof series_names / sizeof series_names[0])
 
@@ -66,8 +67,10 @@ static const cdem_cli_help help = {
     .about = "The run's whole time series (/series) as CSV: a header of the column names (step, "
              "time, kinetic_energy, contacts, bonds, n_elements, net_displacement, "
              "boundary_force_x, boundary_force_y, base_force_x, base_force_y, axial_strain, "
-             "differential_stress, sea_level; units in docs/format.md), then one line per "
-             "sample, full precision, nan for sea_level without sedimentation.",
+             "differential_stress, sea_level, left_wall_force_x, left_wall_force_y, "
+             "right_wall_force_x, right_wall_force_y; units in docs/format.md), then one line "
+             "per sample, full precision, nan for sea_level without sedimentation and for the "
+             "wall forces of files written before they were measured.",
     .options = series_options,
 };
 

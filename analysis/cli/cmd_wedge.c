@@ -25,8 +25,9 @@ static const cdem_cli_help help = {
     .program = "cdem-strain wedge",
     .forms = wedge_forms,
     .about = "Accretionary-wedge measurements per increment from the end of equilibration, as "
-             "CSV: shortening, height, length, taper, area change and the wall forces "
-             "(columns and definitions in docs/analysis.md, \"Wedge\").",
+             "CSV: shortening, height, length, taper, area change and the forces on the moving "
+             "wall, the base and each lateral wall (columns and definitions in "
+             "docs/analysis.md, \"Wedge\").",
     .options = wedge_options,
 };
 
@@ -66,8 +67,8 @@ static int run(int argc, char **argv) {
         cdem_analysis_params(a)->detachment_walls == CDEM_WALLS_BOTH)
         fprintf(stderr,
                 "cdem-strain wedge: note: %s moves both walls: the wedge is measured from "
-                "the right wall, and the wall force columns are the sum over both walls "
-                "(their x components cancel)\n",
+                "the right wall; wall_force_* is the sum over both walls (their x components "
+                "cancel), left_wall_force_* and right_wall_force_* give each wall's push\n",
                 file);
     cdem_wedge_row *rows = NULL;
     size_t n = 0;

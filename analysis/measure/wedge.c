@@ -5,6 +5,7 @@
 
 #include <gsl/gsl_fit.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -223,6 +224,8 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
     row->area_change = area - r->area0;
     row->area_change_percent = r->area0 > 0 ? 100.0 * row->area_change / r->area0 : NAN;
     row->wall_force_x = row->wall_force_y = row->base_force_x = row->base_force_y = NAN;
+    row->left_wall_force_x = row->left_wall_force_y = NAN;
+    row->right_wall_force_x = row->right_wall_force_y = NAN;
     cdem_id_map_free(&map);
     free(top);
     free(top0);
@@ -231,9 +234,35 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
     return st;
 }
 
+/* The series columns cdem_wedge_forces averages, and where each mean goes in a row. */
+typedef struct {
+    size_t sample; /* offsetof(cdem_series_sample, ...) */
+    size_t row;    /* offsetof(cdem_wedge_row, ...) */
+} force_column;
+#define FORCE(s, r)                                                                                \
+    { offsetof(cdem_series_sample, s), offsetof(cdem_wedge_row, r) }
+static const force_column force_columns[] = {
+    FORCE(boundary_force_x, wall_force_x),
+    FORCE(boundary_force_y, wall_force_y),
+    FORCE(base_force_x, base_force_x),
+    FORCE(base_force_y, base_force_y),
+    FORCE(left_wall_force_x, left_wall_force_x),
+    FORCE(left_wall_force_y, left_wall_force_y),
+    FORCE(right_wall_force_x, right_wall_force_x),
+    FORCE(right_wall_force_y, right_wall_force_y),
+};
+#undef FORCE
+#define N_FORCES (sizeof force_columns / sizeof force_columns[0])
+
+static double sample_value(const cdem_series_sample *q, size_t c) {
+    double v;
+    memcpy(&v, (const char *)q + force_columns[c].sample, sizeof v);
+    return v;
+}
+
 void cdem_wedge_forces(const cdem_series_sample *smp, size_t n, long step_from, long step_to,
                        cdem_wedge_row *row) {
-    double s[4] = {0, 0, 0, 0};
+    double s[N_FORCES] = {0};
     size_t m = 0, nearest = SIZE_MAX;
     long best = 0;
     for (size_t k = 0; k < n; k++) {
@@ -244,25 +273,21 @@ void cdem_wedge_forces(const cdem_series_sample *smp, size_t n, long step_from, 
             best = d;
         }
         if (st > step_from && st <= step_to) {
-            s[0] += smp[k].boundary_force_x;
-            s[1] += smp[k].boundary_force_y;
-            s[2] += smp[k].base_force_x;
-            s[3] += smp[k].base_force_y;
+            for (size_t c = 0; c < N_FORCES; c++)
+                s[c] += sample_value(&smp[k], c);
             m++;
         }
     }
     if (m == 0 && nearest != SIZE_MAX) {
-        s[0] = smp[nearest].boundary_force_x;
-        s[1] = smp[nearest].boundary_force_y;
-        s[2] = smp[nearest].base_force_x;
-        s[3] = smp[nearest].base_force_y;
+        for (size_t c = 0; c < N_FORCES; c++)
+            s[c] = sample_value(&smp[nearest], c);
         m = 1;
     }
     const double inv = m ? 1.0 / (double)m : NAN;
-    row->wall_force_x = m ? s[0] * inv : NAN;
-    row->wall_force_y = m ? s[1] * inv : NAN;
-    row->base_force_x = m ? s[2] * inv : NAN;
-    row->base_force_y = m ? s[3] * inv : NAN;
+    for (size_t c = 0; c < N_FORCES; c++) {
+        const double mean = m ? s[c] * inv : NAN;
+        memcpy((char *)row + force_columns[c].row, &mean, sizeof mean);
+    }
 }
 
 cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, size_t first,
@@ -336,7 +361,8 @@ static const char csv_header[] =
     "increment,step,shortening_m,shortening_percent,height_m,length_m,length_thickened_m,"
     "taper_deg,"
     "area_change_m2,area_change_percent,wall_force_x_N,wall_force_y_N,base_force_x_N,"
-    "base_force_y_N,front_x_m,wall_x_m,n_fitted";
+    "base_force_y_N,front_x_m,wall_x_m,n_fitted,left_wall_force_x_N,left_wall_force_y_N,"
+    "right_wall_force_x_N,right_wall_force_y_N";
 
 const char *cdem_wedge_csv_header(void) {
     return csv_header;
@@ -366,7 +392,11 @@ cdem_status cdem_wedge_write_csv(FILE *f, const cdem_wedge_row *rows, size_t n, 
                             r->front_x,          r->wall_x};
         for (size_t j = 0; j < sizeof v / sizeof v[0]; j++)
             put(f, v[j], ",");
-        fprintf(f, "%zu\n", r->n_fitted);
+        fprintf(f, "%zu,", r->n_fitted);
+        const double w[] = {r->left_wall_force_x, r->left_wall_force_y, r->right_wall_force_x,
+                            r->right_wall_force_y};
+        for (size_t j = 0; j < sizeof w / sizeof w[0]; j++)
+            put(f, w[j], j + 1 < sizeof w / sizeof w[0] ? "," : "\n");
     }
     if (ferror(f))
         return CDEM_FAIL(err, CDEM_ERR_IO, "wedge: error writing the CSV output");

@@ -63,6 +63,12 @@ typedef struct {
     double wall_force_y;        /* N, same for boundary_force_y */
     double base_force_x;        /* N, same for base_force_x (basal shear) */
     double base_force_y;        /* N, same for base_force_y (basal normal force) */
+    double left_wall_force_x;   /* N, same for left_wall_force_x (the left lateral wall's
+                                   own push: a backstop, or a moving wall of a two-sided
+                                   shortening); NaN for files from before the column */
+    double left_wall_force_y;   /* N, same for left_wall_force_y */
+    double right_wall_force_x;  /* N, same for right_wall_force_x */
+    double right_wall_force_y;  /* N, same for right_wall_force_y */
     double front_x;             /* m, left edge of the farthest deformed column (NaN: none) */
     double wall_x;              /* m, inner face of the moving wall */
     size_t n_fitted;            /* columns in the taper fit */
