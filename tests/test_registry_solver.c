@@ -1,0 +1,191 @@
+/* The registration tables of cdem-run are complete (issue 20): every boundary mode and every
+ * granular contact law that the parameter table offers (the words of boundary.mode and
+ * material.granular_law, common/params.c) is
+ *   - implemented: the mode has a row in the boundary-mode registry (solver/bc_registry.c,
+ *     cdem_bc_find succeeds); the law is accepted by the contact kernel
+ *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact;
+ *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
+ *   - tested: a test source under tests/ (other than this file) names its enum constant
+ *     (CDEM_MODE_<NAME> / CDEM_LAW_<NAME>, '-' as '_').
+ * Adding a mode or a law without its registration, documentation or test fails here, naming
+ * it. The checker itself is tested on a text with a name left out. Runs from the repository
+ * root. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "bc.h"
+#include "contact.h"
+#include "params.h"
+
+#include <ctype.h>
+#include <glob.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scratch.h"
+
+/* The choice words of an enum parameter, and their count. */
+static const char *const *choices_of(const char *section, const char *key, size_t *n) {
+    const cdem_param_def *d = cdem_params_find(section, key);
+    assert_non_null(d);
+    assert_int_equal(d->type, CDEM_PTYPE_ENUM);
+    *n = 0;
+    while (d->choices[*n])
+        ++*n;
+    assert_true(*n > 0);
+    return d->choices;
+}
+
+/* "planar-fault" with prefix "CDEM_MODE_" -> "CDEM_MODE_PLANAR_FAULT". */
+static void constant_name(char *out, size_t cap, const char *prefix, const char *word) {
+    size_t k = (size_t)snprintf(out, cap, "%s", prefix);
+    for (const char *c = word; *c && k + 1 < cap; c++)
+        out[k++] = *c == '-' ? '_' : (char)toupper((unsigned char)*c);
+    out[k] = '\0';
+}
+
+/* Every test source except this one, concatenated. */
+static char *test_sources(void) {
+    glob_t g;
+    assert_int_equal(glob("tests/test_*.c", 0, NULL, &g), 0);
+    char *all = calloc(1, 1);
+    size_t len = 0;
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        if (strstr(g.gl_pathv[i], "test_registry_solver.c"))
+            continue;
+        char *text = scratch_read_file(g.gl_pathv[i]);
+        assert_non_null(text);
+        size_t n = strlen(text);
+        char *grown = realloc(all, len + n + 1);
+        assert_non_null(grown);
+        memcpy(grown + len, text, n + 1);
+        all = grown;
+        len += n;
+        free(text);
+    }
+    globfree(&g);
+    return all;
+}
+
+/* The first word of words[0..n) that `docs` does not quote as `WORD` or `tests` does not
+ * name as PREFIX<WORD>; NULL when every word is there. */
+static const char *first_missing(const char *const *words, size_t n, const char *prefix,
+                                 const char *docs, const char *params_doc, const char *tests) {
+    for (size_t i = 0; i < n; i++) {
+        char quoted[96], constant[96];
+        snprintf(quoted, sizeof quoted, "`%s`", words[i]);
+        constant_name(constant, sizeof constant, prefix, words[i]);
+        if (!strstr(docs, quoted) || !strstr(params_doc, words[i]) || !strstr(tests, constant))
+            return words[i];
+    }
+    return NULL;
+}
+
+static void test_registry_boundary_modes(void **state) {
+    (void)state;
+    size_t n;
+    const char *const *modes = choices_of("boundary", "mode", &n);
+    for (size_t i = 0; i < n; i++) {
+        const cdem_bc_ops *ops = NULL;
+        cdem_error err;
+        if (cdem_bc_find((cdem_mode)i, &ops, &err) != CDEM_OK)
+            fail_msg("boundary.mode = %s has no implementation: %s", modes[i], err.msg);
+        assert_non_null(ops);
+        assert_string_equal(cdem_mode_name((cdem_mode)i), modes[i]);
+    }
+    char *docs = scratch_read_file("docs/solver.md");
+    char *params = scratch_read_file("docs/parameters.md");
+    char *tests = test_sources();
+    assert_non_null(docs);
+    assert_non_null(params);
+    const char *miss = first_missing(modes, n, "CDEM_MODE_", docs, params, tests);
+    if (miss)
+        fail_msg("boundary.mode = %s: not quoted in docs/solver.md, not in docs/parameters.md "
+                 "or no test names CDEM_MODE_ of it",
+                 miss);
+    free(docs);
+    free(params);
+    free(tests);
+}
+
+static void test_registry_contact_laws(void **state) {
+    (void)state;
+    size_t n;
+    const char *const *laws = choices_of("material", "granular_law", &n);
+    assert_int_equal(n, CDEM_LAW_COUNT);
+    /* each law is accepted and is a law of its own: a cohesive contact pushed past its
+     * strength transmits a different tangential force under each law */
+    double force[CDEM_LAW_COUNT];
+    for (size_t i = 0; i < n; i++) {
+        cdem_params p;
+        cdem_params_defaults(&p);
+        p.granular_law = (cdem_granular_law)i;
+        cdem_contact_law law;
+        cdem_error err;
+        if (cdem_contact_law_init(&law, &p, 1e9, 1e9, &err) != CDEM_OK)
+            fail_msg("material.granular_law = %s is refused: %s", laws[i], err.msg);
+        assert_int_equal(law.granular, (int)i);
+        force[i] = 0.0;
+        switch (law.granular) {
+        case CDEM_LAW_COULOMB:
+            force[i] = cdem_law_coulomb(1e12, 1e9, 0.25, 5e8).force;
+            break;
+        case CDEM_LAW_SPRING_COHESION:
+            force[i] = cdem_law_spring_cohesion(1e12, 1e9, 0.25, 5e8).force;
+            break;
+        case CDEM_LAW_NORMAL_COHESION:
+            force[i] = cdem_law_normal_cohesion(1e12, 1e9, 0.25, 5e8).force;
+            break;
+        default:
+            fail_msg("material.granular_law = %s: no case in this test or in the kernel's "
+                     "switch (solver/contact.h)",
+                     laws[i]);
+        }
+        assert_true(isfinite(force[i]) && force[i] > 0.0);
+        for (size_t j = 0; j < i; j++)
+            if (force[j] == force[i])
+                fail_msg("laws %s and %s give the same sliding force %g", laws[j], laws[i],
+                         force[i]);
+    }
+    char *docs = scratch_read_file("docs/solver.md");
+    char *params = scratch_read_file("docs/parameters.md");
+    char *tests = test_sources();
+    const char *miss = first_missing(laws, n, "CDEM_LAW_", docs, params, tests);
+    if (miss)
+        fail_msg("material.granular_law = %s: not quoted in docs/solver.md, not in "
+                 "docs/parameters.md or no test names CDEM_LAW_ of it",
+                 miss);
+    free(docs);
+    free(params);
+    free(tests);
+}
+
+/* The checker finds a word left out of the docs, of the parameter page or of the tests. */
+static void test_registry_checker_finds_omissions(void **state) {
+    (void)state;
+    static const char *const words[] = {"planar-fault", "new-mode", NULL};
+    const char *docs = "`planar-fault` and `new-mode`", *params = "planar-fault, new-mode";
+    const char *tests = "CDEM_MODE_PLANAR_FAULT CDEM_MODE_NEW_MODE";
+    assert_null(first_missing(words, 2, "CDEM_MODE_", docs, params, tests));
+    assert_string_equal(first_missing(words, 2, "CDEM_MODE_", "`planar-fault`", params, tests),
+                        "new-mode");
+    assert_string_equal(first_missing(words, 2, "CDEM_MODE_", docs, "planar-fault", tests),
+                        "new-mode");
+    assert_string_equal(first_missing(words, 2, "CDEM_MODE_", docs, params, "CDEM_MODE_NEW_MODE"),
+                        "planar-fault");
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_registry_boundary_modes),
+        cmocka_unit_test(test_registry_contact_laws),
+        cmocka_unit_test(test_registry_checker_finds_omissions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
