@@ -87,6 +87,24 @@ static const char *first_missing(const char *const *words, size_t n, const char 
     return NULL;
 }
 
+/* Fails naming the first of the parameter's words that the repository's docs or tests miss. */
+static void assert_documented_and_tested(const char *param, const char *const *words, size_t n,
+                                         const char *prefix) {
+    char *docs = scratch_read_file("docs/solver.md");
+    char *params = scratch_read_file("docs/parameters.md");
+    char *tests = test_sources();
+    assert_non_null(docs);
+    assert_non_null(params);
+    const char *miss = first_missing(words, n, prefix, docs, params, tests);
+    if (miss)
+        fail_msg("%s = %s: not quoted in docs/solver.md, not in docs/parameters.md or no test "
+                 "names %s of it",
+                 param, miss, prefix);
+    free(docs);
+    free(params);
+    free(tests);
+}
+
 static void test_registry_boundary_modes(void **state) {
     (void)state;
     size_t n;
@@ -99,19 +117,7 @@ static void test_registry_boundary_modes(void **state) {
         assert_non_null(ops);
         assert_string_equal(cdem_mode_name((cdem_mode)i), modes[i]);
     }
-    char *docs = scratch_read_file("docs/solver.md");
-    char *params = scratch_read_file("docs/parameters.md");
-    char *tests = test_sources();
-    assert_non_null(docs);
-    assert_non_null(params);
-    const char *miss = first_missing(modes, n, "CDEM_MODE_", docs, params, tests);
-    if (miss)
-        fail_msg("boundary.mode = %s: not quoted in docs/solver.md, not in docs/parameters.md "
-                 "or no test names CDEM_MODE_ of it",
-                 miss);
-    free(docs);
-    free(params);
-    free(tests);
+    assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }
 
 static void test_registry_contact_laws(void **state) {
@@ -153,17 +159,7 @@ static void test_registry_contact_laws(void **state) {
                 fail_msg("laws %s and %s give the same sliding force %g", laws[j], laws[i],
                          force[i]);
     }
-    char *docs = scratch_read_file("docs/solver.md");
-    char *params = scratch_read_file("docs/parameters.md");
-    char *tests = test_sources();
-    const char *miss = first_missing(laws, n, "CDEM_LAW_", docs, params, tests);
-    if (miss)
-        fail_msg("material.granular_law = %s: not quoted in docs/solver.md, not in "
-                 "docs/parameters.md or no test names CDEM_LAW_ of it",
-                 miss);
-    free(docs);
-    free(params);
-    free(tests);
+    assert_documented_and_tested("material.granular_law", laws, n, "CDEM_LAW_");
 }
 
 /* The checker finds a word left out of the docs, of the parameter page or of the tests. */
