@@ -11,6 +11,8 @@
  * barrier per pass. */
 #include "force.h"
 
+#include "force_pairs.h"
+
 #include <omp.h>
 #include <sched.h>
 #include <stdlib.h>
@@ -42,37 +44,6 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
         f->workcap = c;
     }
     return CDEM_OK;
-}
-
-/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
- * the common case of a list pair that does not touch is settled here, everything else by
- * the one contact kernel (contact.h). (A branch-free variant of the granular law,
- * evaluating every list pair and selecting the result, was measured 40-50 % slower: gcc -O2
- * still branches and does more work.) */
-static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
-                                   double dy, double dvx, double dvy, const double *restrict Rp,
-                                   const uint8_t *restrict cls, uint8_t *restrict hist,
-                                   double *restrict xs, double *restrict pfx, double *restrict pfy,
-                                   double dt) {
-    const double R = Rp[p];
-    const uint8_t h = hist[p];
-    const double r2 = dx * dx + dy * dy;
-    if (!(h & CDEM_PAIR_BONDED)) {
-        if (r2 >= R * R || r2 <= 0.0) {
-            /* separated: xs != 0 only with h != 0 */
-            pfx[p] = 0.0;
-            pfy[p] = 0.0;
-            if (h) {
-                hist[p] = cdem_contact_separated(h, r2, R);
-                xs[p] = 0.0;
-            }
-            return;
-        }
-        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
-                              &pfy[p]);
-        return;
-    }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
 }
 
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
@@ -119,9 +90,15 @@ typedef struct {
     int nchunk;           /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
+    int avx2;                        /* 1: the AVX2 block evaluation (force.h, "Paths") */
+    cdem_force_pairs pairs;          /* the same arrays, for the block evaluation */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
+
+/* Pairs the vector path evaluates before scattering them: their slots (about 40 bytes a
+ * pair) and most of their elements stay in the L1 cache until the scatter reads them. */
+#define PAIR_BLOCK 128
 
 /* How many cross pairs a chunk evaluates between two publications of its progress: small
  * enough that an earlier chunk seldom waits, large enough that the shared line is rarely
@@ -166,8 +143,8 @@ static void cross_eval(const force_pass *fp, int c) {
     for (int32_t k = a; k < b; k++) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
-        pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                   fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+        cdem_force_pair(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                        fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
@@ -205,21 +182,33 @@ static void chunk_pass(force_pass *fp, int chunk) {
     const long p0 = istart[lo], pe = istart[hi];
     /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
     int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
-    for (long p = p0; p < pe; p++) {
-        const int32_t i = pi[p], j = pj[p];
-        if (j < hi) {
-            pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                       fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
-            fx[j] -= pfx[p];
-            fy[j] -= pfy[p];
-            fx[i] += pfx[p];
-            fy[i] += pfy[p];
-        } else {
-            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
-            if (p >= safe)
-                safe = wait_cross(fp, chunk, (int32_t)p + 1);
-            fx[i] += fp->pfx[p];
-            fy[i] += fp->pfy[p];
+    /* the vector path evaluates a block of pairs into their slots, then scatters it; the
+     * scalar path evaluates each pair where it scatters it (one block). Either way every
+     * element's sum has the same additions in the same order. */
+    const int avx2 = fp->avx2;
+    const long block = avx2 ? PAIR_BLOCK : (pe > p0 ? pe - p0 : 1);
+    for (long b = p0; b < pe; b += block) {
+        const long be = pe - b > block ? b + block : pe;
+        if (avx2)
+            cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
+        for (long p = b; p < be; p++) {
+            const int32_t i = pi[p], j = pj[p];
+            if (j < hi) {
+                if (!avx2)
+                    cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i],
+                                    fp->Rp, fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+                fx[j] -= pfx[p];
+                fy[j] -= pfy[p];
+                fx[i] += pfx[p];
+                fy[i] += pfy[p];
+            } else {
+                /* a cross pair: evaluated by the chunk of j (not through the restrict
+                 * pointers) */
+                if (p >= safe)
+                    safe = wait_cross(fp, chunk, (int32_t)p + 1);
+                fx[i] += fp->pfx[p];
+                fy[i] += fp->pfy[p];
+            }
         }
     }
     /* the cross pairs out of this chunk read its velocities: kick only after all of them */
@@ -373,6 +362,18 @@ static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t 
     }
 }
 
+cdem_force_path cdem_force_path_choose(const char *request) {
+    if (request && strcmp(request, "scalar") == 0)
+        return CDEM_FORCE_PATH_SCALAR;
+    return cdem_force_avx2_usable() ? CDEM_FORCE_PATH_AVX2 : CDEM_FORCE_PATH_SCALAR;
+}
+
+const char *cdem_force_path_name(cdem_force_path path) {
+    return path == CDEM_FORCE_PATH_AVX2     ? "avx2"
+           : path == CDEM_FORCE_PATH_SCALAR ? "scalar"
+                                            : "auto";
+}
+
 int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n) {
     const long np = (long)nb->np;
     const int want = (np > par_min || n > par_min) ? omp_get_max_threads() : 1;
@@ -422,6 +423,23 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         .vx = s->vx,
         .vy = s->vy,
     };
+    if (f->path == CDEM_FORCE_PATH_AUTO)
+        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    fp.avx2 = f->path == CDEM_FORCE_PATH_AVX2;
+    fp.pairs = (cdem_force_pairs){.law = &lawc,
+                                  .dt = in->dt,
+                                  .x = s->x,
+                                  .y = s->y,
+                                  .vx = s->vx,
+                                  .vy = s->vy,
+                                  .pi = nb->pi,
+                                  .pj = nb->pj,
+                                  .R = nb->R,
+                                  .cls = nb->cls,
+                                  .hist = nb->hist,
+                                  .xs = nb->xs,
+                                  .pfx = nb->pfx,
+                                  .pfy = nb->pfy};
     const int nch = cdem_force_chunks_wanted(nb, in->par_min, n);
     if (f->nchunk != nch || f->chunk_build != nb->n_builds || f->chunk_n != (size_t)n)
         make_chunks(f, nb, s->flags, (size_t)n, nch, in->par_min);

@@ -1,0 +1,189 @@
+/* force_avx2: the AVX2 evaluation of a block of pairs (force_pairs.h), four pairs per step in
+ * the lanes of 256-bit registers: the gathers of the two elements' positions and velocities,
+ * the distance, the touch test, the square root and the division, the normal and the trial
+ * tangential force, and the granular law with masks (blends) where the scalar kernel
+ * branches; the history bytes per lane. A group of four falls back to the scalar kernel when
+ * one of its pairs is an intact bond (bonded model) or belongs to another chunk; so does the
+ * tail of the block. Compiled for the baseline x86-64 like the rest, with target("avx2") on
+ * these functions only, so the scalar path still runs on any x86-64; elsewhere this file
+ * provides cdem_force_avx2_usable() = 0 and the scalar path is the only one. */
+#include "force_pairs.h"
+
+#include <string.h>
+
+#if defined(__GNUC__) && defined(__x86_64__)
+
+#include <immintrin.h>
+
+#define AVX2 __attribute__((target("avx2")))
+
+int cdem_force_avx2_usable(void) {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") ? 1 : 0;
+}
+
+/* The lanes of a vector, lowest first. */
+AVX2 static inline void lanes(__m256d v, double out[4]) {
+    _mm256_storeu_pd(out, v);
+}
+
+/* pj[p] - pi[p] differences of one array for the four pairs. */
+AVX2 static inline __m256d gather_diff(const double *v, __m128i i4, __m128i j4) {
+    return _mm256_sub_pd(_mm256_i32gather_pd(v, j4, 8), _mm256_i32gather_pd(v, i4, 8));
+}
+
+/* The four pairs at p by the scalar kernel (those whose pj is below `below`). */
+AVX2 static void group_scalar(const cdem_force_pairs *a, long p, long end, int32_t below) {
+    for (long q = p; q < end; q++)
+        if (a->pj[q] < below)
+            cdem_force_pair_at(a, q);
+}
+
+/* The separated lanes (mask) with a history: what cdem_force_pair does for them (the force
+ * slots are written by the caller). */
+AVX2 static void separated_lanes(const cdem_force_pairs *a, long p, const uint8_t hb[4], __m256d r2,
+                                 __m256d R, int mask) {
+    double r2l[4], Rl[4];
+    lanes(r2, r2l);
+    lanes(R, Rl);
+    for (int k = 0; k < 4; k++)
+        if (((mask >> k) & 1) && hb[k]) {
+            a->hist[p + k] = cdem_contact_separated(hb[k], r2l[k], Rl[k]);
+            a->xs[p + k] = 0.0;
+        }
+}
+
+AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+    const cdem_contact_law *law = a->law;
+    const int tangential = law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0;
+    const cdem_granular_law glaw = law->granular;
+    const uint8_t coh_new = law->cohesive_new ? CDEM_PAIR_COHESIVE : 0;
+    const uint8_t slip_clears = law->first_slip ? CDEM_PAIR_COHESIVE : 0;
+    const uint32_t bonded4 = 0x01010101u * CDEM_PAIR_BONDED;
+    const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
+    const __m256d one = _mm256_set1_pd(1.0), kn = _mm256_set1_pd(law->kn);
+    const __m256d ks = _mm256_set1_pd(law->ks), dt = _mm256_set1_pd(a->dt);
+    const __m128i below4 = _mm_set1_epi32(below);
+    long p = p0;
+    for (; p + 4 <= p1; p += 4) {
+        const __m128i i4 = _mm_loadu_si128((const __m128i *)(a->pi + p));
+        const __m128i j4 = _mm_loadu_si128((const __m128i *)(a->pj + p));
+        uint32_t h4;
+        memcpy(&h4, a->hist + p, 4);
+        const int own = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(below4, j4)));
+        if (own != 0xF || (h4 & bonded4)) {
+            group_scalar(a, p, p + 4, below);
+            continue;
+        }
+        uint8_t hb[4];
+        memcpy(hb, &h4, 4);
+        const __m256d dx = gather_diff(a->x, i4, j4);
+        const __m256d dy = gather_diff(a->y, i4, j4);
+        const __m256d r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+        const __m256d R = _mm256_loadu_pd(a->R + p);
+        /* separated: r2 >= R^2 or r2 <= 0 (ordered compares: a NaN distance counts as touching,
+         * as in the scalar test) */
+        const __m256d sep = _mm256_or_pd(_mm256_cmp_pd(r2, _mm256_mul_pd(R, R), _CMP_GE_OQ),
+                                         _mm256_cmp_pd(r2, zero, _CMP_LE_OQ));
+        const int sepm = _mm256_movemask_pd(sep);
+        if (sepm == 0xF) {
+            _mm256_storeu_pd(a->pfx + p, zero);
+            _mm256_storeu_pd(a->pfy + p, zero);
+            if (h4)
+                separated_lanes(a, p, hb, r2, R, 0xF);
+            continue;
+        }
+        /* the touching lanes: cdem_contact_touching, operation by operation */
+        const __m256d r = _mm256_sqrt_pd(r2);
+        const __m256d inv = _mm256_div_pd(one, r);
+        const __m256d nx = _mm256_mul_pd(dx, inv), ny = _mm256_mul_pd(dy, inv);
+        const __m256d fn = _mm256_mul_pd(kn, _mm256_sub_pd(R, r));
+        uint8_t hn[4];
+        for (int k = 0; k < 4; k++)
+            hn[k] = (uint8_t)(hb[k] | CDEM_PAIR_TOUCH | ((hb[k] & CDEM_PAIR_TOUCH) ? 0 : coh_new));
+        __m256d ftx = zero, fty = zero;
+        if (tangential) {
+            const __m256d dvx = gather_diff(a->vx, i4, j4);
+            const __m256d dvy = gather_diff(a->vy, i4, j4);
+            const __m256d tx = _mm256_xor_pd(ny, sign), ty = nx;
+            const __m256d xs0 = _mm256_loadu_pd(a->xs + p);
+            __m256d sv = _mm256_add_pd(
+                xs0,
+                _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(dvx, tx), _mm256_mul_pd(dvy, ty)), dt));
+            const __m256d spring = _mm256_mul_pd(ks, sv);
+            const uint8_t *c = a->cls + p;
+            const __m256d mu = _mm256_set_pd(law->friction[c[3]], law->friction[c[2]],
+                                             law->friction[c[1]], law->friction[c[0]]);
+            const __m256d c0 =
+                _mm256_set_pd((hn[3] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[3]] : 0.0,
+                              (hn[2] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[2]] : 0.0,
+                              (hn[1] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[1]] : 0.0,
+                              (hn[0] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[0]] : 0.0);
+            /* the law (law_*.h): the trial force f, its limit; slid = |f| > limit */
+            __m256d f = spring, limit;
+            switch (glaw) {
+            case CDEM_LAW_COULOMB: {
+                const __m256d l = _mm256_mul_pd(mu, fn);
+                limit =
+                    _mm256_blendv_pd(l, _mm256_add_pd(l, c0), _mm256_cmp_pd(c0, zero, _CMP_GT_OQ));
+                break;
+            }
+            case CDEM_LAW_SPRING_COHESION: {
+                limit = _mm256_mul_pd(mu, fn);
+                const __m256d add = _mm256_and_pd(_mm256_cmp_pd(c0, zero, _CMP_GT_OQ),
+                                                  _mm256_cmp_pd(spring, zero, _CMP_NEQ_UQ));
+                const __m256d sc = _mm256_blendv_pd(_mm256_xor_pd(c0, sign), c0,
+                                                    _mm256_cmp_pd(spring, zero, _CMP_GT_OQ));
+                f = _mm256_blendv_pd(spring, _mm256_add_pd(spring, sc), add);
+                break;
+            }
+            default:
+                limit = _mm256_mul_pd(mu, _mm256_add_pd(fn, c0));
+                break;
+            }
+            const __m256d slid = _mm256_cmp_pd(_mm256_andnot_pd(sign, f), limit, _CMP_GT_OQ);
+            const __m256d capped = _mm256_blendv_pd(_mm256_xor_pd(limit, sign), limit,
+                                                    _mm256_cmp_pd(f, zero, _CMP_GT_OQ));
+            const __m256d force = _mm256_blendv_pd(f, capped, slid);
+            const int slidm = _mm256_movemask_pd(slid);
+            if (slidm)
+                sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
+            /* separated lanes keep their value here (set to 0 below when they have a history) */
+            _mm256_storeu_pd(a->xs + p, _mm256_blendv_pd(sv, xs0, sep));
+            for (int k = 0; k < 4; k++)
+                if ((slidm >> k) & 1)
+                    hn[k] &= (uint8_t)~slip_clears;
+            ftx = _mm256_mul_pd(force, tx);
+            fty = _mm256_mul_pd(force, ty);
+        }
+        const __m256d nfn = _mm256_xor_pd(fn, sign);
+        const __m256d fx = _mm256_add_pd(_mm256_mul_pd(nfn, nx), ftx);
+        const __m256d fy = _mm256_add_pd(_mm256_mul_pd(nfn, ny), fty);
+        _mm256_storeu_pd(a->pfx + p, _mm256_blendv_pd(fx, zero, sep));
+        _mm256_storeu_pd(a->pfy + p, _mm256_blendv_pd(fy, zero, sep));
+        if (sepm) {
+            for (int k = 0; k < 4; k++)
+                if ((sepm >> k) & 1)
+                    hn[k] = hb[k];
+            memcpy(a->hist + p, hn, 4);
+            separated_lanes(a, p, hb, r2, R, sepm);
+        } else {
+            memcpy(a->hist + p, hn, 4);
+        }
+    }
+    group_scalar(a, p, p1, below);
+}
+
+#else
+
+int cdem_force_avx2_usable(void) {
+    return 0;
+}
+
+void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+    for (long p = p0; p < p1; p++)
+        if (a->pj[p] < below)
+            cdem_force_pair_at(a, p);
+}
+
+#endif
