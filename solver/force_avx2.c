@@ -53,44 +53,67 @@ AVX2 static void separated_lanes(const cdem_force_pairs *a, long p, const uint8_
         }
 }
 
+/* A byte mask per bit of a 4-bit lane mask: byte k of lane_bytes[m] is 0xff when bit k of m
+ * is set (the history bytes of four pairs handled as one 32-bit word). */
+static const uint32_t lane_bytes[16] = {0x00000000u, 0x000000ffu, 0x0000ff00u, 0x0000ffffu,
+                                        0x00ff0000u, 0x00ff00ffu, 0x00ffff00u, 0x00ffffffu,
+                                        0xff000000u, 0xff0000ffu, 0xff00ff00u, 0xff00ffffu,
+                                        0xffff0000u, 0xffff00ffu, 0xffffff00u, 0xffffffffu};
+
 AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
     const cdem_contact_law *law = a->law;
     const int tangential = law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0;
     const cdem_granular_law glaw = law->granular;
-    const uint8_t coh_new = law->cohesive_new ? CDEM_PAIR_COHESIVE : 0;
-    const uint8_t slip_clears = law->first_slip ? CDEM_PAIR_COHESIVE : 0;
-    const uint32_t bonded4 = 0x01010101u * CDEM_PAIR_BONDED;
+    /* the history rules on four bytes at once: every byte's TOUCH bit set, COHESIVE added to
+     * the bytes that were not touching when forming contacts are cohesive, COHESIVE cleared on
+     * a slip with first_slip */
+    const uint32_t ones = 0x01010101u;
+    const uint32_t touch4 = ones * CDEM_PAIR_TOUCH, coh4 = ones * CDEM_PAIR_COHESIVE;
+    const uint32_t bonded4 = ones * CDEM_PAIR_BONDED;
+    const uint32_t coh_new4 = law->cohesive_new ? coh4 : 0u;
+    const uint32_t slip_clears4 = law->first_slip ? coh4 : 0u;
+    _Static_assert(CDEM_PAIR_COHESIVE == CDEM_PAIR_TOUCH << 1, "COHESIVE is the bit above TOUCH");
+    /* local copies of the pointers (not restrict: the scalar fallbacks write the same arrays
+     * through a), so that they stay in registers across the history stores */
+    const int32_t *pi = a->pi, *pj = a->pj;
+    const double *x = a->x, *y = a->y, *vx = a->vx, *vy = a->vy, *Rp = a->R;
+    const uint8_t *cls = a->cls;
+    uint8_t *hist = a->hist;
+    double *xs = a->xs, *pfx = a->pfx, *pfy = a->pfy;
+    const double *friction = law->friction, *cohesion = law->cohesion;
     const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
     const __m256d one = _mm256_set1_pd(1.0), kn = _mm256_set1_pd(law->kn);
     const __m256d ks = _mm256_set1_pd(law->ks), dt = _mm256_set1_pd(a->dt);
+    const __m256i coh_bit = _mm256_set1_epi64x(CDEM_PAIR_COHESIVE);
     const __m128i below4 = _mm_set1_epi32(below);
     long p = p0;
     for (; p + 4 <= p1; p += 4) {
-        const __m128i i4 = _mm_loadu_si128((const __m128i *)(a->pi + p));
-        const __m128i j4 = _mm_loadu_si128((const __m128i *)(a->pj + p));
+        const __m128i i4 = _mm_loadu_si128((const __m128i *)(pi + p));
+        const __m128i j4 = _mm_loadu_si128((const __m128i *)(pj + p));
         uint32_t h4;
-        memcpy(&h4, a->hist + p, 4);
+        memcpy(&h4, hist + p, 4);
         const int own = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(below4, j4)));
         if (own != 0xF || (h4 & bonded4)) {
             group_scalar(a, p, p + 4, below);
             continue;
         }
-        uint8_t hb[4];
-        memcpy(hb, &h4, 4);
-        const __m256d dx = gather_diff(a->x, i4, j4);
-        const __m256d dy = gather_diff(a->y, i4, j4);
+        const __m256d dx = gather_diff(x, i4, j4);
+        const __m256d dy = gather_diff(y, i4, j4);
         const __m256d r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-        const __m256d R = _mm256_loadu_pd(a->R + p);
+        const __m256d R = _mm256_loadu_pd(Rp + p);
         /* separated: r2 >= R^2 or r2 <= 0 (ordered compares: a NaN distance counts as touching,
          * as in the scalar test) */
         const __m256d sep = _mm256_or_pd(_mm256_cmp_pd(r2, _mm256_mul_pd(R, R), _CMP_GE_OQ),
                                          _mm256_cmp_pd(r2, zero, _CMP_LE_OQ));
         const int sepm = _mm256_movemask_pd(sep);
         if (sepm == 0xF) {
-            _mm256_storeu_pd(a->pfx + p, zero);
-            _mm256_storeu_pd(a->pfy + p, zero);
-            if (h4)
+            _mm256_storeu_pd(pfx + p, zero);
+            _mm256_storeu_pd(pfy + p, zero);
+            if (h4) {
+                uint8_t hb[4];
+                memcpy(hb, &h4, 4);
                 separated_lanes(a, p, hb, r2, R, 0xF);
+            }
             continue;
         }
         /* the touching lanes: cdem_contact_touching, operation by operation */
@@ -98,28 +121,27 @@ AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
         const __m256d inv = _mm256_div_pd(one, r);
         const __m256d nx = _mm256_mul_pd(dx, inv), ny = _mm256_mul_pd(dy, inv);
         const __m256d fn = _mm256_mul_pd(kn, _mm256_sub_pd(R, r));
-        uint8_t hn[4];
-        for (int k = 0; k < 4; k++)
-            hn[k] = (uint8_t)(hb[k] | CDEM_PAIR_TOUCH | ((hb[k] & CDEM_PAIR_TOUCH) ? 0 : coh_new));
+        uint32_t hn4 = h4 | touch4 | (((~h4 & touch4) << 1) & coh_new4);
         __m256d ftx = zero, fty = zero;
         if (tangential) {
-            const __m256d dvx = gather_diff(a->vx, i4, j4);
-            const __m256d dvy = gather_diff(a->vy, i4, j4);
+            const __m256d dvx = gather_diff(vx, i4, j4);
+            const __m256d dvy = gather_diff(vy, i4, j4);
             const __m256d tx = _mm256_xor_pd(ny, sign), ty = nx;
-            const __m256d xs0 = _mm256_loadu_pd(a->xs + p);
+            const __m256d xs0 = _mm256_loadu_pd(xs + p);
             __m256d sv = _mm256_add_pd(
                 xs0,
                 _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(dvx, tx), _mm256_mul_pd(dvy, ty)), dt));
             const __m256d spring = _mm256_mul_pd(ks, sv);
-            const uint8_t *c = a->cls + p;
-            const __m256d mu = _mm256_set_pd(law->friction[c[3]], law->friction[c[2]],
-                                             law->friction[c[1]], law->friction[c[0]]);
+            uint32_t c4;
+            memcpy(&c4, cls + p, 4);
+            const __m128i cl = _mm_cvtepu8_epi32(_mm_cvtsi32_si128((int)c4));
+            const __m256d mu = _mm256_i32gather_pd(friction, cl, 8);
+            const __m256i cohesive = _mm256_cmpeq_epi64(
+                _mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)hn4)), coh_bit),
+                coh_bit);
             const __m256d c0 =
-                _mm256_set_pd((hn[3] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[3]] : 0.0,
-                              (hn[2] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[2]] : 0.0,
-                              (hn[1] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[1]] : 0.0,
-                              (hn[0] & CDEM_PAIR_COHESIVE) ? law->cohesion[c[0]] : 0.0);
-            /* the law (law_*.h): the trial force f, its limit; slid = |f| > limit */
+                _mm256_and_pd(_mm256_i32gather_pd(cohesion, cl, 8), _mm256_castsi256_pd(cohesive));
+            /* the law (law_*.h): the trial force f and its limit; slid = |f| > limit */
             __m256d f = spring, limit;
             switch (glaw) {
             case CDEM_LAW_COULOMB: {
@@ -145,30 +167,26 @@ AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
             const __m256d capped = _mm256_blendv_pd(_mm256_xor_pd(limit, sign), limit,
                                                     _mm256_cmp_pd(f, zero, _CMP_GT_OQ));
             const __m256d force = _mm256_blendv_pd(f, capped, slid);
-            const int slidm = _mm256_movemask_pd(slid);
-            if (slidm)
-                sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
+            sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
             /* separated lanes keep their value here (set to 0 below when they have a history) */
-            _mm256_storeu_pd(a->xs + p, _mm256_blendv_pd(sv, xs0, sep));
-            for (int k = 0; k < 4; k++)
-                if ((slidm >> k) & 1)
-                    hn[k] &= (uint8_t)~slip_clears;
+            _mm256_storeu_pd(xs + p, _mm256_blendv_pd(sv, xs0, sep));
+            hn4 &= ~(lane_bytes[_mm256_movemask_pd(slid)] & slip_clears4);
             ftx = _mm256_mul_pd(force, tx);
             fty = _mm256_mul_pd(force, ty);
         }
         const __m256d nfn = _mm256_xor_pd(fn, sign);
         const __m256d fx = _mm256_add_pd(_mm256_mul_pd(nfn, nx), ftx);
         const __m256d fy = _mm256_add_pd(_mm256_mul_pd(nfn, ny), fty);
-        _mm256_storeu_pd(a->pfx + p, _mm256_blendv_pd(fx, zero, sep));
-        _mm256_storeu_pd(a->pfy + p, _mm256_blendv_pd(fy, zero, sep));
-        if (sepm) {
-            for (int k = 0; k < 4; k++)
-                if ((sepm >> k) & 1)
-                    hn[k] = hb[k];
-            memcpy(a->hist + p, hn, 4);
+        _mm256_storeu_pd(pfx + p, _mm256_blendv_pd(fx, zero, sep));
+        _mm256_storeu_pd(pfy + p, _mm256_blendv_pd(fy, zero, sep));
+        /* separated lanes keep their byte here; those with a history are finished below */
+        const uint32_t sepb = lane_bytes[sepm];
+        const uint32_t out4 = (hn4 & ~sepb) | (h4 & sepb);
+        memcpy(hist + p, &out4, 4);
+        if (h4 & sepb) {
+            uint8_t hb[4];
+            memcpy(hb, &h4, 4);
             separated_lanes(a, p, hb, r2, R, sepm);
-        } else {
-            memcpy(a->hist + p, hn, 4);
         }
     }
     group_scalar(a, p, p1, below);
