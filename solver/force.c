@@ -151,6 +151,80 @@ static void cross_eval(const force_pass *fp, int c) {
     publish_cross(fp, c, INT32_MAX);
 }
 
+/* The scalar path over the chunk's pairs p0..pe-1 (elements below hi are the chunk's or
+ * earlier): each pair evaluated and scattered at once, in slot order. `safe` as in
+ * chunk_pass; returns its new value. */
+static int32_t pairs_scalar(force_pass *fp, int chunk, long p0, long pe, long hi, int32_t safe) {
+    const cdem_contact_law *restrict law = fp->law;
+    const double *restrict x = fp->x, *restrict y = fp->y;
+    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
+    double *restrict fx = fp->fx, *restrict fy = fp->fy;
+    double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+    const double dt = fp->dt;
+    for (long p = p0; p < pe; p++) {
+        const int32_t i = pi[p], j = pj[p];
+        if (j < hi) {
+            cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                            fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+            fx[j] -= pfx[p];
+            fy[j] -= pfy[p];
+            fx[i] += pfx[p];
+            fy[i] += pfy[p];
+        } else {
+            /* a cross pair: evaluated by the chunk of j (not through the restrict pointers) */
+            if (p >= safe)
+                safe = wait_cross(fp, chunk, (int32_t)p + 1);
+            fx[i] += fp->pfx[p];
+            fy[i] += fp->pfy[p];
+        }
+    }
+    return safe;
+}
+
+/* The scatter of the evaluated pairs b..be-1, in slot order, as pairs_scalar's; cross says
+ * whether the range has cross pairs (pj >= hi) at all. */
+static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long be, long hi,
+                                         int32_t safe, int cross) {
+    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
+    double *restrict fx = fp->fx, *restrict fy = fp->fy;
+    if (!cross) {
+        const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+        for (long p = b; p < be; p++) {
+            const int32_t i = pi[p], j = pj[p];
+            const double ux = pfx[p], uy = pfy[p];
+            fx[j] -= ux;
+            fy[j] -= uy;
+            fx[i] += ux;
+            fy[i] += uy;
+        }
+        return safe;
+    }
+    for (long p = b; p < be; p++) {
+        const int32_t i = pi[p], j = pj[p];
+        if (j < hi) {
+            fx[j] -= fp->pfx[p];
+            fy[j] -= fp->pfy[p];
+        } else if (p >= safe) {
+            safe = wait_cross(fp, chunk, (int32_t)p + 1);
+        }
+        fx[i] += fp->pfx[p];
+        fy[i] += fp->pfy[p];
+    }
+    return safe;
+}
+
+/* The vector path over the chunk's pairs p0..pe-1: blocks of PAIR_BLOCK pairs evaluated
+ * into their slots four at a time (force_avx2.c), then scattered in slot order. */
+static int32_t pairs_avx2(force_pass *fp, int chunk, long p0, long pe, long hi, int32_t safe) {
+    for (long b = p0; b < pe; b += PAIR_BLOCK) {
+        const long be = pe - b > PAIR_BLOCK ? b + PAIR_BLOCK : pe;
+        const long cross = cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
+        safe = scatter_block(fp, chunk, b, be, hi, safe, cross > 0);
+    }
+    return safe;
+}
+
 /* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
  * istart[hi]-1). Every element's sum is built in ascending pair order, as one scatter loop
  * over all pairs would: fx, fy of the chunk start at zero, the cross pairs from earlier
@@ -162,55 +236,28 @@ static void cross_eval(const force_pass *fp, int c) {
  * mispredict their exits.) */
 static void chunk_pass(force_pass *fp, int chunk) {
     const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
-    const int32_t *restrict list = fp->cross;
-    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
-    const cdem_contact_law *restrict law = fp->law;
-    const double *restrict x = fp->x, *restrict y = fp->y;
+    const int32_t *restrict istart = fp->istart;
     double *restrict vx = fp->vx, *restrict vy = fp->vy;
-    const int32_t *restrict pj = fp->pj, *restrict istart = fp->istart;
+    const double *restrict x = fp->x;
     double *restrict fx = fp->fx, *restrict fy = fp->fy;
-    double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
-    const double dt = fp->dt;
     memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
     memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
-    for (int32_t k = ca; k < cb; k++) {
-        const long p = list[k];
-        fx[pj[p]] -= pfx[p];
-        fy[pj[p]] -= pfy[p];
+    {
+        const int32_t *restrict list = fp->cross, *restrict pj = fp->pj;
+        const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+        const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
+        for (int32_t k = ca; k < cb; k++) {
+            const long p = list[k];
+            fx[pj[p]] -= pfx[p];
+            fy[pj[p]] -= pfy[p];
+        }
     }
-    const int32_t *restrict pi = fp->pi;
     const long p0 = istart[lo], pe = istart[hi];
     /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
     int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
-    /* the vector path evaluates a block of pairs into their slots, then scatters it; the
-     * scalar path evaluates each pair where it scatters it (one block). Either way every
-     * element's sum has the same additions in the same order. */
-    const int avx2 = fp->avx2;
-    const long block = avx2 ? PAIR_BLOCK : (pe > p0 ? pe - p0 : 1);
-    for (long b = p0; b < pe; b += block) {
-        const long be = pe - b > block ? b + block : pe;
-        if (avx2)
-            cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
-        for (long p = b; p < be; p++) {
-            const int32_t i = pi[p], j = pj[p];
-            if (j < hi) {
-                if (!avx2)
-                    cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i],
-                                    fp->Rp, fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
-                fx[j] -= pfx[p];
-                fy[j] -= pfy[p];
-                fx[i] += pfx[p];
-                fy[i] += pfy[p];
-            } else {
-                /* a cross pair: evaluated by the chunk of j (not through the restrict
-                 * pointers) */
-                if (p >= safe)
-                    safe = wait_cross(fp, chunk, (int32_t)p + 1);
-                fx[i] += fp->pfx[p];
-                fy[i] += fp->pfy[p];
-            }
-        }
-    }
+    /* either path: every element's sum has the same additions in the same order */
+    safe = fp->avx2 ? pairs_avx2(fp, chunk, p0, pe, hi, safe)
+                    : pairs_scalar(fp, chunk, p0, pe, hi, safe);
     /* the cross pairs out of this chunk read its velocities: kick only after all of them */
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);

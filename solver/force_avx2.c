@@ -33,10 +33,15 @@ AVX2 static inline __m256d gather_diff(const double *v, __m128i i4, __m128i j4) 
 }
 
 /* The four pairs at p by the scalar kernel (those whose pj is below `below`). */
-AVX2 static void group_scalar(const cdem_force_pairs *a, long p, long end, int32_t below) {
-    for (long q = p; q < end; q++)
+AVX2 static long group_scalar(const cdem_force_pairs *a, long p, long end, int32_t below) {
+    long left = 0;
+    for (long q = p; q < end; q++) {
         if (a->pj[q] < below)
             cdem_force_pair_at(a, q);
+        else
+            left++;
+    }
+    return left;
 }
 
 /* The separated lanes (mask) with a history: what cdem_force_pair does for them (the force
@@ -60,7 +65,7 @@ static const uint32_t lane_bytes[16] = {0x00000000u, 0x000000ffu, 0x0000ff00u, 0
                                         0xff000000u, 0xff0000ffu, 0xff00ff00u, 0xff00ffffu,
                                         0xffff0000u, 0xffff00ffu, 0xffffff00u, 0xffffffffu};
 
-AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
     const cdem_contact_law *law = a->law;
     const int tangential = law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0;
     const cdem_granular_law glaw = law->granular;
@@ -86,7 +91,7 @@ AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
     const __m256d ks = _mm256_set1_pd(law->ks), dt = _mm256_set1_pd(a->dt);
     const __m256i coh_bit = _mm256_set1_epi64x(CDEM_PAIR_COHESIVE);
     const __m128i below4 = _mm_set1_epi32(below);
-    long p = p0;
+    long p = p0, left = 0;
     for (; p + 4 <= p1; p += 4) {
         const __m128i i4 = _mm_loadu_si128((const __m128i *)(pi + p));
         const __m128i j4 = _mm_loadu_si128((const __m128i *)(pj + p));
@@ -94,7 +99,7 @@ AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
         memcpy(&h4, hist + p, 4);
         const int own = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(below4, j4)));
         if (own != 0xF || (h4 & bonded4)) {
-            group_scalar(a, p, p + 4, below);
+            left += group_scalar(a, p, p + 4, below);
             continue;
         }
         const __m256d dx = gather_diff(x, i4, j4);
@@ -189,7 +194,7 @@ AVX2 void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
             separated_lanes(a, p, hb, r2, R, sepm);
         }
     }
-    group_scalar(a, p, p1, below);
+    return left + group_scalar(a, p, p1, below);
 }
 
 #else
@@ -198,10 +203,15 @@ int cdem_force_avx2_usable(void) {
     return 0;
 }
 
-void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
-    for (long p = p0; p < p1; p++)
+long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+    long left = 0;
+    for (long p = p0; p < p1; p++) {
         if (a->pj[p] < below)
             cdem_force_pair_at(a, p);
+        else
+            left++;
+    }
+    return left;
 }
 
 #endif

@@ -71,7 +71,8 @@ int cdem_force_avx2_usable(void);
 
 /* Evaluates every pair p in p0..p1-1 whose pj is below `below` (the others are left
  * untouched: another chunk evaluates them), exactly as cdem_force_pair would, four at a time
- * in AVX2 lanes. Only call when cdem_force_avx2_usable(). */
-void cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below);
+ * in AVX2 lanes. Returns the number of pairs left (pj >= below). Only call when
+ * cdem_force_avx2_usable(). */
+long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below);
 
 #endif
