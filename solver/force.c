@@ -23,6 +23,7 @@ void cdem_force_free(cdem_force *f) {
         return;
     free(f->cross);
     free(f->elem_work);
+    free(f->acc);
     memset(f, 0, sizeof *f);
 }
 
@@ -42,6 +43,14 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
             return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
         f->elem_work = w;
         f->workcap = c;
+    }
+    if (f->acccap < n) {
+        const size_t c = n + n / 2 + 16;
+        double *a = realloc(f->acc, 2 * c * sizeof *a);
+        if (!a)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+        f->acc = a;
+        f->acccap = c;
     }
     return CDEM_OK;
 }
@@ -91,6 +100,7 @@ typedef struct {
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
     int avx2;                        /* 1: the AVX2 block evaluation (force.h, "Paths") */
+    double *acc;                     /* its interleaved sums (cdem_force acc) */
     cdem_force_pairs pairs;          /* the same arrays, for the block evaluation */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
@@ -182,34 +192,26 @@ static int32_t pairs_scalar(force_pass *fp, int chunk, long p0, long pe, long hi
     return safe;
 }
 
-/* The scatter of the evaluated pairs b..be-1, in slot order, as pairs_scalar's; cross says
- * whether the range has cross pairs (pj >= hi) at all. */
+/* The scatter of the evaluated pairs b..be-1 into the interleaved sums, in slot order, as
+ * pairs_scalar's; cross says whether the range has cross pairs (pj >= hi) at all. */
 static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long be, long hi,
                                          int32_t safe, int cross) {
-    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
-    double *restrict fx = fp->fx, *restrict fy = fp->fy;
     if (!cross) {
-        const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
-        for (long p = b; p < be; p++) {
-            const int32_t i = pi[p], j = pj[p];
-            const double ux = pfx[p], uy = pfy[p];
-            fx[j] -= ux;
-            fy[j] -= uy;
-            fx[i] += ux;
-            fy[i] += uy;
-        }
+        cdem_force_scatter_avx2(&fp->pairs, b, be, fp->acc);
         return safe;
     }
+    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
+    double *restrict acc = fp->acc;
     for (long p = b; p < be; p++) {
-        const int32_t i = pi[p], j = pj[p];
+        const long i = pi[p], j = pj[p];
         if (j < hi) {
-            fx[j] -= fp->pfx[p];
-            fy[j] -= fp->pfy[p];
+            acc[2 * j] -= fp->pfx[p];
+            acc[2 * j + 1] -= fp->pfy[p];
         } else if (p >= safe) {
             safe = wait_cross(fp, chunk, (int32_t)p + 1);
         }
-        fx[i] += fp->pfx[p];
-        fy[i] += fp->pfy[p];
+        acc[2 * i] += fp->pfx[p];
+        acc[2 * i + 1] += fp->pfy[p];
     }
     return safe;
 }
@@ -240,30 +242,47 @@ static void chunk_pass(force_pass *fp, int chunk) {
     double *restrict vx = fp->vx, *restrict vy = fp->vy;
     const double *restrict x = fp->x;
     double *restrict fx = fp->fx, *restrict fy = fp->fy;
-    memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
-    memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
-    {
-        const int32_t *restrict list = fp->cross, *restrict pj = fp->pj;
-        const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
-        const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
-        for (int32_t k = ca; k < cb; k++) {
-            const long p = list[k];
-            fx[pj[p]] -= pfx[p];
-            fy[pj[p]] -= pfy[p];
-        }
-    }
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
     const long p0 = istart[lo], pe = istart[hi];
     /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
     int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
     /* either path: every element's sum has the same additions in the same order */
-    safe = fp->avx2 ? pairs_avx2(fp, chunk, p0, pe, hi, safe)
-                    : pairs_scalar(fp, chunk, p0, pe, hi, safe);
-    /* the cross pairs out of this chunk read its velocities: kick only after all of them */
-    if (pe > safe)
-        wait_cross(fp, chunk, (int32_t)pe);
-    for (long i = lo; i < hi; i++)
-        finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
-                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
+    if (fp->avx2) {
+        double *acc = fp->acc; /* written by pairs_avx2 too: not restrict here */
+        memset(acc + 2 * lo, 0, (size_t)(hi - lo) * 2 * sizeof *acc);
+        for (int32_t k = ca; k < cb; k++) {
+            const long p = fp->cross[k], j = fp->pj[p];
+            acc[2 * j] -= fp->pfx[p];
+            acc[2 * j + 1] -= fp->pfy[p];
+        }
+        safe = pairs_avx2(fp, chunk, p0, pe, hi, safe);
+        /* the cross pairs out of this chunk read its velocities: kick only after all */
+        if (pe > safe)
+            wait_cross(fp, chunk, (int32_t)pe);
+        for (long i = lo; i < hi; i++)
+            finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, vx,
+                           vy, fx, fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef,
+                           fp->exmid);
+    } else {
+        memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
+        memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
+        {
+            const int32_t *restrict list = fp->cross, *restrict pj = fp->pj;
+            const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
+            for (int32_t k = ca; k < cb; k++) {
+                const long p = list[k];
+                fx[pj[p]] -= pfx[p];
+                fy[pj[p]] -= pfy[p];
+            }
+        }
+        safe = pairs_scalar(fp, chunk, p0, pe, hi, safe);
+        /* the cross pairs out of this chunk read its velocities: kick only after all */
+        if (pe > safe)
+            wait_cross(fp, chunk, (int32_t)pe);
+        for (long i = lo; i < hi; i++)
+            finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
+                           fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
+    }
     fp->unstable[chunk] = -1;
     if (fp->radius) {
         /* the run loop's guard (integrate.h): here, while the velocities are in cache */
@@ -472,7 +491,10 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     };
     if (f->path == CDEM_FORCE_PATH_AUTO)
         f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
-    fp.avx2 = f->path == CDEM_FORCE_PATH_AVX2;
+    /* (a pass before the first cdem_force_reserve for this size takes the scalar path: the
+     * same bits) */
+    fp.avx2 = f->path == CDEM_FORCE_PATH_AVX2 && f->acc && f->acccap >= (size_t)n;
+    fp.acc = f->acc;
     fp.pairs = (cdem_force_pairs){.law = &lawc,
                                   .dt = in->dt,
                                   .x = s->x,

@@ -68,6 +68,9 @@ typedef struct {
     int share_n;                         /* nchunk the shares are for (0: none yet) */
     double chunk_share[CDEM_MAX_CHUNKS]; /* fractions of the work, sum 1 */
     double chunk_time[CDEM_MAX_CHUNKS];  /* s per pass, running mean (0: none yet) */
+    double *acc;          /* the vector path's per-element contact-force sums, x and y
+                             interleaved (acc[2e], acc[2e+1]): one 128-bit add per pair end */
+    size_t acccap;        /* elements acc holds */
     cdem_force_path path; /* the pair evaluation (AUTO until the first pass; a caller may set
                              SCALAR, or AVX2 when cdem_force_path_choose(NULL) gives it) */
 } cdem_force;

@@ -200,6 +200,18 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
     return left + group_scalar(a, p, p1, below);
 }
 
+AVX2 void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, double *acc) {
+    const int32_t *restrict pi = a->pi, *restrict pj = a->pj;
+    const double *restrict pfx = a->pfx, *restrict pfy = a->pfy;
+    double *restrict sum = acc;
+    for (long p = p0; p < p1; p++) {
+        const __m128d u = _mm_loadh_pd(_mm_load_sd(pfx + p), pfy + p);
+        double *sj = sum + 2 * (long)pj[p], *si = sum + 2 * (long)pi[p];
+        _mm_storeu_pd(sj, _mm_sub_pd(_mm_loadu_pd(sj), u));
+        _mm_storeu_pd(si, _mm_add_pd(_mm_loadu_pd(si), u));
+    }
+}
+
 #else
 
 int cdem_force_avx2_usable(void) {
@@ -215,6 +227,15 @@ long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t 
             left++;
     }
     return left;
+}
+
+void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, double *acc) {
+    for (long p = p0; p < p1; p++) {
+        acc[2 * a->pj[p]] -= a->pfx[p];
+        acc[2 * a->pj[p] + 1] -= a->pfy[p];
+        acc[2 * a->pi[p]] += a->pfx[p];
+        acc[2 * a->pi[p] + 1] += a->pfy[p];
+    }
 }
 
 #endif

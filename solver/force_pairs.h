@@ -75,4 +75,10 @@ int cdem_force_avx2_usable(void);
  * cdem_force_avx2_usable(). */
 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below);
 
+/* The scatter of the pairs p0..p1-1 (none of them a cross pair) into the interleaved sums
+ * acc (acc[2e], acc[2e+1] = x and y of element e): acc[pj] -= f, acc[pi] += f in slot order,
+ * both components in one 128-bit operation (the same two IEEE additions). Only call when
+ * cdem_force_avx2_usable(). */
+void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, double *acc);
+
 #endif
