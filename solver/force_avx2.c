@@ -173,9 +173,7 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
                                                     _mm256_cmp_pd(f, zero, _CMP_GT_OQ));
             const __m256d force = _mm256_blendv_pd(f, capped, slid);
             const int slidm = _mm256_movemask_pd(slid);
-            /* the division only when a lane slid: the divider is the busiest unit here */
-            if (slidm)
-                sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
+            sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
             /* separated lanes keep their value here (set to 0 below when they have a history) */
             _mm256_storeu_pd(xs + p, _mm256_blendv_pd(sv, xs0, sep));
             hn4 &= ~(lane_bytes[slidm] & slip_clears4);
