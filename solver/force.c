@@ -44,7 +44,10 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
         f->elem_work = w;
         f->workcap = c;
     }
-    if (f->acccap < n) {
+    if (f->path == CDEM_FORCE_PATH_AUTO)
+        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    /* only the vector path's buffer: the scalar path's memory stays as it was */
+    if (f->path == CDEM_FORCE_PATH_AVX2 && f->acccap < n) {
         const size_t c = n + n / 2 + 16;
         double *a = realloc(f->acc, 2 * c * sizeof *a);
         if (!a)
@@ -161,17 +164,53 @@ static void cross_eval(const force_pass *fp, int c) {
     publish_cross(fp, c, INT32_MAX);
 }
 
-/* The scalar path over the chunk's pairs p0..pe-1 (elements below hi are the chunk's or
- * earlier): each pair evaluated and scattered at once, in slot order. `safe` as in
- * chunk_pass; returns its new value. */
-static int32_t pairs_scalar(force_pass *fp, int chunk, long p0, long pe, long hi, int32_t safe) {
+/* The run loop's guard (integrate.h) over the chunk's elements, while the velocities are in
+ * cache: the lowest index whose element moves more than its radius in a step, or -1. */
+static long unstable_in(const force_pass *fp, long lo, long hi) {
+    if (!fp->radius)
+        return -1;
+    const double *restrict rad = fp->radius;
+    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const double dt2 = fp->dt * fp->dt;
+    for (long i = lo; i < hi; i++) {
+        const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
+        if (d2 > rad[i] * rad[i])
+            return i;
+    }
+    return -1;
+}
+
+/* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
+ * istart[hi]-1), scalar path. Every element's sum is built in ascending pair order, as one
+ * scatter loop over all pairs would: fx, fy of the chunk start at zero, the cross pairs from
+ * earlier chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then
+ * the chunk's pairs are evaluated and scattered in order (a pair whose pj lies in a later
+ * chunk was evaluated by that chunk's thread and only adds to its pi here). Then the chunk's
+ * elements are finished. (A loop nested per element, accumulating each pi range in
+ * registers and finishing the element right after it, was measured slower: the short inner
+ * loops mispredict their exits.) */
+static void chunk_pass_scalar(force_pass *fp, int chunk) {
+    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
+    const int32_t *restrict list = fp->cross;
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
     const cdem_contact_law *restrict law = fp->law;
     const double *restrict x = fp->x, *restrict y = fp->y;
-    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
-    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
+    double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const int32_t *restrict pj = fp->pj, *restrict istart = fp->istart;
     double *restrict fx = fp->fx, *restrict fy = fp->fy;
     double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
     const double dt = fp->dt;
+    memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
+    memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
+    for (int32_t k = ca; k < cb; k++) {
+        const long p = list[k];
+        fx[pj[p]] -= pfx[p];
+        fy[pj[p]] -= pfy[p];
+    }
+    const int32_t *restrict pi = fp->pi;
+    const long p0 = istart[lo], pe = istart[hi];
+    /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
+    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
@@ -189,11 +228,17 @@ static int32_t pairs_scalar(force_pass *fp, int chunk, long p0, long pe, long hi
             fy[i] += fp->pfy[p];
         }
     }
-    return safe;
+    /* the cross pairs out of this chunk read its velocities: kick only after all of them */
+    if (pe > safe)
+        wait_cross(fp, chunk, (int32_t)pe);
+    for (long i = lo; i < hi; i++)
+        finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
+                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
+    fp->unstable[chunk] = unstable_in(fp, lo, hi);
 }
 
 /* The scatter of the evaluated pairs b..be-1 into the interleaved sums, in slot order, as
- * pairs_scalar's; cross says whether the range has cross pairs (pj >= hi) at all. */
+ * chunk_pass_scalar's; cross says whether the range has cross pairs (pj >= hi) at all. */
 static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long be, long hi,
                                          int32_t safe, int cross) {
     if (!cross) {
@@ -216,86 +261,41 @@ static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long
     return safe;
 }
 
-/* The vector path over the chunk's pairs p0..pe-1: blocks of PAIR_BLOCK pairs evaluated
- * into their slots four at a time (force_avx2.c), then scattered in slot order. */
-static int32_t pairs_avx2(force_pass *fp, int chunk, long p0, long pe, long hi, int32_t safe) {
+/* chunk_pass_scalar's work on the vector path: the sums in the interleaved buffer acc (zeroed,
+ * the incoming cross pairs subtracted), then blocks of PAIR_BLOCK pairs evaluated into their
+ * slots four at a time (force_avx2.c) and scattered in slot order, then the finish. Each
+ * element's sum has the same additions in the same order as on the scalar path. */
+static void chunk_pass_avx2(force_pass *fp, int chunk) {
+    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
+    const long p0 = fp->istart[lo], pe = fp->istart[hi];
+    double *acc = fp->acc; /* written by scatter_block too: not restrict here */
+    memset(acc + 2 * lo, 0, (size_t)(hi - lo) * 2 * sizeof *acc);
+    for (int32_t k = ca; k < cb; k++) {
+        const long p = fp->cross[k], j = fp->pj[p];
+        acc[2 * j] -= fp->pfx[p];
+        acc[2 * j + 1] -= fp->pfy[p];
+    }
+    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
     for (long b = p0; b < pe; b += PAIR_BLOCK) {
         const long be = pe - b > PAIR_BLOCK ? b + PAIR_BLOCK : pe;
         const long cross = cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
         safe = scatter_block(fp, chunk, b, be, hi, safe, cross > 0);
     }
-    return safe;
+    if (pe > safe)
+        wait_cross(fp, chunk, (int32_t)pe);
+    for (long i = lo; i < hi; i++)
+        finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, fp->vx,
+                       fp->vy, fp->fx, fp->fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, fp->x,
+                       fp->ef, fp->exmid);
+    fp->unstable[chunk] = unstable_in(fp, lo, hi);
 }
 
-/* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
- * istart[hi]-1). Every element's sum is built in ascending pair order, as one scatter loop
- * over all pairs would: fx, fy of the chunk start at zero, the cross pairs from earlier
- * chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then the
- * chunk's pairs are scattered in order (a pair whose pj lies in a later chunk was evaluated
- * by that chunk's thread and only adds to its pi here). Then the chunk's elements are
- * finished. (A loop nested per element, accumulating each pi range in registers and
- * finishing the element right after it, was measured slower: the short inner loops
- * mispredict their exits.) */
 static void chunk_pass(force_pass *fp, int chunk) {
-    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
-    const int32_t *restrict istart = fp->istart;
-    double *restrict vx = fp->vx, *restrict vy = fp->vy;
-    const double *restrict x = fp->x;
-    double *restrict fx = fp->fx, *restrict fy = fp->fy;
-    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
-    const long p0 = istart[lo], pe = istart[hi];
-    /* cross pairs at slots below `safe` are evaluated (the last chunk has none out) */
-    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
-    /* either path: every element's sum has the same additions in the same order */
-    if (fp->avx2) {
-        double *acc = fp->acc; /* written by pairs_avx2 too: not restrict here */
-        memset(acc + 2 * lo, 0, (size_t)(hi - lo) * 2 * sizeof *acc);
-        for (int32_t k = ca; k < cb; k++) {
-            const long p = fp->cross[k], j = fp->pj[p];
-            acc[2 * j] -= fp->pfx[p];
-            acc[2 * j + 1] -= fp->pfy[p];
-        }
-        safe = pairs_avx2(fp, chunk, p0, pe, hi, safe);
-        /* the cross pairs out of this chunk read its velocities: kick only after all */
-        if (pe > safe)
-            wait_cross(fp, chunk, (int32_t)pe);
-        for (long i = lo; i < hi; i++)
-            finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, vx,
-                           vy, fx, fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef,
-                           fp->exmid);
-    } else {
-        memset(fx + lo, 0, (size_t)(hi - lo) * sizeof *fx);
-        memset(fy + lo, 0, (size_t)(hi - lo) * sizeof *fy);
-        {
-            const int32_t *restrict list = fp->cross, *restrict pj = fp->pj;
-            const double *restrict pfx = fp->pfx, *restrict pfy = fp->pfy;
-            for (int32_t k = ca; k < cb; k++) {
-                const long p = list[k];
-                fx[pj[p]] -= pfx[p];
-                fy[pj[p]] -= pfy[p];
-            }
-        }
-        safe = pairs_scalar(fp, chunk, p0, pe, hi, safe);
-        /* the cross pairs out of this chunk read its velocities: kick only after all */
-        if (pe > safe)
-            wait_cross(fp, chunk, (int32_t)pe);
-        for (long i = lo; i < hi; i++)
-            finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
-                           fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
-    }
-    fp->unstable[chunk] = -1;
-    if (fp->radius) {
-        /* the run loop's guard (integrate.h): here, while the velocities are in cache */
-        const double *restrict rad = fp->radius;
-        const double dt2 = fp->dt * fp->dt;
-        for (long i = lo; i < hi; i++) {
-            const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
-            if (d2 > rad[i] * rad[i]) {
-                fp->unstable[chunk] = i;
-                break;
-            }
-        }
-    }
+    if (fp->avx2)
+        chunk_pass_avx2(fp, chunk);
+    else
+        chunk_pass_scalar(fp, chunk);
 }
 
 /* Relative costs of the work of a step (measured at 9,000 elements: a touching pair's law
