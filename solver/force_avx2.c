@@ -139,13 +139,21 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
             const __m256d spring = _mm256_mul_pd(ks, sv);
             uint32_t c4;
             memcpy(&c4, cls + p, 4);
-            const __m128i cl = _mm_cvtepu8_epi32(_mm_cvtsi32_si128((int)c4));
-            const __m256d mu = _mm256_i32gather_pd(friction, cl, 8);
+            /* the class values: one class in all four lanes is the common case (broadcast);
+             * else gathered */
+            __m256d mu, coh;
+            if (c4 == (c4 & 0xffu) * ones) {
+                mu = _mm256_broadcast_sd(friction + (c4 & 0xffu));
+                coh = _mm256_broadcast_sd(cohesion + (c4 & 0xffu));
+            } else {
+                const __m128i cl = _mm_cvtepu8_epi32(_mm_cvtsi32_si128((int)c4));
+                mu = _mm256_i32gather_pd(friction, cl, 8);
+                coh = _mm256_i32gather_pd(cohesion, cl, 8);
+            }
             const __m256i cohesive = _mm256_cmpeq_epi64(
                 _mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)hn4)), coh_bit),
                 coh_bit);
-            const __m256d c0 =
-                _mm256_and_pd(_mm256_i32gather_pd(cohesion, cl, 8), _mm256_castsi256_pd(cohesive));
+            const __m256d c0 = _mm256_and_pd(coh, _mm256_castsi256_pd(cohesive));
             /* the law (law_*.h): the trial force f and its limit; slid = |f| > limit */
             __m256d f = spring, limit;
             switch (glaw) {
