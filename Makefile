@@ -27,7 +27,9 @@ OPT     ?= -O2
 # `make fuzz` swap.
 CFLAGS  ?=
 # -fno-math-errno: sqrt inlines without the errno branch (the results are the same IEEE values)
-CDEM_CFLAGS := $(OPT) -g -fno-math-errno
+# -ffp-contract=off: no fused multiply-adds, whatever -march a user adds, so the scalar and
+# the AVX2 force paths (and any two builds) round the same operations the same way
+CDEM_CFLAGS := $(OPT) -g -fno-math-errno -ffp-contract=off
 CDEM_CFLAGS += -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE \
                -MMD -MP
 # (after the layer's include paths: a library's header never shadows one of ours)

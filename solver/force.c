@@ -11,6 +11,8 @@
  * barrier per pass. */
 #include "force.h"
 
+#include "force_pairs.h"
+
 #include <omp.h>
 #include <sched.h>
 #include <stdlib.h>
@@ -21,6 +23,7 @@ void cdem_force_free(cdem_force *f) {
         return;
     free(f->cross);
     free(f->elem_work);
+    free(f->acc);
     memset(f, 0, sizeof *f);
 }
 
@@ -41,38 +44,18 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
         f->elem_work = w;
         f->workcap = c;
     }
-    return CDEM_OK;
-}
-
-/* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
- * the common case of a list pair that does not touch is settled here, everything else by
- * the one contact kernel (contact.h). (A branch-free variant of the granular law,
- * evaluating every list pair and selecting the result, was measured 40-50 % slower: gcc -O2
- * still branches and does more work.) */
-static CDEM_INLINE void pair_force(const cdem_contact_law *restrict law, long p, double dx,
-                                   double dy, double dvx, double dvy, const double *restrict Rp,
-                                   const uint8_t *restrict cls, uint8_t *restrict hist,
-                                   double *restrict xs, double *restrict pfx, double *restrict pfy,
-                                   double dt) {
-    const double R = Rp[p];
-    const uint8_t h = hist[p];
-    const double r2 = dx * dx + dy * dy;
-    if (!(h & CDEM_PAIR_BONDED)) {
-        if (r2 >= R * R || r2 <= 0.0) {
-            /* separated: xs != 0 only with h != 0 */
-            pfx[p] = 0.0;
-            pfy[p] = 0.0;
-            if (h) {
-                hist[p] = cdem_contact_separated(h, r2, R);
-                xs[p] = 0.0;
-            }
-            return;
-        }
-        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
-                              &pfy[p]);
-        return;
+    if (f->path == CDEM_FORCE_PATH_AUTO)
+        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    /* only the vector path's buffer: the scalar path's memory stays as it was */
+    if (f->path == CDEM_FORCE_PATH_AVX2 && f->acccap < n) {
+        const size_t c = n + n / 2 + 16;
+        double *a = realloc(f->acc, 2 * c * sizeof *a);
+        if (!a)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+        f->acc = a;
+        f->acccap = c;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
+    return CDEM_OK;
 }
 
 /* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
@@ -119,9 +102,16 @@ typedef struct {
     int nchunk;           /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
+    int avx2;                        /* 1: the AVX2 block evaluation (force.h, "Paths") */
+    double *acc;                     /* its interleaved sums (cdem_force acc) */
+    cdem_force_pairs pairs;          /* the same arrays, for the block evaluation */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
     double seconds[CDEM_MAX_CHUNKS]; /* per thread: time in this pass (load balance) */
 } force_pass;
+
+/* Pairs the vector path evaluates before scattering them: their slots (about 40 bytes a
+ * pair) and most of their elements stay in the L1 cache until the scatter reads them. */
+#define PAIR_BLOCK 128
 
 /* How many cross pairs a chunk evaluates between two publications of its progress: small
  * enough that an earlier chunk seldom waits, large enough that the shared line is rarely
@@ -166,24 +156,40 @@ static void cross_eval(const force_pass *fp, int c) {
     for (int32_t k = a; k < b; k++) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
-        pair_force(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                   fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+        cdem_force_pair(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                        fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
     publish_cross(fp, c, INT32_MAX);
 }
 
+/* The run loop's guard (integrate.h) over the chunk's elements, while the velocities are in
+ * cache: the lowest index whose element moves more than its radius in a step, or -1. */
+static long unstable_in(const force_pass *fp, long lo, long hi) {
+    if (!fp->radius)
+        return -1;
+    const double *restrict rad = fp->radius;
+    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
+    const double dt2 = fp->dt * fp->dt;
+    for (long i = lo; i < hi; i++) {
+        const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
+        if (d2 > rad[i] * rad[i])
+            return i;
+    }
+    return -1;
+}
+
 /* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
- * istart[hi]-1). Every element's sum is built in ascending pair order, as one scatter loop
- * over all pairs would: fx, fy of the chunk start at zero, the cross pairs from earlier
- * chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then the
- * chunk's pairs are scattered in order (a pair whose pj lies in a later chunk was evaluated
- * by that chunk's thread and only adds to its pi here). Then the chunk's elements are
- * finished. (A loop nested per element, accumulating each pi range in registers and
- * finishing the element right after it, was measured slower: the short inner loops
- * mispredict their exits.) */
-static void chunk_pass(force_pass *fp, int chunk) {
+ * istart[hi]-1), scalar path. Every element's sum is built in ascending pair order, as one
+ * scatter loop over all pairs would: fx, fy of the chunk start at zero, the cross pairs from
+ * earlier chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then
+ * the chunk's pairs are evaluated and scattered in order (a pair whose pj lies in a later
+ * chunk was evaluated by that chunk's thread and only adds to its pi here). Then the chunk's
+ * elements are finished. (A loop nested per element, accumulating each pi range in
+ * registers and finishing the element right after it, was measured slower: the short inner
+ * loops mispredict their exits.) */
+static void chunk_pass_scalar(force_pass *fp, int chunk) {
     const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
     const int32_t *restrict list = fp->cross;
     const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
@@ -208,8 +214,8 @@ static void chunk_pass(force_pass *fp, int chunk) {
     for (long p = p0; p < pe; p++) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
-            pair_force(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                       fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+            cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
+                            fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
             fx[i] += pfx[p];
@@ -228,19 +234,68 @@ static void chunk_pass(force_pass *fp, int chunk) {
     for (long i = lo; i < hi; i++)
         finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
                        fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
-    fp->unstable[chunk] = -1;
-    if (fp->radius) {
-        /* the run loop's guard (integrate.h): here, while the velocities are in cache */
-        const double *restrict rad = fp->radius;
-        const double dt2 = fp->dt * fp->dt;
-        for (long i = lo; i < hi; i++) {
-            const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
-            if (d2 > rad[i] * rad[i]) {
-                fp->unstable[chunk] = i;
-                break;
-            }
-        }
+    fp->unstable[chunk] = unstable_in(fp, lo, hi);
+}
+
+/* The scatter of the evaluated pairs b..be-1 into the interleaved sums, in slot order, as
+ * chunk_pass_scalar's; cross says whether the range has cross pairs (pj >= hi) at all. */
+static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long be, long hi,
+                                         int32_t safe, int cross) {
+    if (!cross) {
+        cdem_force_scatter_avx2(&fp->pairs, b, be, fp->acc);
+        return safe;
     }
+    const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
+    double *restrict acc = fp->acc;
+    for (long p = b; p < be; p++) {
+        const long i = pi[p], j = pj[p];
+        if (j < hi) {
+            acc[2 * j] -= fp->pfx[p];
+            acc[2 * j + 1] -= fp->pfy[p];
+        } else if (p >= safe) {
+            safe = wait_cross(fp, chunk, (int32_t)p + 1);
+        }
+        acc[2 * i] += fp->pfx[p];
+        acc[2 * i + 1] += fp->pfy[p];
+    }
+    return safe;
+}
+
+/* chunk_pass_scalar's work on the vector path: the sums in the interleaved buffer acc (zeroed,
+ * the incoming cross pairs subtracted), then blocks of PAIR_BLOCK pairs evaluated into their
+ * slots four at a time (force_avx2.c) and scattered in slot order, then the finish. Each
+ * element's sum has the same additions in the same order as on the scalar path. */
+static void chunk_pass_avx2(force_pass *fp, int chunk) {
+    const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
+    const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
+    const long p0 = fp->istart[lo], pe = fp->istart[hi];
+    double *acc = fp->acc; /* written by scatter_block too: not restrict here */
+    memset(acc + 2 * lo, 0, (size_t)(hi - lo) * 2 * sizeof *acc);
+    for (int32_t k = ca; k < cb; k++) {
+        const long p = fp->cross[k], j = fp->pj[p];
+        acc[2 * j] -= fp->pfx[p];
+        acc[2 * j + 1] -= fp->pfy[p];
+    }
+    int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
+    for (long b = p0; b < pe; b += PAIR_BLOCK) {
+        const long be = pe - b > PAIR_BLOCK ? b + PAIR_BLOCK : pe;
+        const long cross = cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
+        safe = scatter_block(fp, chunk, b, be, hi, safe, cross > 0);
+    }
+    if (pe > safe)
+        wait_cross(fp, chunk, (int32_t)pe);
+    for (long i = lo; i < hi; i++)
+        finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, fp->vx,
+                       fp->vy, fp->fx, fp->fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, fp->x,
+                       fp->ef, fp->exmid);
+    fp->unstable[chunk] = unstable_in(fp, lo, hi);
+}
+
+static void chunk_pass(force_pass *fp, int chunk) {
+    if (fp->avx2)
+        chunk_pass_avx2(fp, chunk);
+    else
+        chunk_pass_scalar(fp, chunk);
 }
 
 /* Relative costs of the work of a step (measured at 9,000 elements: a touching pair's law
@@ -373,6 +428,18 @@ static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t 
     }
 }
 
+cdem_force_path cdem_force_path_choose(const char *request) {
+    if (request && strcmp(request, "scalar") == 0)
+        return CDEM_FORCE_PATH_SCALAR;
+    return cdem_force_avx2_usable() ? CDEM_FORCE_PATH_AVX2 : CDEM_FORCE_PATH_SCALAR;
+}
+
+const char *cdem_force_path_name(cdem_force_path path) {
+    return path == CDEM_FORCE_PATH_AVX2     ? "avx2"
+           : path == CDEM_FORCE_PATH_SCALAR ? "scalar"
+                                            : "auto";
+}
+
 int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n) {
     const long np = (long)nb->np;
     const int want = (np > par_min || n > par_min) ? omp_get_max_threads() : 1;
@@ -422,6 +489,26 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         .vx = s->vx,
         .vy = s->vy,
     };
+    if (f->path == CDEM_FORCE_PATH_AUTO)
+        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    /* (a pass before the first cdem_force_reserve for this size takes the scalar path: the
+     * same bits) */
+    fp.avx2 = f->path == CDEM_FORCE_PATH_AVX2 && f->acc && f->acccap >= (size_t)n;
+    fp.acc = f->acc;
+    fp.pairs = (cdem_force_pairs){.law = &lawc,
+                                  .dt = in->dt,
+                                  .x = s->x,
+                                  .y = s->y,
+                                  .vx = s->vx,
+                                  .vy = s->vy,
+                                  .pi = nb->pi,
+                                  .pj = nb->pj,
+                                  .R = nb->R,
+                                  .cls = nb->cls,
+                                  .hist = nb->hist,
+                                  .xs = nb->xs,
+                                  .pfx = nb->pfx,
+                                  .pfy = nb->pfy};
     const int nch = cdem_force_chunks_wanted(nb, in->par_min, n);
     if (f->nchunk != nch || f->chunk_build != nb->n_builds || f->chunk_n != (size_t)n)
         make_chunks(f, nb, s->flags, (size_t)n, nch, in->par_min);

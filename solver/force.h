@@ -22,6 +22,16 @@
 
 #include <stdatomic.h>
 
+/* Paths: how the pair forces are evaluated. Both give the same bits (force_pairs.h says
+ * how); the vector one is faster where the CPU has AVX2. */
+typedef enum {
+    CDEM_FORCE_PATH_AUTO = 0, /* not chosen yet: the first pass calls cdem_force_path_choose
+                                 with the environment's CDEM_SIMD */
+    CDEM_FORCE_PATH_SCALAR,   /* one pair at a time (any CPU) */
+    CDEM_FORCE_PATH_AVX2,     /* four pairs at a time in AVX2 lanes, blocks of pairs evaluated
+                                 then scattered */
+} cdem_force_path;
+
 /* Largest number of element chunks (threads) of the force pass. */
 #define CDEM_MAX_CHUNKS 64
 
@@ -58,6 +68,11 @@ typedef struct {
     int share_n;                         /* nchunk the shares are for (0: none yet) */
     double chunk_share[CDEM_MAX_CHUNKS]; /* fractions of the work, sum 1 */
     double chunk_time[CDEM_MAX_CHUNKS];  /* s per pass, running mean (0: none yet) */
+    double *acc;          /* the vector path's per-element contact-force sums, x and y
+                             interleaved (acc[2e], acc[2e+1]): one 128-bit add per pair end */
+    size_t acccap;        /* elements acc holds */
+    cdem_force_path path; /* the pair evaluation (AUTO until the first pass; a caller may set
+                             SCALAR, or AVX2 when cdem_force_path_choose(NULL) gives it) */
 } cdem_force;
 
 /* The loads the element finish adds to the contact-force sum of a free element. */
@@ -86,6 +101,14 @@ typedef struct {
 } cdem_force_step;
 
 void cdem_force_free(cdem_force *f);
+
+/* The path for a request ("scalar": the scalar path; anything else or NULL: AVX2 when this
+ * build and the CPU have it, else scalar). CDEM_SIMD=scalar in the environment forces the
+ * scalar path (tests, comparisons). */
+cdem_force_path cdem_force_path_choose(const char *request);
+
+/* "auto", "scalar" or "avx2". */
+const char *cdem_force_path_name(cdem_force_path path);
 
 /* Grows the buffers for the pair list nb of n elements (after each list build, outside the
  * step's hot loops). */

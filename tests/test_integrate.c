@@ -185,26 +185,101 @@ static void make_box(cdem_state *s, int nx, int ny, uint64_t seed) {
         }
 }
 
-static void run_box(int threads, int nsteps, cdem_state *out) {
+/* The materials of the path test: the laws and cohesion rules the vector path implements
+ * with masks, and the bonded model (intact bonds go through the scalar kernel). */
+enum {
+    BOX_DEFAULT, /* normal-cohesion, first slip, cohesive at make_cohesive */
+    BOX_COULOMB, /* coulomb, cohesion lost at separation, forming contacts cohesive */
+    BOX_SPRING,  /* spring-cohesion, initial contacts cohesive */
+    BOX_BONDED,  /* bonded model */
+    BOX_MATERIAL_COUNT
+};
+
+/* make_box(1234) stepped `nsteps` times on `threads` threads with every loop threaded, the
+ * pair forces by `path`, the touching pairs made cohesive half way. Returns the path used
+ * (CDEM_FORCE_PATH_AVX2 is given SCALAR where the CPU has no AVX2). */
+static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, int material,
+                                    cdem_force_path path) {
     omp_set_num_threads(threads);
     const double dt = 0.028;
     cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
-    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    cdem_params p =
+        hand_params(material == BOX_BONDED ? CDEM_MATERIAL_BONDED : CDEM_MATERIAL_GRANULAR);
     p.element.cohesion = 1e7;
+    if (material == BOX_BONDED)
+        p.element.breaking_strain = 0.002;
+    if (material == BOX_COULOMB) {
+        p.granular_law = CDEM_LAW_COULOMB;
+        p.first_slip = 0;
+        p.cohesive_contacts = CDEM_COHESIVE_FORMED;
+    }
+    if (material == BOX_SPRING) {
+        p.granular_law = CDEM_LAW_SPRING_COHESION;
+        p.cohesive_contacts = CDEM_COHESIVE_INITIAL;
+    }
     cdem_integrator it;
     cdem_error err;
     make_box(out, 50, 40, 1234);
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
     cdem_integrator_enable_escape(&it);
     it.par_min = 0; /* thread every loop, whatever its size */
+    if (path == CDEM_FORCE_PATH_AVX2 && cdem_force_path_choose(NULL) != CDEM_FORCE_PATH_AVX2)
+        path = CDEM_FORCE_PATH_SCALAR;
+    it.force.path = path;
+    if (material == BOX_SPRING)
+        cdem_integrator_mark_initial(&it, out);
     for (int k = 0; k < nsteps; k++) {
         assert_int_equal(cdem_integrator_step(&it, out, NULL, 0, 0.0, &err), CDEM_OK);
-        if (k == nsteps / 2)
-            assert_true(cdem_integrator_make_cohesive(&it, out) > 0);
+        if (k == nsteps / 2) {
+            const long made = cdem_integrator_make_cohesive(&it, out);
+            if (material == BOX_DEFAULT)
+                assert_true(made > 0);
+        }
     }
     assert_true(it.nb.np > 2048);
     assert_true(it.nb.n_builds > 1);
+    assert_int_equal(it.force.path, path);
     cdem_integrator_free(&it);
+    return path;
+}
+
+static void run_box(int threads, int nsteps, cdem_state *out) {
+    run_box_with(threads, nsteps, out, BOX_DEFAULT, CDEM_FORCE_PATH_SCALAR);
+}
+
+static void assert_same_state(const cdem_state *a, const cdem_state *b) {
+    assert_int_equal(a->n, b->n);
+    assert_memory_equal(a->id, b->id, a->n * sizeof *a->id);
+    assert_memory_equal(a->x, b->x, a->n * sizeof *a->x);
+    assert_memory_equal(a->y, b->y, a->n * sizeof *a->y);
+    assert_memory_equal(a->vx, b->vx, a->n * sizeof *a->vx);
+    assert_memory_equal(a->vy, b->vy, a->n * sizeof *a->vy);
+    assert_memory_equal(a->fx, b->fx, a->n * sizeof *a->fx);
+    assert_memory_equal(a->fy, b->fy, a->n * sizeof *a->fy);
+}
+
+/* The scalar and the AVX2 force paths (force.h) give the same bits, on 1, 2 and 3 threads,
+ * for every granular law and cohesion rule and the bonded model. */
+static void test_integrate_simd_paths(void **st) {
+    (void)st;
+    if (cdem_force_path_choose(NULL) != CDEM_FORCE_PATH_AVX2)
+        fprintf(stderr, "test_integrate_simd_paths: no AVX2 here, scalar path only\n");
+    assert_int_equal(cdem_force_path_choose("scalar"), CDEM_FORCE_PATH_SCALAR);
+    for (int material = 0; material < BOX_MATERIAL_COUNT; material++) {
+        cdem_state a, b;
+        run_box_with(1, 120, &a, material, CDEM_FORCE_PATH_SCALAR);
+        for (int threads = 1; threads <= 3; threads++) {
+            run_box_with(threads, 120, &b, material, CDEM_FORCE_PATH_AVX2);
+            assert_same_state(&a, &b);
+            cdem_state_free(&b);
+            if (threads > 1) {
+                run_box_with(threads, 120, &b, material, CDEM_FORCE_PATH_SCALAR);
+                assert_same_state(&a, &b);
+                cdem_state_free(&b);
+            }
+        }
+        cdem_state_free(&a);
+    }
 }
 
 /* A settled-looking box stepper for the threaded tests: make_box(seed), granular law, dt
@@ -390,6 +465,7 @@ int main(void) {
         cmocka_unit_test(test_integrate_free_fall),
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
+        cmocka_unit_test(test_integrate_simd_paths),
         cmocka_unit_test(test_integrate_unstable_guard),
         cmocka_unit_test(test_integrate_rebuild_test_in_force_pass),
         cmocka_unit_test(test_integrate_nan_and_escape),
