@@ -52,8 +52,8 @@ check() { # name, then the command
 check default-run "$RUN" -q -o "$TMP/default.h5"
 check default-kinematics $CHECK "$TMP/default.h5" --equil 56 --total 282 --dip 30 --sense normal
 # The default run's file size (issue 18, item 10; docs/format.md, "Size"): at most the
-# original program's 10.1 MB (9.90 MB measured). The run completes, so close drops its two
-# checkpoint slots (0.52 MB; 10.43 MB with them) and compacts the file ("Completed runs");
+# original program's 10.1 MB (9.93 MB measured, docs/measured.md). The run completes, so close drops its two
+# checkpoint slots (0.52 MB; 10.45 MB with them) and compacts the file ("Completed runs");
 # make test checks the same in test_run_output_default_file_size.
 check default-file-size /usr/bin/python3 -c "
 import os, sys, h5py
