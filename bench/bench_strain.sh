@@ -6,7 +6,7 @@
 set -e
 BUILD=${1:-build}
 make -s "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a"
-CFLAGS="-O2 -std=c17 -fopenmp -D_POSIX_C_SOURCE=200809L -Icommon -Ianalysis $(pkg-config --cflags gsl hdf5)"
+CFLAGS="-O2 -std=c17 -fopenmp -D_POSIX_C_SOURCE=200809L -Icommon -Ianalysis/measure -Ianalysis/input -Ianalysis/draw $(pkg-config --cflags gsl hdf5)"
 LIBS="$(pkg-config --libs gsl hdf5) -lm -fopenmp"
 cc $CFLAGS -o "$BUILD/bench_strain" bench/bench_strain.c "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a" $LIBS
 if [ -z "$PYTHON" ]; then

@@ -138,7 +138,7 @@ if has analysis; then
     echo "== 4. Analysis path"
     h5="$WORK/default.h5"
     t0=$(now)
-    OMP_NUM_THREADS=1 "$BUILD/cdem-run" -q -o "$h5"
+    OMP_NUM_THREADS=1 "$BUILD/cdem-run" -q --force -o "$h5"  # the benchmark's own scratch file
     t1=$(now)
     echo "   default run (cdem-run, 1 thread, writes every increment): $(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.1f", b-a}') s, load $(load)"
     "$BUILD/bench_io" "$h5" 3 >"$WORK/io.out"
@@ -172,7 +172,7 @@ if has analysis; then
     sh bench/bench_strain.sh "$BUILD" | sed 's/^/   /'
     echo "   -- renderer on synthetic states (bench/bench_render.c, best of 3 draws):"
     make -s "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a"
-    cc -O2 -std=c17 -D_DEFAULT_SOURCE -Icommon -Ianalysis $(pkg-config --cflags cairo) \
+    cc -O2 -std=c17 -D_DEFAULT_SOURCE -Icommon -Ianalysis/measure -Ianalysis/input -Ianalysis/draw $(pkg-config --cflags cairo) \
         bench/bench_render.c "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a" \
         $(pkg-config --libs cairo) -lgif -lm -fopenmp -o "$BUILD/bench_render"
     "$BUILD/bench_render" "$WORK" render | sed 's/^/   /'
