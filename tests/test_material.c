@@ -4,11 +4,11 @@
  * settling_friction = 1) does both, which shows that the measures can fail.
  *   - extension: the paper's Fig. 7A set-up (30 degree planar normal fault, first slip off)
  *     on a 10 x 2.5 km assembly at default radii, 400 s of equilibration and 600 s (about
- *     420 m) of slip: no void (analysis/measure/voids.h) and no surface steeper than 40 degrees over
- *     1 km (a graben's flanks); version 0.1's material: a cavity or a chasm.
+ *     420 m) of slip: no void (analysis/measure/voids.h) and no surface steeper than 40 degrees
+ * over 1 km (a graben's flanks); version 0.1's material: a cavity or a chasm.
  *   - collapse: the repose test (right wall removed) on the default 10 x 5 km assembly,
- *     2000 s after the wall goes: a slope of 20-40 degrees is fitted (analysis/measure/repose.h) and
- *     nothing is steeper than 60 degrees over 1 km; version 0.1's material: a standing cliff. */
+ *     2000 s after the wall goes: a slope of 20-40 degrees is fitted (analysis/measure/repose.h)
+ * and nothing is steeper than 60 degrees over 1 km; version 0.1's material: a standing cliff. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
