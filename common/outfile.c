@@ -25,15 +25,8 @@ cdem_status cdem_outfile_begin(cdem_outfile *o, const char *path, cdem_error *er
     struct stat sb;
     if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
         return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: it is a folder", path);
-    /* the folder of path: everything before the last '/' ("." when none) */
     char dir[CDEM_OUTFILE_PATH_MAX];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if (slash == path)
-        snprintf(dir, sizeof dir, "/");
-    else
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    cdem_outfile_folder_of(path, dir, sizeof dir);
     if (stat(dir, &sb) != 0)
         return CDEM_FAIL(err, CDEM_ERR_IO, "cannot create %s: folder %s: %s", path, dir,
                          strerror(errno));
@@ -130,4 +123,14 @@ cdem_status cdem_outfile_close_text(cdem_outfile *o, FILE *f, cdem_status st, cd
     if ((fclose(f) != 0 || bad) && st == CDEM_OK)
         st = CDEM_FAIL(err, CDEM_ERR_IO, "error writing %s", o->tmp);
     return cdem_outfile_end(o, st, err);
+}
+
+void cdem_outfile_folder_of(const char *path, char *buf, size_t cap) {
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(buf, cap, ".");
+    else if (slash == path)
+        snprintf(buf, cap, "/");
+    else
+        snprintf(buf, cap, "%.*s", (int)(slash - path), path);
 }

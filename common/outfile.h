@@ -36,6 +36,11 @@ cdem_status cdem_outfile_end(cdem_outfile *o, cdem_status st, cdem_error *err);
  * that name, or a parent that cannot be created, fails with CDEM_ERR_IO naming it. */
 cdem_status cdem_outfile_make_dirs(const char *dir, cdem_error *err);
 
+/* The folder part of path into buf: everything before the last '/', "/" for a file at the
+ * root, "." when path has no '/'. The one definition for every module that checks, syncs or
+ * measures the folder an output goes to. */
+void cdem_outfile_folder_of(const char *path, char *buf, size_t cap);
+
 /* A text output through o: cdem_outfile_begin, then o->tmp opened for writing into *f.
  * On failure (the message names o->tmp) nothing is left behind and *f is NULL. */
 cdem_status cdem_outfile_open_text(cdem_outfile *o, const char *path, FILE **f, cdem_error *err);

@@ -2,6 +2,8 @@
 #define _GNU_SOURCE /* F_OFD_SETLK, F_OFD_GETLK (Linux open-file-description locks) */
 #include "runlock.h"
 
+#include "outfile.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -20,17 +22,6 @@ struct cdem_runlock {
 int cdem_runlock_path(const char *path, char *buf, size_t cap) {
     int n = snprintf(buf, cap, "%s.lock", path ? path : "");
     return n < 0 || (size_t)n >= cap ? -1 : 0;
-}
-
-/* The folder part of path ("." when none) into buf. */
-static void folder_of(const char *path, char *buf, size_t cap) {
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(buf, cap, ".");
-    else if (slash == path)
-        snprintf(buf, cap, "/");
-    else
-        snprintf(buf, cap, "%.*s", (int)(slash - path), path);
 }
 
 /* Reads the holder's line from fd into buf (empty when the file is empty). */
@@ -73,7 +64,7 @@ static int still_at_path(int fd, const char *lock_path) {
 
 static cdem_status open_failure(const char *path, const char *lock_path, int e, cdem_error *err) {
     char dir[4096];
-    folder_of(path, dir, sizeof dir);
+    cdem_outfile_folder_of(path, dir, sizeof dir);
     if (e == ENOENT)
         return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s: folder %s does not exist", path, dir);
     if (e == ENOTDIR)

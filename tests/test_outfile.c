@@ -147,6 +147,20 @@ static void test_outfile_make_dirs(void **state) {
     assert_non_null(strstr(err.msg, "output folder name is empty"));
 }
 
+/* The folder of a path: before the last '/', "/" at the root, "." without a '/'. */
+static void test_outfile_folder_of(void **state) {
+    (void)state;
+    char buf[64];
+    cdem_outfile_folder_of("out/runs/a.h5", buf, sizeof buf);
+    assert_string_equal(buf, "out/runs");
+    cdem_outfile_folder_of("/a.h5", buf, sizeof buf);
+    assert_string_equal(buf, "/");
+    cdem_outfile_folder_of("a.h5", buf, sizeof buf);
+    assert_string_equal(buf, ".");
+    cdem_outfile_folder_of("/tmp/x/", buf, sizeof buf);
+    assert_string_equal(buf, "/tmp/x");
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_outfile_success_renames),
@@ -154,6 +168,7 @@ int main(void) {
         cmocka_unit_test(test_outfile_stale_temporary_removed),
         cmocka_unit_test(test_outfile_refusals),
         cmocka_unit_test(test_outfile_make_dirs),
+        cmocka_unit_test(test_outfile_folder_of),
     };
     return cmocka_run_group_tests(tests, scratch_setup, scratch_teardown);
 }

@@ -10,6 +10,7 @@
  * a failure is not an error of the run, the caller gets a note saying why the file kept its
  * checkpoints. Runs under the writer's lock (runlock.h), which close releases only after. */
 #include "h5_internal.h"
+#include "outfile.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -195,8 +196,7 @@ void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep
     }
     /* the copy needs about the file's size; without it the file stays as it is */
     char dir[4096];
-    const char *slash = strrchr(path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + 1 : 1, slash ? path : ".");
+    cdem_outfile_folder_of(path, dir, sizeof dir);
     struct statvfs vs;
     if (statvfs(dir, &vs) == 0 && (uint64_t)vs.f_bavail * vs.f_frsize < (uint64_t)sb.st_size) {
         snprintf(rep->note, sizeof rep->note,

@@ -4,6 +4,7 @@
  * (estimates measured on the default run, docs/format.md "Size"). The writer repeats the
  * replace check under its lock (h5i_check_replace). */
 #include "h5_internal.h"
+#include "outfile.h"
 
 #include <errno.h>
 #include <math.h>
@@ -48,13 +49,7 @@ cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem
     if (!path || !*path)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_check_free_space: no path");
     char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if (slash == path)
-        snprintf(dir, sizeof dir, "/");
-    else
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    cdem_outfile_folder_of(path, dir, sizeof dir);
     struct statvfs sv;
     if (statvfs(dir, &sv) != 0) {
         int e = errno;

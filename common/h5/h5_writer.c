@@ -11,6 +11,7 @@
  * file as a killed writer would (closing would rewrite the superblock with an end-of-file
  * the disk cannot hold). */
 #include "h5_internal.h"
+#include "outfile.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -73,13 +74,7 @@ cdem_status h5i_commit_flush(cdem_h5_writer *w, cdem_error *err) {
 /* After a rename, the directory entry is durable only once the folder is synced. */
 void h5i_sync_folder_of(const char *path) {
     char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if (slash == path)
-        snprintf(dir, sizeof dir, "/");
-    else
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    cdem_outfile_folder_of(path, dir, sizeof dir);
     int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd >= 0) {
         if (fsync(fd) != 0)
