@@ -5,76 +5,67 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* The /series columns in file order (docs/format.md): the one list of the analysis side,
+ * used by plot-series and series. Integer columns are read as int64. */
 typedef struct {
     const char *name;  /* column name */
     const char *label; /* axis label with unit */
+    size_t offset;     /* offsetof(cdem_series_sample, the column) */
+    int is_int;        /* 1: int64 in the sample */
 } column_def;
 
+#define COL(f, label)                                                                              \
+    { #f, label, offsetof(cdem_series_sample, f), 0 }
+#define ICOL(f, label)                                                                             \
+    { #f, label, offsetof(cdem_series_sample, f), 1 }
 static const column_def columns[] = {
-    {"time", "Time (s)"},
-    {"step", "Time step"},
-    {"kinetic_energy", "Kinetic energy (J/m)"},
-    {"contacts", "Contacts"},
-    {"bonds", "Bonds"},
-    {"n_elements", "Elements"},
-    {"net_displacement", "Net displacement (m)"},
-    {"boundary_force_x", "Boundary force x (N)"},
-    {"boundary_force_y", "Boundary force y (N)"},
-    {"base_force_x", "Base force x (N)"},
-    {"base_force_y", "Base force y (N)"},
-    {"axial_strain", "Axial strain"},
-    {"differential_stress", "Differential stress (N/m)"},
-    {"sea_level", "Sea level (m)"},
-    {"left_wall_force_x", "Left wall force x (N)"},
-    {"left_wall_force_y", "Left wall force y (N)"},
-    {"right_wall_force_x", "Right wall force x (N)"},
-    {"right_wall_force_y", "Right wall force y (N)"},
+    ICOL(step, "Time step"),
+    COL(time, "Time (s)"),
+    COL(kinetic_energy, "Kinetic energy (J/m)"),
+    ICOL(contacts, "Contacts"),
+    ICOL(bonds, "Bonds"),
+    ICOL(n_elements, "Elements"),
+    COL(net_displacement, "Net displacement (m)"),
+    COL(boundary_force_x, "Boundary force x (N)"),
+    COL(boundary_force_y, "Boundary force y (N)"),
+    COL(base_force_x, "Base force x (N)"),
+    COL(base_force_y, "Base force y (N)"),
+    COL(axial_strain, "Axial strain"),
+    COL(differential_stress, "Differential stress (N/m)"),
+    COL(sea_level, "Sea level (m)"),
+    COL(left_wall_force_x, "Left wall force x (N)"),
+    COL(left_wall_force_y, "Left wall force y (N)"),
+    COL(right_wall_force_x, "Right wall force x (N)"),
+    COL(right_wall_force_y, "Right wall force y (N)"),
 };
+#undef COL
+#undef ICOL
 #define N_COLUMNS (sizeof columns / sizeof columns[0])
 
 static double column_value(const cdem_series_sample *s, size_t c) {
-    switch (c) {
-    case 0:
-        return s->time;
-    case 1:
-        return (double)s->step;
-    case 2:
-        return s->kinetic_energy;
-    case 3:
-        return (double)s->contacts;
-    case 4:
-        return (double)s->bonds;
-    case 5:
-        return (double)s->n_elements;
-    case 6:
-        return s->net_displacement;
-    case 7:
-        return s->boundary_force_x;
-    case 8:
-        return s->boundary_force_y;
-    case 9:
-        return s->base_force_x;
-    case 10:
-        return s->base_force_y;
-    case 11:
-        return s->axial_strain;
-    case 12:
-        return s->differential_stress;
-    case 13:
-        return s->sea_level;
-    case 14:
-        return s->left_wall_force_x;
-    case 15:
-        return s->left_wall_force_y;
-    case 16:
-        return s->right_wall_force_x;
-    default:
-        return s->right_wall_force_y;
+    const char *p = (const char *)s + columns[c].offset;
+    if (columns[c].is_int) {
+        int64_t v;
+        memcpy(&v, p, sizeof v);
+        return (double)v;
     }
+    double v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+size_t cdem_cmd_series_column_count(void) {
+    return N_COLUMNS;
+}
+
+const char *cdem_cmd_series_column_name(size_t c) {
+    return c < N_COLUMNS ? columns[c].name : NULL;
 }
 
 cdem_status cdem_cmd_plot_column(const cdem_series_sample *samples, size_t n, const char *name,

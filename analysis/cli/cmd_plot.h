@@ -18,6 +18,11 @@
 
 #include <stddef.h>
 
+/* The /series columns in file order (docs/format.md): their count, and the name of column c
+ * (NULL past the end). */
+size_t cdem_cmd_series_column_count(void);
+const char *cdem_cmd_series_column_name(size_t c);
+
 /* out[k] = column `name` of samples[k] for k < n (names as in docs/format.md /series:
  * time, step, kinetic_energy, contacts, bonds, n_elements, net_displacement,
  * boundary_force_x, boundary_force_y, base_force_x, base_force_y, axial_strain,

@@ -7,16 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-/* The /series columns in file order (docs/format.md). */
-/* clang-format off */
-static const char *const series_names[] = {
-    "step", "time", "kinetic_energy", "contacts", "bonds", "n_elements", "net_displacement",
-    "boundary_force_x", "boundary_force_y", "base_force_x", "base_force_y", "axial_strain",
-    "differential_stress", "sea_level", "left_wall_force_x", "left_wall_force_y",
-    "right_wall_force_x", "right_wall_force_y"};
-/* clang-format on */
-#define N_SERIES_NAMES (sizeof series_names / sizeof series_names[0])
-
 static int cmd_series(const cdem_cmd_options *o) {
     if (!o->file)
         return cdem_cmd_usage(o->help, "missing the run file (RUN.h5)");
@@ -27,28 +17,29 @@ static int cmd_series(const cdem_cmd_options *o) {
     cdem_series_sample *smp = NULL;
     size_t n = 0;
     double *cols = NULL;
+    const size_t nc = cdem_cmd_series_column_count();
     cdem_status st = cdem_h5_reader_read_series(r, &smp, &n, &err);
     cdem_h5_reader_close(r);
-    if (st == CDEM_OK && !(cols = malloc((n ? n : 1) * N_SERIES_NAMES * sizeof *cols)))
+    if (st == CDEM_OK && !(cols = malloc((n ? n : 1) * nc * sizeof *cols)))
         st = CDEM_FAIL(&err, CDEM_ERR_NOMEM, "out of memory for %zu samples", n);
-    for (size_t c = 0; c < N_SERIES_NAMES && st == CDEM_OK; c++)
-        st = cdem_cmd_plot_column(smp, n, series_names[c], cols + c * n, NULL, &err);
+    for (size_t c = 0; c < nc && st == CDEM_OK; c++)
+        st = cdem_cmd_plot_column(smp, n, cdem_cmd_series_column_name(c), cols + c * n, NULL, &err);
     cdem_cmd_output out; /* -o OUT: written to OUT.tmp, renamed on success */
     if (st == CDEM_OK)
         st = cdem_cmd_output_open(&out, o->out, &err);
     if (st == CDEM_OK) {
         FILE *f = out.f;
-        for (size_t c = 0; c < N_SERIES_NAMES; c++)
-            fprintf(f, "%s%s", c ? "," : "", series_names[c]);
+        for (size_t c = 0; c < nc; c++)
+            fprintf(f, "%s%s", c ? "," : "", cdem_cmd_series_column_name(c));
         fputc('\n', f);
         for (size_t k = 0; k < n; k++)
-            for (size_t c = 0; c < N_SERIES_NAMES; c++) {
+            for (size_t c = 0; c < nc; c++) {
                 const double v = cols[c * n + k];
                 if (isfinite(v))
                     fprintf(f, "%s%.17g", c ? "," : "", v);
                 else
                     fprintf(f, "%snan", c ? "," : "");
-                if (c + 1 == N_SERIES_NAMES)
+                if (c + 1 == nc)
                     fputc('\n', f);
             }
         st = cdem_cmd_output_close(&out, st, &err);
