@@ -151,19 +151,17 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     if (run_logging(r) && p->weak_interval != CDEM_WEAK_OFF)
         fprintf(opt->log, "cdem-run: weak/light interval: %ld elements flagged weak\n", n_weak);
     r->erosion_y = INFINITY;
-    double ywall = INFINITY;
-    for (size_t i = 0; i < r->s.n; i++)
-        if (r->s.flags[i] & CDEM_FLAG_WALL)
-            ywall = fmin(ywall, r->s.y[i]);
-    r->base_tol_y = ywall + 0.5 * r->m.radius[0];
-    /* the lateral walls' sides: halfway between the outermost wall elements (the walls only
-     * ever move inward, never past the middle) */
-    double xlo = INFINITY, xhi = -INFINITY;
+    /* the base: wall elements within half a radius of the lowest; the lateral walls' sides:
+     * halfway between the outermost wall elements (walls only ever move inward, never past
+     * the middle) */
+    double ywall = INFINITY, xlo = INFINITY, xhi = -INFINITY;
     for (size_t i = 0; i < r->s.n; i++)
         if (r->s.flags[i] & CDEM_FLAG_WALL) {
+            ywall = fmin(ywall, r->s.y[i]);
             xlo = fmin(xlo, r->s.x[i]);
             xhi = fmax(xhi, r->s.x[i]);
         }
+    r->base_tol_y = ywall + 0.5 * r->m.radius[0];
     r->wall_mid_x = 0.5 * (xlo + xhi);
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
