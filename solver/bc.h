@@ -37,6 +37,12 @@ typedef struct {
      * holding their contact forces of the previous step (biaxial servo platens); 0: apply
      * sees only deformation steps (k >= 1) */
     int moves_in_equilibration;
+    /* 1: apply reads and writes only boundary elements (CDEM_FLAGS_BOUNDARY) and the context,
+     * never a free element, so it commutes exactly with the drift of the free elements: the
+     * stepper then applies it first and drifts inside the force pass's parallel region (one
+     * region a step instead of two). 0 (the safe default for a new mode): apply runs after
+     * the drift, as documented above (biaxial: its servo reads the free elements' extent). */
+    int boundary_only;
     double (*net_displacement)(const void *ctx);
     void (*view)(const void *ctx, FILE *out);
     void (*free)(void *ctx); /* may be NULL when the context owns no memory */
@@ -81,6 +87,9 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
  * apply with k = 0 when it moves boundaries in equilibration (nothing otherwise). */
 cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double dt,
                           cdem_error *err);
+/* 1 when cdem_bc_apply(bc, s, k, ...) touches no free element (ops->boundary_only, or an
+ * equilibration step of a mode that does not move then): it may run before the drift. */
+int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k);
 /* 1 when the mode moves boundaries during equilibration (ops->moves_in_equilibration). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
 double cdem_bc_net_displacement(const cdem_bc *bc);

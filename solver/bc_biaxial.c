@@ -352,6 +352,7 @@ static const cdem_bc_ops biaxial_ops = {
     .init = biaxial_init,               /* adds the top platen */
     .apply = biaxial_apply,             /* moves both platens (servo in equilibration) */
     .moves_in_equilibration = 1,        /* servo platens: isotropic start */
+    .boundary_only = 0,                 /* the servo reads the free elements' extent */
     .net_displacement = biaxial_net,    /* platen closure */
     .view = biaxial_view,               /* view */
     .free = biaxial_free,               /* averaging buffers */

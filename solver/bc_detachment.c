@@ -66,7 +66,7 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             /* the right wall moves left, the left wall right: both inward */
@@ -120,6 +120,7 @@ static const cdem_bc_ops detach_ops = {
     .state_size = sizeof(detach_ctx), /* state_size */
     .init = detach_init,              /* init */
     .apply = detach_apply,            /* apply */
+    .boundary_only = 1,               /* moves boundary elements only */
     .net_displacement = detach_net,   /* net_displacement */
     .view = detach_view,              /* view */
     .free = NULL,                     /* free: the context owns no memory */

@@ -254,7 +254,7 @@ static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, d
     c->sheet -= sgn * du;
     const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
     const long n = (long)s->n;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
     for (long i = 0; i < n; i++) {
         const uint32_t f = s->flags[i];
         if (!(f & CDEM_FLAG_MOVING))
@@ -292,7 +292,7 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
     for (long i = 0; i < n; i++) {
         if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
             (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {
@@ -400,6 +400,7 @@ static const cdem_bc_ops listric_ops = {
     .state_size = sizeof(listric_ctx),
     .init = listric_init,
     .apply = listric_apply,
+    .boundary_only = 1, /* fault, mylar, wall and footwall-display elements only */
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
@@ -412,6 +413,7 @@ static const cdem_bc_ops irregular_ops = {
     .state_size = sizeof(listric_ctx),
     .init = irregular_init,
     .apply = listric_apply,
+    .boundary_only = 1, /* fault, mylar, wall and footwall-display elements only */
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,

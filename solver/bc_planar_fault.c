@@ -129,7 +129,7 @@ static cdem_status planar_apply(void *vctx, cdem_state *s, long k, double du, do
     const long n = (long)s->n;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             x[i] += ux;
@@ -186,6 +186,7 @@ static const cdem_bc_ops planar_ops = {
     .state_size = sizeof(planar_ctx), /* state_size */
     .init = planar_init,              /* init */
     .apply = planar_apply,            /* apply */
+    .boundary_only = 1,               /* moves boundary elements only */
     .net_displacement = planar_net,   /* net_displacement */
     .view = planar_view,              /* view */
     .free = NULL,                     /* free: the context owns no memory */

@@ -72,6 +72,12 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
     return bc->ops->apply(bc->ctx, s, k <= 0 ? 0 : k, du, dt, err);
 }
 
+int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k) {
+    if (!bc || !bc->ops)
+        return 0;
+    return bc->ops->boundary_only || (k <= 0 && !bc->ops->moves_in_equilibration);
+}
+
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
     return bc && bc->ops && bc->ops->moves_in_equilibration;
 }

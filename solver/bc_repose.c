@@ -108,6 +108,7 @@ static const cdem_bc_ops repose_ops = {
     .state_size = sizeof(repose_ctx),  /* state_size */
     .init = repose_init,               /* init */
     .apply = repose_apply,             /* apply */
+    .boundary_only = 1,                /* moves nothing */
     .net_displacement = repose_net,    /* net_displacement */
     .view = repose_view,               /* view */
     .free = NULL,                      /* free: the context owns no memory */

@@ -96,7 +96,7 @@ static cdem_status vert_apply(void *vctx, cdem_state *s, long k, double du, doub
     const long n = (long)s->n;
     double *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN)
+#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
     for (long i = 0; i < n; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             y[i] += uy;
@@ -143,6 +143,7 @@ static const cdem_bc_ops vert_ops = {
     .state_size = sizeof(vert_ctx), /* state_size */
     .init = vert_init,              /* init */
     .apply = vert_apply,            /* apply */
+    .boundary_only = 1,             /* moves boundary elements only */
     .net_displacement = vert_net,   /* net_displacement */
     .view = vert_view,              /* view */
     .free = NULL,                   /* free: the context owns no memory */

@@ -1,4 +1,5 @@
-/* force: see force.h. One pass: the rebuild test (optional), then the pair loop (chunk_pass)
+/* force: see force.h. One pass: the drift (optional), the rebuild test (optional), then the
+ * pair loop (chunk_pass)
  * computes each pair force once into its slot and scatters it to its two elements, then the
  * elements are finished (second half kick, loads, instability test).
  * Threads: the elements are cut into one chunk per thread, by estimated work and then by
@@ -453,6 +454,26 @@ const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour 
     return current ? f->chunk_elem : NULL;
 }
 
+/* The first half kick and drift of the free elements lo..hi-1 (cdem_force_step drift): the
+ * stepper's drift (integrate.c) operation by operation, so the same bits. */
+static void drift_range(cdem_state *s, const cdem_force_step *in, long lo, long hi) {
+    const double dt = in->dt, hdt = 0.5 * in->dt;
+    double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
+    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
+    const uint32_t *restrict flags = s->flags;
+    const double *restrict kd = in->drift_factor;
+    for (long i = lo; i < hi; i++) {
+        if (flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        const double a = kd ? kd[i] : hdt / mass[i];
+        const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
+        vx[i] = hvx;
+        vy[i] = hvy;
+        x[i] += dt * hvx;
+        y[i] += dt * hvy;
+    }
+}
+
 /* The pass (force.h): the parallel driver of chunk_pass; see the top of this file. */
 int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
                     long *unstable) {
@@ -520,6 +541,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     fp.f = f;
     fp.radius = in->unstable_test ? s->radius : NULL;
     if (nchunk == 1) {
+        if (in->drift)
+            drift_range(s, in, 0, n);
         if (check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
             return 1;
         chunk_pass(&fp, 0);
@@ -534,6 +557,9 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         {
             const int t = omp_get_thread_num(), nt = omp_get_num_threads();
             int go = 1;
+            if (in->drift) /* each thread moves the elements it tests and computes next */
+                for (int c = t; c < nchunk; c += nt)
+                    drift_range(s, in, fp.chunk_elem[c], fp.chunk_elem[c + 1]);
             if (check_moved) {
                 int mine = 0;
                 for (int c = t; c < nchunk; c += nt)
@@ -548,6 +574,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
 #pragma omp atomic read
                 any = moved;
                 go = !any;
+            } else if (in->drift) {
+#pragma omp barrier /* every chunk drifted before any thread reads another's positions */
             }
             /* each thread first evaluates the cross pairs into its chunks, then runs them */
             if (go) {

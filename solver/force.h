@@ -98,6 +98,11 @@ typedef struct {
     long par_min;      /* passes over fewer pairs and elements run on one thread */
     int check_moved;   /* 1: first test the rebuild criterion (cdem_neighbour_moved) */
     int unstable_test; /* 1: find the lowest index whose element moved more than its radius */
+    /* 1: first the half kick and drift of the free elements (v += drift_factor F, x += dt v;
+     * drift_factor[i] = (dt/2) / m_i, or NULL: divide), each thread over its own chunks, in
+     * the pass's one parallel region: the stepper's drift phase without a region of its own */
+    int drift;
+    const double *drift_factor;
 } cdem_force_step;
 
 void cdem_force_free(cdem_force *f);
@@ -123,8 +128,9 @@ int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n);
 const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour *nb, size_t n,
                                       int nchunk);
 
-/* One force pass over the pair list nb (matching the state's element count): pair forces,
- * per-element sums and the element finish, threaded over chunks (one parallel region; each
+/* One force pass over the pair list nb (matching the state's element count): the drift
+ * (in->drift), pair forces, per-element sums and the element finish, threaded over chunks
+ * (one parallel region; each
  * thread evaluates the cross pairs into its chunks, publishing its progress, then runs its
  * chunks, waiting only where it meets a cross pair not yet evaluated).
  * check_moved: if some element moved more than half the skin since the last build (tested

@@ -6,7 +6,11 @@
  *   force pass      the rebuild test, the pair forces and the second half kick (force.h)
  * and when the test says the list is stale: the NaN check, the rebuild (escapes found and
  * removed, the list built, pair classes, surface and edge elements) and the force pass again.
- * Two parallel regions and one barrier per step. */
+ * When the boundary mode touches boundary elements only (every mode but the biaxial servo,
+ * cdem_bc_apply_is_boundary_only), it commutes exactly with the drift, which moves free
+ * elements only: the mode is applied first and the drift runs inside the force pass's
+ * parallel region (one region and one barrier a step). Otherwise the drift has a region of
+ * its own before the mode (two regions and one barrier). Either order gives the same bits. */
 #include "integrate.h"
 
 #include "checkpoint.h"
@@ -170,9 +174,11 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
 }
 
 /* The force pass (force.h) of the current step: pair forces, per-element sums, loads and,
- * when kick, the second half kick. check_moved: the rebuild test first; returns 1 (nothing
+ * when kick, the second half kick. drift: the step's drift first (the drift function's work,
+ * in the pass's region). check_moved: the rebuild test first; returns 1 (nothing else
  * computed) when the list is stale, else 0 with unstable_index updated. */
-static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved) {
+static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved,
+                           int drift) {
     const cdem_force_step in = {
         .law = &it->law,
         .equilibrating = it->equilibrating,
@@ -184,6 +190,8 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .par_min = it->par_min,
         .check_moved = check_moved,
         .unstable_test = it->unstable_guard,
+        .drift = drift,
+        .drift_factor = (drift && update_kick(it, s)) ? it->kick.drift : NULL,
     };
     long unstable = -1;
     if (cdem_force_pass(&it->force, &it->nb, s, &in, &unstable))
@@ -203,7 +211,7 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0);
+    forces_and_kick(it, s, 0, 0, 0);
     it->dt = dt;
     return CDEM_OK;
 }
@@ -247,17 +255,21 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     it->removal.n_removed_last = 0;
     if (it->nb.n_builds == 0)
         CDEM_TRY(cdem_integrator_prime(it, s, err));
-    drift(it, s);
+    /* the drift in the force pass's region when the mode commutes with it (top of file) */
+    const int list_current = it->nb.n == s->n;
+    const int drift_in_pass = list_current && (!bc || cdem_bc_apply_is_boundary_only(bc, k));
+    if (!drift_in_pass)
+        drift(it, s);
     it->step++;
     cdem_loads_begin_step(&it->loads, it->step);
     if (bc)
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
-    if (it->nb.n == s->n && forces_and_kick(it, s, 1, 1) == 0)
+    if (list_current && forces_and_kick(it, s, 1, 1, drift_in_pass) == 0)
         return CDEM_OK;
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    forces_and_kick(it, s, 1, 0);
+    forces_and_kick(it, s, 1, 0, 0);
     return CDEM_OK;
 }
 
@@ -271,7 +283,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     CDEM_TRY(build_list(it, s, it->removal.keep, err));
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0);
+    forces_and_kick(it, s, 0, 0, 0);
     it->dt = dt;
     return CDEM_OK;
 }
