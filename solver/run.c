@@ -228,12 +228,29 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
     return CDEM_OK;
 }
 
+/* The first change of the thread count is logged (later ones only counted: a machine whose
+ * load comes and goes would fill the log); the last line of the log sums them up. */
+static void log_thread_change(run_ctx *r, long step) {
+    if (r->gov.changes != 1 || !run_logging(r))
+        return;
+    run_end_progress_line(r);
+    fprintf(r->opt->log,
+            "cdem-run: step %ld: 1 thread runs faster than %d now (other processes are using "
+            "the cores); the run goes on with 1 and measures again from time to time "
+            "(results are the same for any thread count)\n",
+            step, r->gov.allowed);
+}
+
 static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
     const long total = r->m.total_steps;
     const long equil = r->m.equil_steps;
     const long interval = p->series_interval > 0 ? p->series_interval : 1;
+    if (!r->gov_started) {
+        cdem_governor_init(&r->gov, run_now(), r->step);
+        r->gov_started = 1;
+    }
     while (r->step < total && r->step < until && !r->finished) {
         const long step = r->step + 1;
         /* settling after a sediment deposit: boundaries still, not a deformation step */
@@ -267,6 +284,9 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         if (st != CDEM_OK)
             return st;
         r->step = step;
+        if (cdem_governor_after_step(&r->gov, step,
+                                     cdem_governor_wants_clock(&r->gov, step) ? run_now() : -1.0))
+            log_thread_change(r, step);
         CDEM_TRY(check_unstable(r, err));
         log_removed(r);
         if (step == equil) {
@@ -362,6 +382,8 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
 }
 
 static void run_release(run_ctx *r) {
+    if (r->gov_started)
+        cdem_governor_finish(&r->gov);
     cdem_integrator_free(&r->it);
     cdem_sediment_free(&r->sed);
     cdem_bc_free(&r->bc);

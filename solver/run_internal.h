@@ -13,6 +13,7 @@
 #include "assembly.h"
 #include "bc.h"
 #include "cdem_error.h"
+#include "governor.h"
 #include "h5format.h"
 #include "integrate.h"
 #include "model.h"
@@ -81,6 +82,8 @@ struct cdem_run_ctx {
     const char *stop_kind;       /* "completed", "stopped-early", "interrupted" once recorded */
     run_progress_state prog;     /* run_progress.c */
     run_ckpt_state ckpt;         /* run_ckpt.c */
+    cdem_governor gov;           /* the thread count in use (governor.h) */
+    int gov_started;             /* 1 once the first run_loop call started the governor */
 };
 typedef struct cdem_run_ctx run_ctx;
 

@@ -125,9 +125,18 @@ void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
     if (st == CDEM_OK && r->stop_kind && !strcmp(r->stop_kind, "stopped-early"))
         run_resume_hint(r, hint, sizeof hint);
     const double wall = run_now() - r->prog.t_start;
+    const long steps = r->step - r->prog.step0;
+    /* the threads: N, and the share of the steps the governor ran on one (governor.h) */
+    const int nthreads = r->gov_started ? r->gov.allowed : 1;
+    char threads[128];
+    int len = snprintf(threads, sizeof threads, "%d thread%s", nthreads, nthreads == 1 ? "" : "s");
+    if (r->gov_started && r->gov.steps_on_one > 0 && steps > 0)
+        snprintf(threads + len, sizeof threads - (size_t)len,
+                 ", 1 for %.0f %% of the steps: faster while the cores were busy",
+                 100.0 * (double)r->gov.steps_on_one / (double)steps);
     fprintf(r->opt->log,
             "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "
-            "%ld steps in %.1f s wall time, %.3g element-steps/s; stop reason: %s%s)\n",
-            r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, r->step - r->prog.step0,
-            wall, wall > 0.0 ? r->prog.element_steps / wall : 0.0, how, hint);
+            "%ld steps in %.1f s wall time, %.3g element-steps/s on %s; stop reason: %s%s)\n",
+            r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, steps, wall,
+            wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads, how, hint);
 }

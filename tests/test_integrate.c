@@ -196,11 +196,14 @@ enum {
 };
 
 /* make_box(1234) stepped `nsteps` times on `threads` threads with every loop threaded, the
- * pair forces by `path`, the touching pairs made cohesive half way. Returns the path used
- * (CDEM_FORCE_PATH_AVX2 is given SCALAR where the CPU has no AVX2). */
+ * pair forces by `path`, the touching pairs made cohesive half way; threads = 0: a count
+ * that changes at every step (1, 2, 3, 2, 1, ...; the run loop's thread governor may change
+ * it at any step). Returns the path used (CDEM_FORCE_PATH_AVX2 is given SCALAR where the CPU
+ * has no AVX2). */
 static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, int material,
                                     cdem_force_path path) {
-    omp_set_num_threads(threads);
+    static const int changing[4] = {1, 2, 3, 2};
+    omp_set_num_threads(threads > 0 ? threads : 1);
     const double dt = 0.028;
     cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
     cdem_params p =
@@ -229,6 +232,8 @@ static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, in
     if (material == BOX_SPRING)
         cdem_integrator_mark_initial(&it, out);
     for (int k = 0; k < nsteps; k++) {
+        if (threads == 0)
+            omp_set_num_threads(changing[k % 4]);
         assert_int_equal(cdem_integrator_step(&it, out, NULL, 0, 0.0, &err), CDEM_OK);
         if (k == nsteps / 2) {
             const long made = cdem_integrator_make_cohesive(&it, out);
@@ -280,6 +285,26 @@ static void test_integrate_simd_paths(void **st) {
         }
         cdem_state_free(&a);
     }
+}
+
+/* The thread count changing from step to step (the run loop's governor, solver/governor.h)
+ * gives the same bits as one thread throughout, on both force paths and for the bonded
+ * model. */
+static void test_integrate_threads_change_mid_run(void **st) {
+    (void)st;
+    const int materials[2] = {BOX_DEFAULT, BOX_BONDED};
+    for (int k = 0; k < 2; k++) {
+        cdem_state a, b;
+        run_box_with(1, 120, &a, materials[k], CDEM_FORCE_PATH_SCALAR);
+        run_box_with(0, 120, &b, materials[k], CDEM_FORCE_PATH_AVX2);
+        assert_same_state(&a, &b);
+        cdem_state_free(&b);
+        run_box_with(0, 120, &b, materials[k], CDEM_FORCE_PATH_SCALAR);
+        assert_same_state(&a, &b);
+        cdem_state_free(&a);
+        cdem_state_free(&b);
+    }
+    omp_set_num_threads(1);
 }
 
 /* A settled-looking box stepper for the threaded tests: make_box(seed), granular law, dt
@@ -466,6 +491,7 @@ int main(void) {
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
         cmocka_unit_test(test_integrate_simd_paths),
+        cmocka_unit_test(test_integrate_threads_change_mid_run),
         cmocka_unit_test(test_integrate_unstable_guard),
         cmocka_unit_test(test_integrate_rebuild_test_in_force_pass),
         cmocka_unit_test(test_integrate_nan_and_escape),

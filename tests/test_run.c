@@ -15,6 +15,7 @@
 #include "scratch.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -170,7 +171,11 @@ static void test_run_stops_early_and_on_signal(void **st) {
     snprintf(want, sizeof want, "; %ld steps in ", m.equil_steps + 40);
     assert_non_null(strstr(last, want));
     assert_non_null(strstr(last, " s wall time, "));
-    assert_non_null(strstr(last, " element-steps/s; stop reason: "));
+    /* and the threads it ran on (omp_get_max_threads of this process) */
+    snprintf(want, sizeof want, " element-steps/s on %d thread%s", omp_get_max_threads(),
+             omp_get_max_threads() == 1 ? "" : "s");
+    assert_non_null(strstr(last, want));
+    assert_non_null(strstr(last, "; stop reason: "));
     snprintf(want, sizeof want,
              "stop reason: stopped-early; continue it with: cdem-run --resume %s)\n", path);
     assert_non_null(strstr(last, want));

@@ -1,0 +1,91 @@
+/* governor: see governor.h. */
+#include "governor.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void use(cdem_governor *g, int threads) {
+    if (g->current != threads)
+        omp_set_num_threads(threads);
+    g->current = threads;
+}
+
+void cdem_governor_init(cdem_governor *g, double now, long step) {
+    memset(g, 0, sizeof *g);
+    g->allowed = omp_get_max_threads();
+    const char *off = getenv("CDEM_THREAD_GOVERNOR");
+    g->enabled = g->allowed > 1 && !(off && strcmp(off, "off") == 0);
+    g->chosen = g->current = g->allowed;
+    g->phase = CDEM_GOVERNOR_RUN;
+    g->interval = GOVERNOR_MIN_S;
+    g->t_next_probe = now + GOVERNOR_FIRST_S;
+    g->step_last = step;
+}
+
+void cdem_governor_finish(cdem_governor *g) {
+    if (g->enabled)
+        use(g, g->allowed);
+}
+
+/* The end of a window at (step, now): its time per step, or a negative value when it is
+ * still too short. */
+static double window_per_step(const cdem_governor *g, long step, double now) {
+    const long steps = step - g->step_window;
+    const double t = now - g->t_window;
+    if (steps < GOVERNOR_WINDOW_MIN_STEPS || t < GOVERNOR_WINDOW_S)
+        return -1.0;
+    return t / (double)steps;
+}
+
+static void start_window(cdem_governor *g, long step, double now) {
+    g->t_window = now;
+    g->step_window = step;
+}
+
+int cdem_governor_after_step(cdem_governor *g, long step, double now) {
+    if (!g->enabled)
+        return 0;
+    if (g->chosen == 1 && g->current == 1) /* by choice, not in a probe of one thread */
+        g->steps_on_one += step - g->step_last;
+    g->step_last = step;
+    if (now < 0.0)
+        return 0;
+    switch (g->phase) {
+    case CDEM_GOVERNOR_RUN:
+        if (now >= g->t_next_probe) {
+            g->phase = CDEM_GOVERNOR_TIME;
+            start_window(g, step, now);
+        }
+        return 0;
+    case CDEM_GOVERNOR_TIME: {
+        const double a = window_per_step(g, step, now);
+        if (a < 0.0)
+            return 0;
+        g->per_step_chosen = a;
+        g->phase = CDEM_GOVERNOR_PROBE;
+        use(g, g->chosen == 1 ? g->allowed : 1);
+        start_window(g, step, now);
+        return 0;
+    }
+    case CDEM_GOVERNOR_PROBE: {
+        const double b = window_per_step(g, step, now);
+        if (b < 0.0)
+            return 0;
+        g->probes++;
+        const int change = b < GOVERNOR_SWITCH_RATIO * g->per_step_chosen;
+        if (change) {
+            g->chosen = g->current;
+            g->changes++;
+            g->interval = GOVERNOR_MIN_S;
+        } else {
+            use(g, g->chosen);
+            g->interval = g->interval * 2.0 > GOVERNOR_MAX_S ? GOVERNOR_MAX_S : g->interval * 2.0;
+        }
+        g->phase = CDEM_GOVERNOR_RUN;
+        g->t_next_probe = now + g->interval;
+        return change;
+    }
+    }
+    return 0;
+}
