@@ -181,6 +181,28 @@ static long unstable_in(const force_pass *fp, long lo, long hi) {
     return -1;
 }
 
+/* The vector path's finish of the chunk's elements lo..hi-1 from their sums in the
+ * interleaved buffer acc, and unstable_in's guard in the same loop, while the velocities are
+ * in registers: returns the lowest index whose element moves more than its radius in a
+ * step, or -1 (also when the guard is off). */
+static long finish_chunk(force_pass *fp, const double *acc, long lo, long hi) {
+    const double *restrict rad = fp->radius;
+    const double dt2 = fp->dt * fp->dt;
+    long unstable = -1;
+    for (long i = lo; i < hi; i++) {
+        finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, fp->vx,
+                       fp->vy, fp->fx, fp->fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, fp->x,
+                       fp->ef, fp->exmid);
+        if (rad && unstable < 0) {
+            const double vxi = fp->vx[i], vyi = fp->vy[i];
+            const double d2 = (vxi * vxi + vyi * vyi) * dt2;
+            if (d2 > rad[i] * rad[i])
+                unstable = i;
+        }
+    }
+    return unstable;
+}
+
 /* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
  * istart[hi]-1), scalar path. Every element's sum is built in ascending pair order, as one
  * scatter loop over all pairs would: fx, fy of the chunk start at zero, the cross pairs from
@@ -285,11 +307,7 @@ static void chunk_pass_avx2(force_pass *fp, int chunk) {
     }
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);
-    for (long i = lo; i < hi; i++)
-        finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, fp->vx,
-                       fp->vy, fp->fx, fp->fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, fp->x,
-                       fp->ef, fp->exmid);
-    fp->unstable[chunk] = unstable_in(fp, lo, hi);
+    fp->unstable[chunk] = finish_chunk(fp, acc, lo, hi);
 }
 
 static void chunk_pass(force_pass *fp, int chunk) {
@@ -455,23 +473,35 @@ const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour 
 }
 
 /* The first half kick and drift of the free elements lo..hi-1 (cdem_force_step drift): the
- * stepper's drift (integrate.c) operation by operation, so the same bits. */
-static void drift_range(cdem_state *s, const cdem_force_step *in, long lo, long hi) {
+ * stepper's drift (integrate.c) operation by operation, so the same bits. With nb (the
+ * rebuild test wanted), the test of every element lo..hi-1 in the same loop, while its
+ * position is in a register: 1 when some element moved more than half the skin. */
+static int drift_range(cdem_state *s, const cdem_force_step *in, const cdem_neighbour *nb, long lo,
+                       long hi) {
     const double dt = in->dt, hdt = 0.5 * in->dt;
     double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
     const uint32_t *restrict flags = s->flags;
     const double *restrict kd = in->drift_factor;
+    const double *restrict x0 = nb ? nb->x0 : NULL, *restrict y0 = nb ? nb->y0 : NULL;
+    const double lim2 = nb ? cdem_neighbour_moved_limit2(nb) : 0.0;
+    int moved = 0;
     for (long i = lo; i < hi; i++) {
-        if (flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        const double a = kd ? kd[i] : hdt / mass[i];
-        const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
-        vx[i] = hvx;
-        vy[i] = hvy;
-        x[i] += dt * hvx;
-        y[i] += dt * hvy;
+        double xi = x[i], yi = y[i];
+        if (!(flags[i] & CDEM_FLAGS_BOUNDARY)) {
+            const double a = kd ? kd[i] : hdt / mass[i];
+            const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
+            vx[i] = hvx;
+            vy[i] = hvy;
+            xi += dt * hvx;
+            yi += dt * hvy;
+            x[i] = xi;
+            y[i] = yi;
+        }
+        if (nb)
+            moved |= cdem_neighbour_moved_one(xi, yi, x0[i], y0[i], lim2);
     }
+    return moved;
 }
 
 /* The pass (force.h): the parallel driver of chunk_pass; see the top of this file. */
@@ -541,9 +571,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     fp.f = f;
     fp.radius = in->unstable_test ? s->radius : NULL;
     if (nchunk == 1) {
-        if (in->drift)
-            drift_range(s, in, 0, n);
-        if (check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
+        if (in->drift ? drift_range(s, in, check_moved ? nb : NULL, 0, n)
+                      : check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
             return 1;
         chunk_pass(&fp, 0);
     } else {
@@ -557,14 +586,16 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         {
             const int t = omp_get_thread_num(), nt = omp_get_num_threads();
             int go = 1;
-            if (in->drift) /* each thread moves the elements it tests and computes next */
-                for (int c = t; c < nchunk; c += nt)
-                    drift_range(s, in, fp.chunk_elem[c], fp.chunk_elem[c + 1]);
+            /* each thread moves the elements it tests and computes next */
+            int mine = 0;
+            for (int c = t; c < nchunk; c += nt) {
+                const long lo = fp.chunk_elem[c], hi = fp.chunk_elem[c + 1];
+                if (in->drift)
+                    mine |= drift_range(s, in, check_moved ? nb : NULL, lo, hi);
+                else if (check_moved)
+                    mine |= cdem_neighbour_moved(nb, s, (size_t)lo, (size_t)hi);
+            }
             if (check_moved) {
-                int mine = 0;
-                for (int c = t; c < nchunk; c += nt)
-                    mine |= cdem_neighbour_moved(nb, s, (size_t)fp.chunk_elem[c],
-                                                 (size_t)fp.chunk_elem[c + 1]);
                 if (mine) {
 #pragma omp atomic write
                     moved = 1;

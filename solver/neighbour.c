@@ -82,15 +82,12 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
 }
 
 int cdem_neighbour_moved(const cdem_neighbour *nb, const cdem_state *s, size_t lo, size_t hi) {
-    const double lim2 = 0.25 * nb->skin * nb->skin;
+    const double lim2 = cdem_neighbour_moved_limit2(nb);
     const double *restrict x = s->x, *restrict y = s->y;
     const double *restrict x0 = nb->x0, *restrict y0 = nb->y0;
     int out = 0;
-    for (size_t i = lo; i < hi; i++) {
-        const double dx = x[i] - x0[i], dy = y[i] - y0[i];
-        /* written so that NaN also triggers a rebuild (which then reports it) */
-        out |= !(dx * dx + dy * dy <= lim2);
-    }
+    for (size_t i = lo; i < hi; i++)
+        out |= cdem_neighbour_moved_one(x[i], y[i], x0[i], y0[i], lim2);
     return out;
 }
 

@@ -107,6 +107,18 @@ int cdem_neighbour_needs_rebuild(const cdem_neighbour *nb, const cdem_state *s);
  * cdem_neighbour_needs_rebuild, for callers that split the elements among threads. */
 int cdem_neighbour_moved(const cdem_neighbour *nb, const cdem_state *s, size_t lo, size_t hi);
 
+/* The criterion for one element at position (x, y): 1 when it moved more than skin/2 from
+ * (x0, y0), its position at the last build, or a coordinate is NaN; lim2 = (skin/2)^2
+ * (cdem_neighbour_moved_limit2). Written so that NaN also triggers a rebuild (which then
+ * reports it). For loops that test while they move the elements (the force pass's drift). */
+static inline int cdem_neighbour_moved_one(double x, double y, double x0, double y0, double lim2) {
+    const double dx = x - x0, dy = y - y0;
+    return !(dx * dx + dy * dy <= lim2);
+}
+static inline double cdem_neighbour_moved_limit2(const cdem_neighbour *nb) {
+    return 0.25 * nb->skin * nb->skin;
+}
+
 /* Rebuilds the list. keep (optional, length s->n): elements with keep[i] == 0 are removed
  * from the state first (histories of the rest kept). resort: 1 forces a re-sort into cell
  * order, 0 lets resort_every decide, -1 never. Fails with CDEM_ERR_NUMERIC naming the
