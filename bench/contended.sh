@@ -8,16 +8,19 @@
 # Environment:
 #   WAITS="cdem"   wait settings to compare, each run in the same way:
 #                  cdem      the environment as it comes (cdem-run chooses: common/threads.h,
-#                            OMP_WAIT_POLICY=passive)
+#                            OMP_WAIT_POLICY=passive, and its thread governor, solver/governor.h,
+#                            runs on one thread while that is faster)
+#                  cdem-fixed  the same with CDEM_THREAD_GOVERNOR=off: the threads asked for,
+#                            throughout (what the wait policy alone does)
 #                  libgomp   GOMP_SPINCOUNT=300000, libgomp's own default
 #                  passive   OMP_WAIT_POLICY=passive
 #                  spin:N    GOMP_SPINCOUNT=N
 #   MODEL="-s assembly.width=20 -s assembly.half_radii=on"  (16,700 elements)
-#   STEPS=1500  REPS=3 (medians)  WORK=/tmp/cdem_bench
+#   STEPS=4000  REPS=3 (medians)  WORK=/tmp/cdem_bench
 BUILD=${1:-build}
 WAITS=${WAITS:-cdem}
 MODEL=${MODEL:-"-s assembly.width=20 -s assembly.half_radii=on"}
-STEPS=${STEPS:-1500}
+STEPS=${STEPS:-4000}
 REPS=${REPS:-3}
 WORK=${WORK:-/tmp/cdem_bench}
 mkdir -p "$WORK"
@@ -27,7 +30,8 @@ median() { sort -g | awk '{a[NR]=$1} END {if (NR % 2) print a[(NR+1)/2]; else pr
 timed() {
     t=$2
     case $1 in
-    cdem) set -- env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT ;;
+    cdem) set -- env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT -u CDEM_THREAD_GOVERNOR ;;
+    cdem-fixed) set -- env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT CDEM_THREAD_GOVERNOR=off ;;
     libgomp) set -- env -u OMP_WAIT_POLICY GOMP_SPINCOUNT=300000 ;;
     passive) set -- env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=passive ;;
     spin:*) set -- env -u OMP_WAIT_POLICY GOMP_SPINCOUNT="${1#spin:}" ;;

@@ -181,7 +181,8 @@ fi
 
 if has contended; then
     echo
-    echo "== 5. Threads on a busy machine (bench/contended.sh): cdem-run's wait policy (passive, common/threads.h)"
-    echo "      and libgomp's default spin, idle and with one CPU-bound competitor"
-    WAITS="cdem libgomp" sh bench/contended.sh "$BUILD"
+    echo "== 5. Threads on a busy machine (bench/contended.sh): cdem-run as it comes (passive wait policy,"
+    echo "      common/threads.h, and the thread governor, solver/governor.h), without the governor"
+    echo "      (cdem-fixed), and with libgomp's default spin, idle and with one CPU-bound competitor"
+    WAITS="cdem cdem-fixed libgomp" sh bench/contended.sh "$BUILD"
 fi
