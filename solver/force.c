@@ -472,24 +472,22 @@ const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour 
     return current ? f->chunk_elem : NULL;
 }
 
-/* The first half kick and drift of the free elements lo..hi-1 (cdem_force_step drift): the
- * stepper's drift (integrate.c) operation by operation, so the same bits. With nb (the
- * rebuild test wanted), the test of every element lo..hi-1 in the same loop, while its
- * position is in a register: 1 when some element moved more than half the skin. */
-static int drift_range(cdem_state *s, const cdem_force_step *in, const cdem_neighbour *nb, long lo,
-                       long hi) {
-    const double dt = in->dt, hdt = 0.5 * in->dt;
+/* The drift (force.h), with the rebuild test in the same loop when nb is given, while each
+ * position is in a register. */
+int cdem_force_drift(cdem_state *s, double dt, const double *drift_factor, const cdem_neighbour *nb,
+                     long lo, long hi) {
+    const double hdt = 0.5 * dt;
     double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
     const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
     const uint32_t *restrict flags = s->flags;
-    const double *restrict kd = in->drift_factor;
+    const double *restrict kd = drift_factor;
     const double *restrict x0 = nb ? nb->x0 : NULL, *restrict y0 = nb ? nb->y0 : NULL;
     const double lim2 = nb ? cdem_neighbour_moved_limit2(nb) : 0.0;
     int moved = 0;
     for (long i = lo; i < hi; i++) {
         double xi = x[i], yi = y[i];
         if (!(flags[i] & CDEM_FLAGS_BOUNDARY)) {
-            const double a = kd ? kd[i] : hdt / mass[i];
+            const double a = kd ? kd[i] : hdt / mass[i]; /* the same bits */
             const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
             vx[i] = hvx;
             vy[i] = hvy;
@@ -571,7 +569,7 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     fp.f = f;
     fp.radius = in->unstable_test ? s->radius : NULL;
     if (nchunk == 1) {
-        if (in->drift ? drift_range(s, in, check_moved ? nb : NULL, 0, n)
+        if (in->drift ? cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL, 0, n)
                       : check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
             return 1;
         chunk_pass(&fp, 0);
@@ -591,7 +589,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
             for (int c = t; c < nchunk; c += nt) {
                 const long lo = fp.chunk_elem[c], hi = fp.chunk_elem[c + 1];
                 if (in->drift)
-                    mine |= drift_range(s, in, check_moved ? nb : NULL, lo, hi);
+                    mine |= cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL,
+                                             lo, hi);
                 else if (check_moved)
                     mine |= cdem_neighbour_moved(nb, s, (size_t)lo, (size_t)hi);
             }

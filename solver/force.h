@@ -128,6 +128,14 @@ int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n);
 const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour *nb, size_t n,
                                       int nchunk);
 
+/* The first half kick and drift of the free elements lo..hi-1 (v += f drift_factor[i], or
+ * f (dt/2) / m when drift_factor is NULL; x += dt v), the one definition of the stepper's
+ * drift, whether in the force pass's region or in a region of its own (integrate.c). With
+ * nb, the rebuild test of every element lo..hi-1 in the same loop: returns 1 when one moved
+ * more than half the skin since the last build (else, and without nb, 0). */
+int cdem_force_drift(cdem_state *s, double dt, const double *drift_factor, const cdem_neighbour *nb,
+                     long lo, long hi);
+
 /* One force pass over the pair list nb (matching the state's element count): the drift
  * (in->drift), pair forces, per-element sums and the element finish, threaded over chunks
  * (one parallel region; each

@@ -216,16 +216,14 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     return CDEM_OK;
 }
 
-/* First half kick and drift of the free elements. Threaded over the force pass's chunks
+/* First half kick and drift of the free elements (cdem_force_drift) in a parallel region of
+ * its own: the steps whose mode is not boundary-only (the biaxial servo) or whose list is
+ * stale; other steps drift inside the force pass. Threaded over the force pass's chunks
  * when they are current (each thread then moves the elements whose forces it computed and
  * whose rebuild test it makes next: they stay in its cache), else over equal ranges. */
 static void drift(cdem_integrator *it, cdem_state *s) {
     const long n = (long)s->n;
-    const double dt = it->dt, hdt = 0.5 * it->dt;
-    double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
-    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
-    const uint32_t *restrict flags = s->flags;
-    const double *restrict kd = update_kick(it, s) ? it->kick.drift : NULL;
+    const double *kd = update_kick(it, s) ? it->kick.drift : NULL;
     const int nchunk = cdem_force_chunks_wanted(&it->nb, it->par_min, n);
     const int32_t *ce = cdem_force_current_cut(&it->force, &it->nb, (size_t)n, nchunk);
     const int chunked = ce != NULL;
@@ -236,16 +234,7 @@ static void drift(cdem_integrator *it, cdem_state *s) {
         for (int c = t; c < parts; c += nt) {
             const long lo = chunked ? ce[c] : n * c / parts;
             const long hi = chunked ? ce[c + 1] : n * (c + 1) / parts;
-            for (long i = lo; i < hi; i++) {
-                if (flags[i] & CDEM_FLAGS_BOUNDARY)
-                    continue;
-                const double a = kd ? kd[i] : hdt / mass[i]; /* the same bits */
-                const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
-                vx[i] = hvx;
-                vy[i] = hvy;
-                x[i] += dt * hvx;
-                y[i] += dt * hvy;
-            }
+            cdem_force_drift(s, it->dt, kd, NULL, lo, hi);
         }
     }
 }
