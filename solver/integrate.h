@@ -6,8 +6,10 @@
  * i.e. the damping force -c v(t+dt) is taken implicitly, so the terminal velocity of a
  * falling element is exactly m g / c; F(t+dt) = F_c - m g e_y - c v(t+dt) is stored in
  * state fx, fy (boundary elements: the contact force on them).
- * A step is a short sequence of phases, each in a module of its own: drift (here), the
- * boundary mode (bc.h), the force pass with the rebuild test (force.h), and at a rebuild the
+ * A step is a short sequence of phases, each in a module of its own: drift
+ * (cdem_force_drift, inside the force pass's parallel region when the boundary mode is
+ * boundary-only, which then moves first: the two commute exactly), the boundary mode
+ * (bc.h), the force pass with the rebuild test (force.h), and at a rebuild the
  * removal of escaping elements (removal.h), the list build (neighbour.h), the pair classes
  * and the surface and edge elements of the loads (loads.h).
  * The integrator owns the neighbour list and contact histories; it never owns the state.
