@@ -43,6 +43,14 @@ typedef struct {
      * region a step instead of two). 0 (the safe default for a new mode): apply runs after
      * the drift, as documented above (biaxial: its servo reads the free elements' extent). */
     int boundary_only;
+    /* optional, for a boundary_only mode (both NULL: apply does it all): apply split in two,
+     * so that the stepper moves the elements inside its parallel region, each thread over
+     * its own range. step_begin does the step's once-only work (checks, sense and velocities
+     * kept in the context, net displacement); step_move the per-element work over elements
+     * lo..hi-1, reading the context only. Such a mode has no apply: cdem_bc_apply is
+     * step_begin, then step_move over every element. */
+    cdem_status (*step_begin)(void *ctx, long k, double du, double dt, cdem_error *err);
+    void (*step_move)(const void *ctx, cdem_state *s, long lo, long hi);
     double (*net_displacement)(const void *ctx);
     void (*view)(const void *ctx, FILE *out);
     void (*free)(void *ctx); /* may be NULL when the context owns no memory */
@@ -90,6 +98,15 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
 /* 1 when cdem_bc_apply(bc, s, k, ...) touches no free element (ops->boundary_only, or an
  * equilibration step of a mode that does not move then): it may run before the drift. */
 int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k);
+/* The per-element half of step k's apply (ops->step_move) when the mode is split and moves
+ * anything in step k, else NULL. The caller then runs cdem_bc_step_begin once and the
+ * returned function over every element (ranges in any order, on any threads) instead of
+ * cdem_bc_apply: the same bits. */
+typedef void (*cdem_bc_move_fn)(const void *ctx, cdem_state *s, long lo, long hi);
+cdem_bc_move_fn cdem_bc_step_move_of(const cdem_bc *bc, long k);
+/* The once-only half of step k's apply (ops->step_begin; the same k, du, dt as
+ * cdem_bc_apply). Only when cdem_bc_step_move_of returned a function. */
+cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_error *err);
 /* 1 when the mode moves boundaries during equilibration (ops->moves_in_equilibration). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
 double cdem_bc_net_displacement(const cdem_bc *bc);

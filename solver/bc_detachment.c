@@ -11,18 +11,18 @@
  * original program "fixed" for this case. Increments come every display interval of
  * boundary (each wall's) displacement, as in every other mode. Units: m, s. */
 #include "bc.h"
-#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
 #include <string.h>
 
 typedef struct {
-    int walls;    /* cdem_walls_choice: right or both */
-    double x_mid; /* m, walls left of this are the left wall */
-    double net;   /* m, total shortening so far (sum over the moving walls), >= 0 */
-    long n_left;  /* moving left-wall elements (0 for "right") */
-    long n_right; /* moving right-wall elements */
+    int walls;              /* cdem_walls_choice: right or both */
+    double x_mid;           /* m, walls left of this are the left wall */
+    double net;             /* m, total shortening so far (sum over the moving walls), >= 0 */
+    long n_left;            /* moving left-wall elements (0 for "right") */
+    long n_right;           /* moving right-wall elements */
+    double step_du, step_v; /* this step's move and speed of each wall (step_begin) */
 } detach_ctx;
 
 static cdem_status detach_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -56,18 +56,24 @@ static cdem_status detach_init(void *vctx, const cdem_params *p, const cdem_mode
     return CDEM_OK;
 }
 
-static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, double dt,
-                                cdem_error *err) {
+static cdem_status detach_step_begin(void *vctx, long k, double du, double dt, cdem_error *err) {
     (void)k;
     detach_ctx *c = vctx;
     if (!(dt > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "detachment: dt = %g s: must be > 0", dt);
-    const double xm = c->x_mid, v = du / dt;
-    const long n = (long)s->n;
+    c->step_du = du;
+    c->step_v = du / dt;
+    /* total shortening: both walls' displacements together */
+    c->net += (c->walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * du;
+    return CDEM_OK;
+}
+
+static void detach_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
+    const detach_ctx *c = vctx;
+    const double xm = c->x_mid, du = c->step_du, v = c->step_v;
     double *restrict x = s->x, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
-    for (long i = 0; i < n; i++) {
+    for (long i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             /* the right wall moves left, the left wall right: both inward */
             const double sgn = x[i] > xm ? -1.0 : 1.0;
@@ -76,9 +82,6 @@ static cdem_status detach_apply(void *vctx, cdem_state *s, long k, double du, do
             vya[i] = 0.0;
         }
     }
-    /* total shortening: both walls' displacements together */
-    c->net += (c->walls == CDEM_WALLS_BOTH ? 2.0 : 1.0) * du;
-    return CDEM_OK;
 }
 
 static double detach_net(const void *vctx) {
@@ -119,7 +122,8 @@ static const cdem_bc_ops detach_ops = {
     .name = "detachment",             /* name */
     .state_size = sizeof(detach_ctx), /* state_size */
     .init = detach_init,              /* init */
-    .apply = detach_apply,            /* apply */
+    .step_begin = detach_step_begin,  /* apply, split: the net displacement */
+    .step_move = detach_step_move,    /* and the walls' elements */
     .boundary_only = 1,               /* moves boundary elements only */
     .net_displacement = detach_net,   /* net_displacement */
     .view = detach_view,              /* view */

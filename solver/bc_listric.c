@@ -27,7 +27,6 @@
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
  * right wall move du along the basal segment. */
 #include "bc.h"
-#include "parallel.h"
 #include "checkpoint.h"
 #include "fault_file.h"
 
@@ -59,6 +58,9 @@ typedef struct {
     double spacing;           /* m, arc spacing of the fault elements (the base radius) */
     int32_t first_id;         /* id of the first fault element; ids are consecutive */
     double sheet;             /* m, CD: arc offset of the sheet so far (down-dip negative) */
+    /* this step's moves (step_begin): CD: base and right wall (bx, by); CH: fault and
+     * footwall display (ux), base and right wall (uy); dt for the velocities */
+    double step_bx, step_by, step_ux, step_uy, step_dt;
 } listric_ctx;
 
 static const char *mode_name(const listric_ctx *c) {
@@ -247,15 +249,33 @@ static cdem_status irregular_init(void *vctx, const cdem_params *p, const cdem_m
     return listric_init_common(c, p, m, s, err);
 }
 
-/* CD: the sheet (fault elements) slides along the fixed path by du per step (down-dip for
- * normal), the base and right wall move along the basal segment by du. */
-static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, double du,
-                            double dt) {
-    c->sheet -= sgn * du;
-    const double bx = sgn * du * c->heave, by = -sgn * du * c->throw_;
-    const long n = (long)s->n;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
-    for (long i = 0; i < n; i++) {
+/* The step's once-only work: the sense, the moves kept for listric_step_move, the net
+ * displacement. CD: the sheet (fault elements) slides along the fixed path by du per step
+ * (down-dip for normal), the base and right wall move along the basal segment by du. CH:
+ * the fault elements and the footwall display move by the heave, the hanging-wall base and
+ * right wall by the throw. */
+static cdem_status listric_step_begin(void *vctx, long k, double du, double dt, cdem_error *err) {
+    listric_ctx *c = vctx;
+    if (!(dt > 0.0))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
+    const double sgn =
+        ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
+    c->step_dt = dt;
+    if (c->cd) {
+        c->sheet -= sgn * du;
+        c->step_bx = sgn * du * c->heave;
+        c->step_by = -sgn * du * c->throw_;
+    } else {
+        c->step_ux = -sgn * du * c->heave;
+        c->step_uy = -sgn * du * c->throw_;
+    }
+    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
+    return CDEM_OK;
+}
+
+static void cd_move(const listric_ctx *c, cdem_state *s, long lo, long hi) {
+    const double bx = c->step_bx, by = c->step_by, dt = c->step_dt;
+    for (long i = lo; i < hi; i++) {
         const uint32_t f = s->flags[i];
         if (!(f & CDEM_FLAG_MOVING))
             continue;
@@ -274,26 +294,19 @@ static cdem_status cd_apply(listric_ctx *c, cdem_state *s, long k, double sgn, d
             s->vy[i] = by / dt;
         }
     }
-    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
-    return CDEM_OK;
 }
 
-static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, double dt,
-                                 cdem_error *err) {
-    listric_ctx *c = vctx;
-    if (!(dt > 0.0))
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: dt = %g s: must be > 0", mode_name(c), dt);
-    const double sgn =
-        ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
-    if (c->cd)
-        return cd_apply(c, s, k, sgn, du, dt);
-    const double ux = -sgn * du * c->heave, uy = -sgn * du * c->throw_;
-    const double vx = ux / dt, vy = uy / dt;
-    const long n = (long)s->n;
+static void listric_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
+    const listric_ctx *c = vctx;
+    if (c->cd) {
+        cd_move(c, s, lo, hi);
+        return;
+    }
+    const double ux = c->step_ux, uy = c->step_uy;
+    const double vx = ux / c->step_dt, vy = uy / c->step_dt;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
-    for (long i = 0; i < n; i++) {
+    for (long i = lo; i < hi; i++) {
         if ((fl[i] & CDEM_FLAG_FOOTWALL) ||
             (fl[i] & (CDEM_FLAG_WALL | CDEM_FLAG_MOVING)) == CDEM_FLAG_WALL) {
             x[i] += ux; /* footwall display and footwall base: ride with the fault */
@@ -311,8 +324,6 @@ static cdem_status listric_apply(void *vctx, cdem_state *s, long k, double du, d
             vya[i] = vy;
         }
     }
-    c->net += ((k <= c->k_inversion) ? 1.0 : -1.0) * du;
-    return CDEM_OK;
 }
 
 static double listric_net(const void *vctx) {
@@ -399,8 +410,9 @@ static const cdem_bc_ops listric_ops = {
     .name = "listric-fault",
     .state_size = sizeof(listric_ctx),
     .init = listric_init,
-    .apply = listric_apply,
-    .boundary_only = 1, /* fault, mylar, wall and footwall-display elements only */
+    .step_begin = listric_step_begin, /* apply, split: the sense, the net displacement */
+    .step_move = listric_step_move,   /* and the fault, wall and footwall elements */
+    .boundary_only = 1,               /* fault, mylar, wall and footwall-display elements only */
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,
@@ -412,8 +424,9 @@ static const cdem_bc_ops irregular_ops = {
     .name = "irregular-fault",
     .state_size = sizeof(listric_ctx),
     .init = irregular_init,
-    .apply = listric_apply,
-    .boundary_only = 1, /* fault, mylar, wall and footwall-display elements only */
+    .step_begin = listric_step_begin, /* apply, split: the sense, the net displacement */
+    .step_move = listric_step_move,   /* and the fault, wall and footwall elements */
+    .boundary_only = 1,               /* fault, mylar, wall and footwall-display elements only */
     .net_displacement = listric_net,
     .view = listric_view,
     .free = listric_free,

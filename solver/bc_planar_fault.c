@@ -13,7 +13,6 @@
  * becomes the exposed fault face as the block rises. Ramps and walls never interact with
  * each other (boundary-boundary pairs are skipped). */
 #include "bc.h"
-#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
@@ -33,6 +32,7 @@ typedef struct {
     long n_ramp_fixed;   /* fixed footwall ramp elements added */
     long n_ramp_moving;  /* moving hanging-wall ramp elements added */
     double ramp_length;  /* m, length of each ramp along the plane */
+    double step_ux, step_uy, step_vx, step_vy; /* this step's move and velocity (step_begin) */
 } planar_ctx;
 
 static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -118,19 +118,26 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     return CDEM_OK;
 }
 
-static cdem_status planar_apply(void *vctx, cdem_state *s, long k, double du, double dt,
-                                cdem_error *err) {
+static cdem_status planar_step_begin(void *vctx, long k, double du, double dt, cdem_error *err) {
     planar_ctx *c = vctx;
     if (!(dt > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "planar fault: dt = %g s: must be > 0", dt);
     const double sgn = (k <= c->k_inversion) ? 1.0 : -1.0;
-    const double ux = sgn * du * c->dir_x, uy = sgn * du * c->dir_y;
-    const double vx = ux / dt, vy = uy / dt;
-    const long n = (long)s->n;
+    c->step_ux = sgn * du * c->dir_x;
+    c->step_uy = sgn * du * c->dir_y;
+    c->step_vx = c->step_ux / dt;
+    c->step_vy = c->step_uy / dt;
+    c->net += sgn * du;
+    c->gross += du;
+    return CDEM_OK;
+}
+
+static void planar_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
+    const planar_ctx *c = vctx;
+    const double ux = c->step_ux, uy = c->step_uy, vx = c->step_vx, vy = c->step_vy;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
-    for (long i = 0; i < n; i++) {
+    for (long i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             x[i] += ux;
             y[i] += uy;
@@ -138,9 +145,6 @@ static cdem_status planar_apply(void *vctx, cdem_state *s, long k, double du, do
             vya[i] = vy;
         }
     }
-    c->net += sgn * du;
-    c->gross += du;
-    return CDEM_OK;
 }
 
 static double planar_net(const void *vctx) {
@@ -185,7 +189,8 @@ static const cdem_bc_ops planar_ops = {
     .name = "planar-fault",           /* name */
     .state_size = sizeof(planar_ctx), /* state_size */
     .init = planar_init,              /* init */
-    .apply = planar_apply,            /* apply */
+    .step_begin = planar_step_begin,  /* apply, split: the sense, the net displacement */
+    .step_move = planar_step_move,    /* and the block's elements */
     .boundary_only = 1,               /* moves boundary elements only */
     .net_displacement = planar_net,   /* net_displacement */
     .view = planar_view,              /* view */

@@ -69,7 +69,26 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_apply: boundary mode not initialised");
     if (k <= 0 && !bc->ops->moves_in_equilibration)
         return CDEM_OK;
+    if (bc->ops->step_begin && bc->ops->step_move) {
+        CDEM_TRY(bc->ops->step_begin(bc->ctx, k <= 0 ? 0 : k, du, dt, err));
+        bc->ops->step_move(bc->ctx, s, 0, (long)s->n);
+        return CDEM_OK;
+    }
     return bc->ops->apply(bc->ctx, s, k <= 0 ? 0 : k, du, dt, err);
+}
+
+cdem_bc_move_fn cdem_bc_step_move_of(const cdem_bc *bc, long k) {
+    if (!bc || !bc->ops || !bc->ops->step_begin || !bc->ops->boundary_only)
+        return NULL;
+    if (k <= 0 && !bc->ops->moves_in_equilibration)
+        return NULL; /* nothing moves in this step */
+    return bc->ops->step_move;
+}
+
+cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_error *err) {
+    if (!bc || !bc->ops || !bc->ops->step_begin)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_bc_step_begin: the mode has no step_begin");
+    return bc->ops->step_begin(bc->ctx, k <= 0 ? 0 : k, du, dt, err);
 }
 
 int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k) {

@@ -12,21 +12,21 @@
  * fixed for caldera (the pit's side walls), moving with the block for piston (the block's
  * faces as it rises). Net displacement = the block's displacement along its sense (>= 0). */
 #include "bc.h"
-#include "parallel.h"
 #include "checkpoint.h"
 
 #include <math.h>
 #include <string.h>
 
 typedef struct {
-    int sense;         /* cdem_vertical_sense: caldera (down) or piston (up) */
-    double x1, x2;     /* m, x of the first and second fault, 0 < x1 < x2 < width */
-    double y_base;     /* m, height of the base centres */
-    double dir_y;      /* -1 (caldera) or +1 (piston): direction of the block's motion */
-    double net;        /* m, displacement of the block along dir_y so far, >= 0 */
-    long n_block;      /* base elements in the moving block */
-    long n_column;     /* fault-column elements added (both faults) */
-    double col_length; /* m, length of each column below the base */
+    int sense;               /* cdem_vertical_sense: caldera (down) or piston (up) */
+    double x1, x2;           /* m, x of the first and second fault, 0 < x1 < x2 < width */
+    double y_base;           /* m, height of the base centres */
+    double dir_y;            /* -1 (caldera) or +1 (piston): direction of the block's motion */
+    double net;              /* m, displacement of the block along dir_y so far, >= 0 */
+    long n_block;            /* base elements in the moving block */
+    long n_column;           /* fault-column elements added (both faults) */
+    double col_length;       /* m, length of each column below the base */
+    double step_uy, step_vy; /* this step's move and velocity of the block (step_begin) */
 } vert_ctx;
 
 static cdem_status vert_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -86,26 +86,29 @@ static cdem_status vert_init(void *vctx, const cdem_params *p, const cdem_model 
     return CDEM_OK;
 }
 
-static cdem_status vert_apply(void *vctx, cdem_state *s, long k, double du, double dt,
-                              cdem_error *err) {
+static cdem_status vert_step_begin(void *vctx, long k, double du, double dt, cdem_error *err) {
     (void)k;
     vert_ctx *c = vctx;
     if (!(dt > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "vertical faults: dt = %g s: must be > 0", dt);
-    const double uy = c->dir_y * du, vy = uy / dt;
-    const long n = (long)s->n;
+    c->step_uy = c->dir_y * du;
+    c->step_vy = c->step_uy / dt;
+    c->net += du;
+    return CDEM_OK;
+}
+
+static void vert_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
+    const vert_ctx *c = vctx;
+    const double uy = c->step_uy, vy = c->step_vy;
     double *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
-#pragma omp parallel for schedule(static) if (n > CDEM_PAR_MIN_SCAN)
-    for (long i = 0; i < n; i++) {
+    for (long i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_MOVING) {
             y[i] += uy;
             vxa[i] = 0.0;
             vya[i] = vy;
         }
     }
-    c->net += du;
-    return CDEM_OK;
 }
 
 static double vert_net(const void *vctx) {
@@ -142,7 +145,8 @@ static const cdem_bc_ops vert_ops = {
     .name = "vertical-faults",      /* name */
     .state_size = sizeof(vert_ctx), /* state_size */
     .init = vert_init,              /* init */
-    .apply = vert_apply,            /* apply */
+    .step_begin = vert_step_begin,  /* apply, split: the net displacement */
+    .step_move = vert_step_move,    /* and the block's elements */
     .boundary_only = 1,             /* moves boundary elements only */
     .net_displacement = vert_net,   /* net_displacement */
     .view = vert_view,              /* view */

@@ -569,6 +569,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     fp.f = f;
     fp.radius = in->unstable_test ? s->radius : NULL;
     if (nchunk == 1) {
+        if (in->drift && in->boundary_move)
+            in->boundary_move(in->boundary_ctx, s, 0, n);
         if (in->drift ? cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL, 0, n)
                       : check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
             return 1;
@@ -588,6 +590,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
             int mine = 0;
             for (int c = t; c < nchunk; c += nt) {
                 const long lo = fp.chunk_elem[c], hi = fp.chunk_elem[c + 1];
+                if (in->drift && in->boundary_move)
+                    in->boundary_move(in->boundary_ctx, s, lo, hi);
                 if (in->drift)
                     mine |= cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL,
                                              lo, hi);

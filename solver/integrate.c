@@ -177,8 +177,8 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
  * when kick, the second half kick. drift: the step's drift first (the drift function's work,
  * in the pass's region). check_moved: the rebuild test first; returns 1 (nothing else
  * computed) when the list is stale, else 0 with unstable_index updated. */
-static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved,
-                           int drift) {
+static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved, int drift,
+                           cdem_bc_move_fn move, const void *move_ctx) {
     const cdem_force_step in = {
         .law = &it->law,
         .equilibrating = it->equilibrating,
@@ -192,6 +192,8 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int che
         .unstable_test = it->unstable_guard,
         .drift = drift,
         .drift_factor = (drift && update_kick(it, s)) ? it->kick.drift : NULL,
+        .boundary_move = move,
+        .boundary_ctx = move_ctx,
     };
     long unstable = -1;
     if (cdem_force_pass(&it->force, &it->nb, s, &in, &unstable))
@@ -211,7 +213,7 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     /* the first evaluation has no previous step: no tangential increment */
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0, 0);
+    forces_and_kick(it, s, 0, 0, 0, NULL, NULL);
     it->dt = dt;
     return CDEM_OK;
 }
@@ -251,14 +253,19 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         drift(it, s);
     it->step++;
     cdem_loads_begin_step(&it->loads, it->step);
-    if (bc)
+    /* a split mode's per-element moves go into the pass's region too (bc.h step_move) */
+    const cdem_bc_move_fn move = drift_in_pass ? cdem_bc_step_move_of(bc, k) : NULL;
+    if (move)
+        CDEM_TRY(cdem_bc_step_begin(bc, k, du, it->dt, err));
+    else if (bc)
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
-    if (list_current && forces_and_kick(it, s, 1, 1, drift_in_pass) == 0)
+    if (list_current &&
+        forces_and_kick(it, s, 1, 1, drift_in_pass, move, move ? bc->ctx : NULL) == 0)
         return CDEM_OK;
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    forces_and_kick(it, s, 1, 0, 0);
+    forces_and_kick(it, s, 1, 0, 0, NULL, NULL);
     return CDEM_OK;
 }
 
@@ -272,7 +279,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     CDEM_TRY(build_list(it, s, it->removal.keep, err));
     const double dt = it->dt;
     it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0, 0);
+    forces_and_kick(it, s, 0, 0, 0, NULL, NULL);
     it->dt = dt;
     return CDEM_OK;
 }

@@ -9,7 +9,9 @@
  * walls), over deformation steps before and after an inversion, on the fixture assembly of
  * the other boundary-mode tests. The biaxial mode, whose servo reads the free elements'
  * extent, must not make it; and an equilibration step of a mode that does not move then is
- * boundary-only whatever the flag. */
+ * boundary-only whatever the flag. A mode split in step_begin and step_move (the stepper runs
+ * the moves over each thread's ranges) gives with its ranges in any order the bits of its
+ * apply. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -94,13 +96,15 @@ static void scramble_free(cdem_state *s) {
 static void check_variant(cdem_mode mode, const cdem_params *p) {
     cdem_model m = fx_model(STEPS);
     cdem_error err;
-    cdem_state a, b, a0, b0;
-    cdem_bc bca, bcb;
+    cdem_state a, b, a0, b0, c;
+    cdem_bc bca, bcb, bcc;
     fx_assembly(&a);
     fx_assembly(&b);
+    fx_assembly(&c);
     if (cdem_bc_init(&bca, p, &m, &a, &err) != CDEM_OK)
         fail_msg("%s: cdem_bc_init: %s", cdem_mode_name(mode), err.msg);
     assert_int_equal(cdem_bc_init(&bcb, p, &m, &b, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_init(&bcc, p, &m, &c, &err), CDEM_OK);
     assert_int_equal(a.n, b.n);
     scramble_free(&b);
     assert_int_equal(cdem_state_copy(&a0, &a, &err), CDEM_OK);
@@ -115,7 +119,28 @@ static void check_variant(cdem_mode mode, const cdem_params *p) {
         assert_true(cdem_bc_apply_is_boundary_only(&bca, k));
         assert_int_equal(cdem_bc_apply(&bca, &a, k, m.displacement_per_step, DT, &err), CDEM_OK);
         assert_int_equal(cdem_bc_apply(&bcb, &b, k, m.displacement_per_step, DT, &err), CDEM_OK);
+        /* a split mode: its moves over three ranges, last range first */
+        const cdem_bc_move_fn move = cdem_bc_step_move_of(&bcc, k);
+        if (move) {
+            assert_int_equal(cdem_bc_step_begin(&bcc, k, m.displacement_per_step, DT, &err),
+                             CDEM_OK);
+            const long n = (long)c.n, cut[4] = {0, n / 3, (2 * n) / 3, n};
+            for (int r = 2; r >= 0; r--)
+                move(bcc.ctx, &c, cut[r], cut[r + 1]);
+        } else {
+            assert_int_equal(cdem_bc_apply(&bcc, &c, k, m.displacement_per_step, DT, &err),
+                             CDEM_OK);
+        }
     }
+    /* the modes whose moves the stepper threads are split (repose moves nothing) */
+    if (mode != CDEM_MODE_REPOSE)
+        assert_non_null(cdem_bc_step_move_of(&bcc, 1));
+    for (size_t i = 0; i < a.n; i++)
+        if (!same_element(&a, &c, i))
+            fail_msg("%s: element id %d differs between apply and the split moves",
+                     cdem_mode_name(mode), (int)a.id[i]);
+    const double nc = cdem_bc_net_displacement(&bcc), na0 = cdem_bc_net_displacement(&bca);
+    assert_memory_equal(&nc, &na0, sizeof nc);
     size_t moved = 0;
     for (size_t i = 0; i < a.n; i++) {
         if (is_free(&a, i)) {
@@ -139,8 +164,10 @@ static void check_variant(cdem_mode mode, const cdem_params *p) {
     cdem_state_free(&b);
     cdem_state_free(&a0);
     cdem_state_free(&b0);
+    cdem_state_free(&c);
     cdem_bc_free(&bca);
     cdem_bc_free(&bcb);
+    cdem_bc_free(&bcc);
 }
 
 static void test_bc_boundary_only_modes_keep_their_promise(void **st) {
