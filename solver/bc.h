@@ -6,7 +6,9 @@
  * CDEM_FLAG_WALL / FAULT / MOVING, record its geometry); apply (deformation step k, 1-based:
  * move the prescribed elements by this step's boundary increment du, sense decided by the
  * mode, and set their velocity to the boundary velocity; walls never move otherwise; a mode
- * with moves_in_equilibration = 1 is also called on every equilibration step, with k = 0);
+ * with moves_in_equilibration = 1 is also called on every equilibration step, with k = 0;
+ * a boundary_only mode gives it as step_begin + step_move instead, so that the stepper can
+ * thread the moves: bc_planar_fault.c does);
  * net_displacement (m, of the moving boundary so far); view (one paragraph of the effective
  * settings); free (releases what init allocated in the context; NULL: nothing);
  * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]

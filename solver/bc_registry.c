@@ -74,6 +74,10 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
         bc->ops->step_move(bc->ctx, s, 0, (long)s->n);
         return CDEM_OK;
     }
+    if (!bc->ops->apply)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_bc_apply: mode %s has neither apply nor step_begin and step_move",
+                         bc->ops->name);
     return bc->ops->apply(bc->ctx, s, k <= 0 ? 0 : k, du, dt, err);
 }
 
