@@ -2,6 +2,8 @@
  * work here is creating the xy view. */
 #include "xdmf.h"
 
+#include "outfile.h"
+
 #include <errno.h>
 #include <limits.h>
 #include <stdlib.h>
@@ -164,22 +166,11 @@ cdem_status cdem_xdmf_write_file(const char *xmf_path, const cdem_xdmf_doc *doc,
     return CDEM_OK;
 }
 
-/* The folder part of path ("." when none), into buf. */
-static void folder_of(const char *path, char *buf, size_t cap) {
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(buf, cap, ".");
-    else if (slash == path)
-        snprintf(buf, cap, "/");
-    else
-        snprintf(buf, cap, "%.*s", (int)(slash - path), path);
-}
-
 cdem_status cdem_xdmf_reference(const char *h5_path, const char *xmf_path, char *buf, size_t cap,
                                 cdem_error *err) {
     char hdir[PATH_MAX], xdir[PATH_MAX], hreal[PATH_MAX], xreal[PATH_MAX];
-    folder_of(h5_path, hdir, sizeof hdir);
-    folder_of(xmf_path, xdir, sizeof xdir);
+    cdem_outfile_folder_of(h5_path, hdir, sizeof hdir);
+    cdem_outfile_folder_of(xmf_path, xdir, sizeof xdir);
     const char *slash = strrchr(h5_path, '/');
     const char *base = slash ? slash + 1 : h5_path;
     if (!realpath(hdir, hreal))
