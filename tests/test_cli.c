@@ -61,13 +61,8 @@ static int run(const cli_ctx *c, const char *args) {
 static char *slurp(const cli_ctx *c, const char *name) {
     char path[1100];
     snprintf(path, sizeof path, "%s/%s", c->scratch.dir, name);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    char *buf = calloc(1, 1 << 20);
+    char *buf = scratch_read_file(path);
     assert_non_null(buf);
-    size_t n = fread(buf, 1, (1 << 20) - 1, f);
-    buf[n] = '\0';
-    fclose(f);
     return buf;
 }
 

@@ -178,13 +178,8 @@ static void assert_same_dataset(hid_t fa, hid_t fb, const char *name) {
 }
 
 static char *read_text(const char *path) {
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    char *buf = calloc(1, 1 << 20);
+    char *buf = scratch_read_file(path);
     assert_non_null(buf);
-    size_t n = fread(buf, 1, (1 << 20) - 1, f);
-    buf[n] = '\0';
-    fclose(f);
     return buf;
 }
 
