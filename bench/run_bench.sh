@@ -4,7 +4,9 @@
 #      at 6, 24 and 240 MB (bench/bench_machine.c), the ceiling for the solver's own.
 #   1. Solver scaling: ns per element-step at ~2k, ~9k, ~35k and ~125k elements (the 100 x
 #      7.5 half-radii assembly), 1 and 2 threads interleaved in one process, medians of REPS,
-#      wall clock and CPU time, 2-thread speed-up (bench/bench_scale.c, "scale").
+#      wall clock and CPU time, 2-thread speed-up (bench/bench_scale.c, "scale"); beside it
+#      the machine's ceiling for that speed-up at that size and moment: two 1-thread copies
+#      of the same run at once, their joint rate against one alone.
 #   2. Long run: element-steps/s in each tenth of the default model's full schedule, first
 #      vs last tenth (bench/bench_scale.c, "full").
 #   3. Against LAMMPS on the same run (bench/lammps_bench.sh; installs Debian's lammps).
@@ -76,8 +78,8 @@ if has scale; then
     echo
     echo "== 1. Solver scaling (deformation of the default planar normal fault after $SETTLE settling steps;"
     echo "      N = all elements incl. walls; median of $REPS runs of ~$ELSTEPS element-steps; 1 and 2 threads interleaved)"
-    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s | %s\n' size N pairs builds \
-        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "load during"
+    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s %8s | %s\n' size N pairs builds \
+        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "2 copies" "load during"
     for size in $SIZES; do
         w=$(echo "$size" | cut -d: -f1)
         h=$(echo "$size" | cut -d: -f2)
@@ -96,14 +98,24 @@ if has scale; then
         # speed-up per repetition (1t and 2t of the same repetition are adjacent in time)
         sp=$(awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="seconds") a[$3]=$(i+1)}
                   /threads 2 / {for (i=1;i<NF;i++) if ($i=="seconds") if (a[$3] > 0) print a[$3]/$(i+1)}' "$out" | median)
+        # the ceiling: two independent 1-thread copies at once, each on its own core (no
+        # sharing, no synchronisation), their joint rate against the 1-thread rate above
+        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy1" &
+        copy=$!
+        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy2"
+        wait "$copy"
+        wc=$(cat "$out.copy1" "$out.copy2" | awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="ns_per_el_step") print $(i+1)}' | median)
+        cp=$(awk -v a="$w1" -v b="$wc" 'BEGIN {print 2 * a / b}')
         ld=$(field load "" "$out" | sort -g | awk 'NR==1 {lo=$1} {hi=$1} END {print lo "-" hi}')
-        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx | %s\n' \
-            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$ld"
+        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %7.2fx | %s\n' \
+            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ld"
     done
     echo "   ns/el = wall-clock ns per element-step (linear scaling = the same figure at every size);"
     echo "   cpu = process CPU ns per element-step (2t: both threads, so cpu 2t ~ cpu 1t when the threads do no extra work);"
     echo "   ns/cont = 1-thread wall ns per touching pair per step; builds = list rebuilds per timed run; 2t/1t = speed-up"
-    echo "   (median of the per-repetition ratios); raw lines in $WORK/scale_*.out"
+    echo "   (median of the per-repetition ratios); 2 copies = two 1-thread runs of the same size at once, their joint"
+    echo "   element-steps/s over one run's (median ns/el of both copies): what the 2 cores give independent work now,"
+    echo "   the ceiling of 2t/1t; raw lines in $WORK/scale_*.out(.copy1, .copy2)"
 fi
 
 if has full; then

@@ -2,9 +2,11 @@
  * key, (2) drop removed elements, (3) maybe permute the state into cell order, (4) bin the
  * elements into cells (common/grid.h: counting sort, each cell lists ascending indices), (5) for
  * each element i in index order scan the 3 x 3 cells around it for j > i within reach + skin, (6)
- * restore histories through the index map, (7) build the CSR. Step (5) is threaded above par_min
- * elements (contiguous element ranges per thread, buffers appended in thread order); everything
- * else is serial and ordered, so the list is the same for any thread count. */
+ * restore histories through the index map, (7) build the CSR. Above par_min elements (or
+ * pairs), (5) is threaded (contiguous element ranges per thread, buffers appended in thread
+ * order), and so are (1), the bounding box and cells of (4) and (6), each in a way that gives
+ * the same arrays as one loop; the re-sort, the cell sort and the CSR are serial. So the list
+ * is the same for any thread count. */
 #include "neighbour.h"
 
 #include "checkpoint.h"
@@ -136,29 +138,68 @@ static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err)
     return CDEM_OK;
 }
 
+/* Whether pair p has a history to carry. */
+static int has_history(const cdem_neighbour *nb, size_t p) {
+    return nb->hist[p] != 0 || nb->xs[p] != 0.0;
+}
+
+/* The histories to carry, in slot order: counted and copied by each thread over its own
+ * slot range (above par_min pairs), the ranges concatenated in order, so the same list as
+ * one loop. */
 static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_error *err) {
     nb->ncarry = 0;
     if (nb->n_builds == 0 || nb->n > s->n)
         return CDEM_OK; /* no list yet (or the state was replaced): nothing valid to carry */
-    size_t k = 0;
-    for (size_t p = 0; p < nb->np; p++)
-        k += (nb->hist[p] != 0 || nb->xs[p] != 0.0);
-    if (k > nb->carrycap) {
-        size_t c = next_cap(nb->carrycap, k);
-        CDEM_TRY(grow((void **)&nb->carry, sizeof(cdem_pair_carry), c, err));
-        nb->carrycap = c;
+    const size_t np = nb->np;
+    int nthr = omp_get_max_threads();
+    if (nthr > CDEM_NB_MAX_THREADS)
+        nthr = CDEM_NB_MAX_THREADS;
+    if ((long)np <= nb->par_min)
+        nthr = 1;
+    size_t count[CDEM_NB_MAX_THREADS + 1] = {0}, total = 0;
+    int failed = 0;
+#pragma omp parallel num_threads(nthr) if (nthr > 1)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const size_t a = np * (size_t)t / (size_t)nt, b = np * (size_t)(t + 1) / (size_t)nt;
+        size_t k = 0;
+        for (size_t p = a; p < b; p++)
+            k += has_history(nb, p);
+        count[t + 1] = k;
+#pragma omp barrier
+#pragma omp single
+        {
+            for (int q = 0; q < nt; q++)
+                count[q + 1] += count[q];
+            total = count[nt];
+            if (total > nb->carrycap) {
+                const size_t c = next_cap(nb->carrycap, total);
+                void *q = realloc(nb->carry, c * sizeof(cdem_pair_carry));
+                if (q) {
+                    nb->carry = q;
+                    nb->carrycap = c;
+                } else {
+                    failed = 1;
+                }
+            }
+        }
+        if (!failed) {
+            k = count[t];
+            for (size_t p = a; p < b; p++) {
+                if (!has_history(nb, p))
+                    continue;
+                nb->carry[k].i = nb->pi[p];
+                nb->carry[k].j = nb->pj[p];
+                nb->carry[k].xs = nb->xs[p];
+                nb->carry[k].hist = nb->hist[p];
+                k++;
+            }
+        }
     }
-    k = 0;
-    for (size_t p = 0; p < nb->np; p++) {
-        if (nb->hist[p] == 0 && nb->xs[p] == 0.0)
-            continue;
-        nb->carry[k].i = nb->pi[p];
-        nb->carry[k].j = nb->pj[p];
-        nb->carry[k].xs = nb->xs[p];
-        nb->carry[k].hist = nb->hist[p];
-        k++;
-    }
-    nb->ncarry = k;
+    if (failed)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "neighbour list: out of memory for %zu entries",
+                         total);
+    nb->ncarry = total;
     return CDEM_OK;
 }
 
@@ -235,7 +276,10 @@ static int buf_grow(cdem_pair_buf *b, size_t want) {
 }
 
 /* Enumerates the pairs (i, j > i) of the elements lo..hi-1 in index order: into the list
- * (buf NULL; serial) or into buf (one thread's share; err unused, buf->failed on NOMEM). */
+ * (buf NULL; serial) or into buf (one thread's share; err unused, buf->failed on NOMEM). The
+ * buffer's count is kept in a local and stored once at the end: the threads' buffer
+ * structs share cache lines, and a count stored at every pair made each store a transfer
+ * between the cores (the threaded enumeration ran 1.4 times slower per thread). */
 static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem_grid *g, size_t lo,
                              size_t hi, cdem_pair_buf *buf, cdem_error *err) {
     const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
@@ -243,6 +287,7 @@ static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem
     const int32_t *restrict cell_start = nb->cell_start, *restrict cell_items = nb->cell_items;
     const double rf = nb->reach_factor, skin = nb->skin;
     const size_t nx = g->nx;
+    size_t bn = buf ? buf->n : 0; /* buf->n, in a register (see above) */
     for (size_t i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_FOOTWALL)
             continue;
@@ -265,11 +310,12 @@ static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem
                 if (cls < 0)
                     continue;
                 if (buf) {
-                    if (buf->n == buf->cap && buf_grow(buf, buf->n + 1) != 0) {
+                    if (bn == buf->cap && buf_grow(buf, bn + 1) != 0) {
+                        buf->n = bn;
                         buf->failed = 1;
                         return CDEM_ERR_NOMEM;
                     }
-                    const size_t p = buf->n++;
+                    const size_t p = bn++;
                     buf->pi[p] = (int32_t)i;
                     buf->pj[p] = (int32_t)j;
                     buf->R[p] = R;
@@ -290,6 +336,35 @@ static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem
             }
         }
     }
+    if (buf)
+        buf->n = bn;
+    return CDEM_OK;
+}
+
+/* The CSR of slots per element (neighbour.h), in ascending slot order: counts, running
+ * sums, then jslot by a counting sort by pj. (Threaded, with a count row per thread, it was
+ * no faster on 2 cores: the passes are bound by memory.) */
+static cdem_status build_csr(cdem_neighbour *nb, size_t n, cdem_error *err) {
+    const size_t np = nb->np;
+    if (np > 0)
+        CDEM_TRY(reserve_pairs(nb, np, err));
+    int32_t *restrict istart = nb->istart, *restrict jstart = nb->jstart;
+    const int32_t *restrict pi = nb->pi, *restrict pj = nb->pj;
+    memset(istart, 0, (n + 1) * sizeof(int32_t));
+    memset(jstart, 0, (n + 1) * sizeof(int32_t));
+    for (size_t p = 0; p < np; p++) {
+        istart[pi[p] + 1]++;
+        jstart[pj[p] + 1]++;
+    }
+    for (size_t i = 0; i < n; i++) {
+        istart[i + 1] += istart[i];
+        jstart[i + 1] += jstart[i];
+    }
+    int32_t *restrict cursor = (int32_t *)nb->scratch;
+    if (n > 0)
+        memcpy(cursor, jstart, n * sizeof(int32_t));
+    for (size_t p = 0; p < np; p++)
+        nb->jslot[cursor[pj[p]]++] = (int32_t)p;
     return CDEM_OK;
 }
 
@@ -306,23 +381,33 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     }
     const size_t n = s->n;
 
-    /* bounding box, largest radius, finiteness */
+    /* bounding box, largest radius, finiteness (threaded: minima and maxima do not depend on
+     * the order, but for the sign of a zero, which moves no element to another cell) */
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        if (!isfinite(s->x[i]) || !isfinite(s->y[i]))
-            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
-                             "element id %d has a non-finite position (x = %g, y = %g): the "
-                             "simulation blew up; the time step is probably too large for the "
-                             "spring constants and masses",
-                             (int)s->id[i], s->x[i], s->y[i]);
+    const double *restrict px = s->x, *restrict py = s->y, *restrict prad = s->radius;
+    int bad = 0;
+#pragma omp parallel for schedule(static) if ((long)n > nb->par_min) reduction(min                 \
+                                                                               : xmin, ymin)       \
+    reduction(max                                                                                  \
+              : xmax, ymax, rmax) reduction(|                                                      \
+                                            : bad)
+    for (long i = 0; i < (long)n; i++) {
         /* plain comparisons (the values are finite here): fmin/fmax are library calls */
-        const double xi = s->x[i], yi = s->y[i], ri = s->radius[i];
+        const double xi = px[i], yi = py[i], ri = prad[i];
+        bad |= !(isfinite(xi) && isfinite(yi));
         xmin = xi < xmin ? xi : xmin;
         xmax = xi > xmax ? xi : xmax;
         ymin = yi < ymin ? yi : ymin;
         ymax = yi > ymax ? yi : ymax;
         rmax = ri > rmax ? ri : rmax;
     }
+    for (size_t i = 0; bad && i < n; i++)
+        if (!isfinite(s->x[i]) || !isfinite(s->y[i]))
+            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                             "element id %d has a non-finite position (x = %g, y = %g): the "
+                             "simulation blew up; the time step is probably too large for the "
+                             "spring constants and masses",
+                             (int)s->id[i], s->x[i], s->y[i]);
     if (n == 0) {
         xmin = xmax = ymin = ymax = 0.0;
     }
@@ -336,8 +421,10 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         CDEM_TRY(grow((void **)&nb->cell_start, sizeof(int32_t), c, err));
         nb->ccap = c;
     }
-    for (size_t i = 0; i < n; i++)
-        nb->cell_of[i] = (int32_t)cdem_grid_cell(&g, s->x[i], s->y[i]);
+    int32_t *restrict cell_of = nb->cell_of;
+#pragma omp parallel for schedule(static) if ((long)n > nb->par_min)
+    for (long i = 0; i < (long)n; i++)
+        cell_of[i] = (int32_t)cdem_grid_cell(&g, px[i], py[i]);
     int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
     if (do_sort && n > 1) {
         /* stable counting sort by (boundary element?, cell): free elements first in cell
@@ -431,25 +518,7 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
                              n);
         }
     }
-    /* CSR of slots per element, ascending slot order */
-    if (nb->np > 0)
-        CDEM_TRY(reserve_pairs(nb, nb->np, err));
-    memset(nb->istart, 0, (n + 1) * sizeof(int32_t));
-    memset(nb->jstart, 0, (n + 1) * sizeof(int32_t));
-    for (size_t p = 0; p < nb->np; p++) {
-        nb->istart[nb->pi[p] + 1]++;
-        nb->jstart[nb->pj[p] + 1]++;
-    }
-    for (size_t i = 0; i < n; i++) {
-        nb->istart[i + 1] += nb->istart[i];
-        nb->jstart[i + 1] += nb->jstart[i];
-    }
-    {
-        int32_t *cursor = (int32_t *)nb->scratch;
-        memcpy(cursor, nb->jstart, n * sizeof(int32_t));
-        for (size_t p = 0; p < nb->np; p++)
-            nb->jslot[cursor[nb->pj[p]]++] = (int32_t)p;
-    }
+    CDEM_TRY(build_csr(nb, n, err));
     restore_carry(nb);
     memcpy(nb->x0, s->x, n * sizeof(double));
     memcpy(nb->y0, s->y, n * sizeof(double));
@@ -542,20 +611,5 @@ cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot 
     nb->n_sorts = (long)n_sorts;
     nb->ncarry = 0;
     /* the CSR exactly as cdem_neighbour_build derives it from pi, pj */
-    memset(nb->istart, 0, (N_ + 1) * sizeof(int32_t));
-    memset(nb->jstart, 0, (N_ + 1) * sizeof(int32_t));
-    for (size_t p = 0; p < P_; p++) {
-        nb->istart[nb->pi[p] + 1]++;
-        nb->jstart[nb->pj[p] + 1]++;
-    }
-    for (size_t i = 0; i < N_; i++) {
-        nb->istart[i + 1] += nb->istart[i];
-        nb->jstart[i + 1] += nb->jstart[i];
-    }
-    int32_t *cursor = (int32_t *)nb->scratch;
-    if (N_ > 0)
-        memcpy(cursor, nb->jstart, N_ * sizeof(int32_t));
-    for (size_t p = 0; p < P_; p++)
-        nb->jslot[cursor[nb->pj[p]]++] = (int32_t)p;
-    return CDEM_OK;
+    return build_csr(nb, N_, err);
 }

@@ -10,8 +10,8 @@
  * Between builds the caller may only append elements to the state (removal goes through
  * the keep argument of the build). Ownership: cdem_neighbour owns its buffers (grown geometrically,
  * only at build time); it never owns the state. Thread safety: one build at a time (it
- * threads its pair enumeration itself: same list for any thread count); readers may share
- * the lists. Units: m. */
+ * threads its pair enumeration and its other long passes itself: the same list for any thread
+ * count); readers may share the lists. Units: m. */
 #ifndef CDEM_NEIGHBOUR_H
 #define CDEM_NEIGHBOUR_H
 

@@ -221,8 +221,10 @@ static void test_neighbour_rejects_bad_input(void **st) {
     cdem_state_free(&s);
 }
 
-/* The threaded pair enumeration (par_min 0, 1..3 threads, contiguous element ranges per
- * thread) gives the same list, slot for slot, as the serial one, and it equals brute force. */
+/* The threaded build (par_min 0, 1..3 threads: the enumeration over contiguous element
+ * ranges, the carried histories, the bounding box and cells, the CSR) gives the same list,
+ * slot for slot, as the serial one, and it equals brute force; so does a second build that
+ * carries histories through a re-sort. */
 static void test_neighbour_threaded_build_same_list(void **st) {
     (void)st;
     const int saved = omp_get_max_threads();
@@ -251,6 +253,41 @@ static void test_neighbour_threaded_build_same_list(void **st) {
         assert_memory_equal(nb[t].jslot, nb[0].jslot, nb[0].np * sizeof *nb[0].jslot);
         for (size_t p = 0; p < nb[t].np; p++)
             assert_true(nb[t].hist[p] == 0 && nb[t].xs[p] == 0.0);
+    }
+    for (int t = 1; t < 3; t++) {
+        assert_memory_equal(nb[t].istart, nb[0].istart, (s[0].n + 1) * sizeof *nb[0].istart);
+        assert_memory_equal(nb[t].jstart, nb[0].jstart, (s[0].n + 1) * sizeof *nb[0].jstart);
+    }
+    /* histories on some pairs, every element moved a little, built again with a re-sort */
+    for (int t = 0; t < 3; t++) {
+        for (size_t p = 0; p < nb[t].np; p++) {
+            nb[t].hist[p] = p % 3 == 0 ? CDEM_PAIR_TOUCH : 0;
+            nb[t].xs[p] = p % 5 == 0 ? 1e-6 * (double)p : 0.0;
+        }
+        for (size_t i = 0; i < s[t].n; i++) {
+            s[t].x[i] += 0.5 * sin((double)s[t].id[i]);
+            s[t].y[i] += 0.5 * cos((double)s[t].id[i]);
+        }
+        omp_set_num_threads(t + 1);
+        assert_int_equal(cdem_neighbour_build(&nb[t], &s[t], NULL, 1, &err), CDEM_OK);
+    }
+    omp_set_num_threads(saved);
+    size_t carried = 0;
+    for (size_t p = 0; p < nb[0].np; p++)
+        carried += nb[0].hist[p] != 0;
+    assert_true(carried > 1000);
+    for (int t = 1; t < 3; t++) {
+        assert_int_equal(nb[t].np, nb[0].np);
+        assert_int_equal(nb[t].ncarry, nb[0].ncarry);
+        assert_memory_equal(s[t].id, s[0].id, s[0].n * sizeof *s[0].id);
+        assert_memory_equal(nb[t].pi, nb[0].pi, nb[0].np * sizeof *nb[0].pi);
+        assert_memory_equal(nb[t].pj, nb[0].pj, nb[0].np * sizeof *nb[0].pj);
+        assert_memory_equal(nb[t].hist, nb[0].hist, nb[0].np * sizeof *nb[0].hist);
+        assert_memory_equal(nb[t].xs, nb[0].xs, nb[0].np * sizeof *nb[0].xs);
+        assert_memory_equal(nb[t].jslot, nb[0].jslot, nb[0].np * sizeof *nb[0].jslot);
+        assert_memory_equal(nb[t].istart, nb[0].istart, (s[0].n + 1) * sizeof *nb[0].istart);
+        assert_memory_equal(nb[t].jstart, nb[0].jstart, (s[0].n + 1) * sizeof *nb[0].jstart);
+        assert_memory_equal(nb[t].cell_of, nb[0].cell_of, s[0].n * sizeof *nb[0].cell_of);
     }
     free(bk);
     for (int t = 0; t < 3; t++) {
