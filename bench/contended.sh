@@ -16,11 +16,12 @@
 #                  passive   OMP_WAIT_POLICY=passive
 #                  spin:N    GOMP_SPINCOUNT=N
 #   MODEL="-s assembly.width=20 -s assembly.half_radii=on"  (16,700 elements)
-#   STEPS=4000  REPS=3 (medians)  WORK=/tmp/cdem_bench
+#   STEPS=10000  REPS=3 (medians)  WORK=/tmp/cdem_bench  (runs of 3-6 s: shorter ones were
+#                  dominated by start-up and by the governor's first probes)
 BUILD=${1:-build}
 WAITS=${WAITS:-cdem}
 MODEL=${MODEL:-"-s assembly.width=20 -s assembly.half_radii=on"}
-STEPS=${STEPS:-4000}
+STEPS=${STEPS:-10000}
 REPS=${REPS:-3}
 WORK=${WORK:-/tmp/cdem_bench}
 mkdir -p "$WORK"

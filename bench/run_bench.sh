@@ -99,13 +99,16 @@ if has scale; then
         sp=$(awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="seconds") a[$3]=$(i+1)}
                   /threads 2 / {for (i=1;i<NF;i++) if ($i=="seconds") if (a[$3] > 0) print a[$3]/$(i+1)}' "$out" | median)
         # the ceiling: two independent 1-thread copies at once, each on its own core (no
-        # sharing, no synchronisation), their joint rate against the 1-thread rate above
+        # sharing, no synchronisation), their joint rate against one copy run alone just
+        # before (this machine's speed drifts over minutes: the two are measured adjacent)
+        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.alone"
         OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy1" &
         copy=$!
         OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy2"
         wait "$copy"
         wc=$(cat "$out.copy1" "$out.copy2" | awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="ns_per_el_step") print $(i+1)}' | median)
-        cp=$(awk -v a="$w1" -v b="$wc" 'BEGIN {print 2 * a / b}')
+        wa=$(field ns_per_el_step "threads 1 " "$out.alone" | median)
+        cp=$(awk -v a="$wa" -v b="$wc" 'BEGIN {print 2 * a / b}')
         ld=$(field load "" "$out" | sort -g | awk 'NR==1 {lo=$1} {hi=$1} END {print lo "-" hi}')
         printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %7.2fx | %s\n' \
             "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ld"
@@ -114,8 +117,8 @@ if has scale; then
     echo "   cpu = process CPU ns per element-step (2t: both threads, so cpu 2t ~ cpu 1t when the threads do no extra work);"
     echo "   ns/cont = 1-thread wall ns per touching pair per step; builds = list rebuilds per timed run; 2t/1t = speed-up"
     echo "   (median of the per-repetition ratios); 2 copies = two 1-thread runs of the same size at once, their joint"
-    echo "   element-steps/s over one run's (median ns/el of both copies): what the 2 cores give independent work now,"
-    echo "   the ceiling of 2t/1t; raw lines in $WORK/scale_*.out(.copy1, .copy2)"
+    echo "   element-steps/s over one such run's alone just before (medians): what the 2 cores give independent work"
+    echo "   now, the ceiling of 2t/1t; raw lines in $WORK/scale_*.out(.alone, .copy1, .copy2)"
 fi
 
 if has full; then
