@@ -221,6 +221,26 @@ static void test_neighbour_rejects_bad_input(void **st) {
     cdem_state_free(&s);
 }
 
+/* The list of nb (state s) is the list of ref (state rs), array by array: the elements'
+ * order, the pairs with their histories, the CSR and the cells. */
+static void assert_same_list(const cdem_neighbour *nb, const cdem_state *s,
+                             const cdem_neighbour *ref, const cdem_state *rs) {
+    const size_t np = ref->np, n = rs->n;
+    assert_int_equal(nb->np, np);
+    assert_int_equal(s->n, n);
+    assert_memory_equal(s->id, rs->id, n * sizeof *rs->id);
+    assert_memory_equal(nb->pi, ref->pi, np * sizeof *ref->pi);
+    assert_memory_equal(nb->pj, ref->pj, np * sizeof *ref->pj);
+    assert_memory_equal(nb->R, ref->R, np * sizeof *ref->R);
+    assert_memory_equal(nb->cls, ref->cls, np * sizeof *ref->cls);
+    assert_memory_equal(nb->hist, ref->hist, np * sizeof *ref->hist);
+    assert_memory_equal(nb->xs, ref->xs, np * sizeof *ref->xs);
+    assert_memory_equal(nb->jslot, ref->jslot, np * sizeof *ref->jslot);
+    assert_memory_equal(nb->istart, ref->istart, (n + 1) * sizeof *ref->istart);
+    assert_memory_equal(nb->jstart, ref->jstart, (n + 1) * sizeof *ref->jstart);
+    assert_memory_equal(nb->cell_of, ref->cell_of, n * sizeof *ref->cell_of);
+}
+
 /* The threaded build (par_min 0, 1..3 threads: the enumeration over contiguous element
  * ranges, the carried histories, the bounding box and cells, the CSR) gives the same list,
  * slot for slot, as the serial one, and it equals brute force; so does a second build that
@@ -243,21 +263,10 @@ static void test_neighbour_threaded_build_same_list(void **st) {
     const size_t nbk = brute_pairs(&s[0], nb[0].reach_factor, nb[0].skin, &bk);
     assert_int_equal(nb[0].np, nbk);
     assert_true(nbk > 3000);
-    for (int t = 1; t < 3; t++) {
-        assert_int_equal(nb[t].np, nb[0].np);
-        assert_memory_equal(s[t].id, s[0].id, s[0].n * sizeof *s[0].id);
-        assert_memory_equal(nb[t].pi, nb[0].pi, nb[0].np * sizeof *nb[0].pi);
-        assert_memory_equal(nb[t].pj, nb[0].pj, nb[0].np * sizeof *nb[0].pj);
-        assert_memory_equal(nb[t].R, nb[0].R, nb[0].np * sizeof *nb[0].R);
-        assert_memory_equal(nb[t].cls, nb[0].cls, nb[0].np * sizeof *nb[0].cls);
-        assert_memory_equal(nb[t].jslot, nb[0].jslot, nb[0].np * sizeof *nb[0].jslot);
-        for (size_t p = 0; p < nb[t].np; p++)
-            assert_true(nb[t].hist[p] == 0 && nb[t].xs[p] == 0.0);
-    }
-    for (int t = 1; t < 3; t++) {
-        assert_memory_equal(nb[t].istart, nb[0].istart, (s[0].n + 1) * sizeof *nb[0].istart);
-        assert_memory_equal(nb[t].jstart, nb[0].jstart, (s[0].n + 1) * sizeof *nb[0].jstart);
-    }
+    for (size_t p = 0; p < nb[0].np; p++)
+        assert_true(nb[0].hist[p] == 0 && nb[0].xs[p] == 0.0);
+    for (int t = 1; t < 3; t++)
+        assert_same_list(&nb[t], &s[t], &nb[0], &s[0]);
     /* histories on some pairs, every element moved a little, built again with a re-sort */
     for (int t = 0; t < 3; t++) {
         for (size_t p = 0; p < nb[t].np; p++) {
@@ -277,17 +286,8 @@ static void test_neighbour_threaded_build_same_list(void **st) {
         carried += nb[0].hist[p] != 0;
     assert_true(carried > 1000);
     for (int t = 1; t < 3; t++) {
-        assert_int_equal(nb[t].np, nb[0].np);
         assert_int_equal(nb[t].ncarry, nb[0].ncarry);
-        assert_memory_equal(s[t].id, s[0].id, s[0].n * sizeof *s[0].id);
-        assert_memory_equal(nb[t].pi, nb[0].pi, nb[0].np * sizeof *nb[0].pi);
-        assert_memory_equal(nb[t].pj, nb[0].pj, nb[0].np * sizeof *nb[0].pj);
-        assert_memory_equal(nb[t].hist, nb[0].hist, nb[0].np * sizeof *nb[0].hist);
-        assert_memory_equal(nb[t].xs, nb[0].xs, nb[0].np * sizeof *nb[0].xs);
-        assert_memory_equal(nb[t].jslot, nb[0].jslot, nb[0].np * sizeof *nb[0].jslot);
-        assert_memory_equal(nb[t].istart, nb[0].istart, (s[0].n + 1) * sizeof *nb[0].istart);
-        assert_memory_equal(nb[t].jstart, nb[0].jstart, (s[0].n + 1) * sizeof *nb[0].jstart);
-        assert_memory_equal(nb[t].cell_of, nb[0].cell_of, s[0].n * sizeof *nb[0].cell_of);
+        assert_same_list(&nb[t], &s[t], &nb[0], &s[0]);
     }
     free(bk);
     for (int t = 0; t < 3; t++) {
