@@ -138,6 +138,15 @@ static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err)
     return CDEM_OK;
 }
 
+/* Threads for a threaded pass of a build over `items` elements or pairs: 1 at or below
+ * par_min, else the current OpenMP count up to CDEM_NB_MAX_THREADS. */
+static int build_threads(const cdem_neighbour *nb, size_t items) {
+    if ((long)items <= nb->par_min)
+        return 1;
+    const int nthr = omp_get_max_threads();
+    return nthr > CDEM_NB_MAX_THREADS ? CDEM_NB_MAX_THREADS : nthr < 1 ? 1 : nthr;
+}
+
 /* Whether pair p has a history to carry. */
 static int has_history(const cdem_neighbour *nb, size_t p) {
     return nb->hist[p] != 0 || nb->xs[p] != 0.0;
@@ -151,11 +160,7 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
     if (nb->n_builds == 0 || nb->n > s->n)
         return CDEM_OK; /* no list yet (or the state was replaced): nothing valid to carry */
     const size_t np = nb->np;
-    int nthr = omp_get_max_threads();
-    if (nthr > CDEM_NB_MAX_THREADS)
-        nthr = CDEM_NB_MAX_THREADS;
-    if ((long)np <= nb->par_min)
-        nthr = 1;
+    const int nthr = build_threads(nb, np);
     size_t count[CDEM_NB_MAX_THREADS + 1] = {0}, total = 0;
     int failed = 0;
 #pragma omp parallel num_threads(nthr) if (nthr > 1)
@@ -386,11 +391,10 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
     const double *restrict px = s->x, *restrict py = s->y, *restrict prad = s->radius;
     int bad = 0;
-#pragma omp parallel for schedule(static) if ((long)n > nb->par_min) reduction(min                 \
-                                                                               : xmin, ymin)       \
-    reduction(max                                                                                  \
-              : xmax, ymax, rmax) reduction(|                                                      \
-                                            : bad)
+    /* clang-format off */
+#pragma omp parallel for schedule(static) if ((long)n > nb->par_min) \
+    reduction(min : xmin, ymin) reduction(max : xmax, ymax, rmax) reduction(| : bad)
+    /* clang-format on */
     for (long i = 0; i < (long)n; i++) {
         /* plain comparisons (the values are finite here): fmin/fmax are library calls */
         const double xi = px[i], yi = py[i], ri = prad[i];
@@ -462,10 +466,8 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
 
     /* enumerate pairs: element i in index order, j > i in the 3 x 3 cells around it */
     nb->np = 0;
-    int nthr = omp_get_max_threads();
-    if (nthr > CDEM_NB_MAX_THREADS)
-        nthr = CDEM_NB_MAX_THREADS;
-    if ((long)n < nb->par_min || nthr < 2) {
+    const int nthr = build_threads(nb, n);
+    if (nthr < 2) {
         CDEM_TRY(enumerate(nb, s, &g, 0, n, NULL, err));
     } else {
         /* thread t takes the t-th contiguous element range into its own buffer; the buffers
