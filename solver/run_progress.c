@@ -109,8 +109,9 @@ void run_progress(run_ctx *r, int force) {
     run_progress_line(r, force, NULL);
 }
 
-/* The last line of a run's log: the file, its size, the increments it holds and how the run
- * ended, with how to continue one that stopped early. */
+/* The last line of a run's log: the file, its size, the increments it holds, the speed, the
+ * threads and the pair kernel (avx2 or scalar: the same bits, not the same speed), and how the
+ * run ended, with how to continue one that stopped early. */
 void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
     if (!run_logging(r) || !had_writer || !r->opt->output_path)
         return;
@@ -136,7 +137,9 @@ void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
                  100.0 * (double)r->gov.steps_on_one / (double)steps);
     fprintf(r->opt->log,
             "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "
-            "%ld steps in %.1f s wall time, %.3g element-steps/s on %s; stop reason: %s%s)\n",
+            "%ld steps in %.1f s wall time, %.3g element-steps/s on %s; pair kernel %s; stop "
+            "reason: %s%s)\n",
             r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, steps, wall,
-            wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads, how, hint);
+            wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads,
+            cdem_force_path_name(r->it.force.path), how, hint);
 }
