@@ -9,7 +9,8 @@
  * waits only if it reaches a cross pair not yet evaluated. Each element's sum has the same
  * additions in the same order (ascending pair index) for any cut, so any thread count and
  * any cut give identical bits, the same as the serial scatter. One parallel region and one
- * barrier per pass. */
+ * barrier per pass (the first pass after a list build or a change of thread count also
+ * lists the cross pairs, in a region of its own). */
 #include "force.h"
 
 #include "force_pairs.h"

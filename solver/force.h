@@ -143,7 +143,8 @@ int cdem_force_drift(cdem_state *s, double dt, const double *drift_factor, const
 
 /* One force pass over the pair list nb (matching the state's element count): the drift
  * (in->drift), pair forces, per-element sums and the element finish, threaded over chunks
- * (one parallel region; each
+ * (one parallel region, and after a list build or a change of thread count a second one
+ * before it that lists the cross pairs; each
  * thread evaluates the cross pairs into its chunks, publishing its progress, then runs its
  * chunks, waiting only where it meets a cross pair not yet evaluated).
  * check_moved: if some element moved more than half the skin since the last build (tested

@@ -56,7 +56,7 @@ typedef struct {
     cdem_contact_law law;  /* contact law and materials */
     cdem_neighbour nb;     /* pair list with histories and force slots */
     long step;             /* steps taken so far */
-    long par_min;          /* loops over fewer items than this run on one thread (>= 0);
+    long par_min;          /* loops over at most this many items run on one thread (>= 0);
                               results are bit-identical either way */
     /* 1 on the steps of the equilibration (the packing phase), 0 afterwards: selects the law
      * in force (cdem_contact_law_phase: settling friction, cohesion of forming contacts).
@@ -96,7 +96,8 @@ void cdem_integrator_enable_escape(cdem_integrator *it);
 cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error *err);
 
 /* One time step. bc (may be NULL: walls still) is applied with deformation step k and
- * increment du after the drift. Fails with CDEM_ERR_NUMERIC naming the element and step
+ * increment du: before the drift when it moves boundary elements only (the two commute
+ * exactly), else after it. Fails with CDEM_ERR_NUMERIC naming the element and step
  * when a position becomes NaN/Inf. */
 cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc, long k, double du,
                                  cdem_error *err);

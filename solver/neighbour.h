@@ -48,8 +48,9 @@ typedef struct {
     double skin;         /* m, extra list distance beyond contact reach, > 0 */
     double reach_factor; /* pairs interact up to R * reach_factor (1 + max breaking strain) */
     int resort_every;    /* re-sort the state into cell order every this many builds, >= 1 */
-    long par_min;        /* builds of fewer elements than this enumerate pairs on one thread;
-                            the list is the same either way (default CDEM_PAR_MIN, >= 0) */
+    long par_min;        /* builds of at most this many elements enumerate pairs on one
+                            thread; the list is the same either way (default CDEM_PAR_MIN,
+                            >= 0) */
 
     /* pair list, struct of arrays, np used of pcap */
     size_t np, pcap;

@@ -10,7 +10,7 @@
 #ifndef CDEM_PARALLEL_H
 #define CDEM_PARALLEL_H
 
-/* Loops over fewer items than this run on one thread (elements or pairs). */
+/* Loops over at most this many items run on one thread (elements or pairs). */
 #define CDEM_PAR_MIN 8192
 
 /* CDEM_PAR_MIN as a string literal, for help texts. */

@@ -13,10 +13,10 @@
  * ("stopped-early", CDEM_OK). Checkpoints: after the step of every checkpoint_interval-th
  * increment and at a stop, cdem_run_capture (every module under its own prefix) ->
  * cdem_h5_writer_write_checkpoint; a resume re-runs the set-up, restores, reopens the file.
- * Progress goes to opt->log only (never stdout); the wall clock is read only for the progress
- * display, never for results. This file holds the set-up and the loop; the increments and
- * samples are run_output.c, the progress display run_progress.c, the checkpoints and resume
- * run_ckpt.c (run_internal.h). */
+ * Progress goes to opt->log only (never stdout); the wall clock is read for the progress
+ * display and the thread governor, never for results. This file holds the set-up and the loop; the
+ * increments and samples are run_output.c, the progress display run_progress.c, the checkpoints and
+ * resume run_ckpt.c (run_internal.h). */
 #include "run_internal.h"
 
 #include "checkpoint.h"

@@ -26,8 +26,8 @@
 #define CDEM_VERSION "0.0.0"
 #endif
 
-/* The progress display's state (run_progress.c; the wall clock is read for it only, never
- * for results). */
+/* The progress display's state (run_progress.c; the wall clock it reads never reaches a
+ * result). */
 typedef struct {
     long step0;                 /* step at which this process started (progress rate only) */
     double t_start, t_last_log; /* s, monotonic clock */

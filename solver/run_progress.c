@@ -1,7 +1,7 @@
 /* run_progress: the progress display of a run and the log line that ends it (run_internal.h).
- * Progress goes to opt->log only (never stdout); the wall clock is read only here, never for
- * results. On a terminal one line is redrawn (at most 4 times a second), else a log line every
- * tenth of the run or 30 s. */
+ * Progress goes to opt->log only (never stdout); the wall clock is read here for the display,
+ * never for results. On a terminal one line is redrawn (at most 4 times a second), else a log line
+ * every tenth of the run or 30 s. */
 #include "run_internal.h"
 
 #include <math.h>
