@@ -55,11 +55,11 @@ _cdem_strain() {
             --increment) COMPREPLY=($(compgen -W "last first equil all" -- "$cur")); return ;;
             --color|--colour) COMPREPLY=($(compgen -W "incr-disp-x incr-disp-y incr-disp-mag total-disp-x total-disp-y total-disp-mag uplift incr-e1 incr-e3 incr-max-shear incr-dilation incr-rotation incr-s1-direction total-e1 total-e3 total-max-shear total-dilation total-s1-direction cum-e1 cum-e3 cum-max-shear cum-dilation sxx syy sxy sigma1 sigma3 max-shear-stress sigma1-direction" -- "$cur")); return ;;
             --vectors) COMPREPLY=($(compgen -W "incr total" -- "$cur")); return ;;
-            --axes|-strain|-strain) COMPREPLY=($(compgen -W "incr total stress" -- "$cur")); return ;;
+            --axes) COMPREPLY=($(compgen -W "incr-strain total-strain stress" -- "$cur")); return ;;
             --width) return ;;
             --height) return ;;
             --zoom) return ;;
-            --highlight|-LAST) return ;;
+            --highlight) return ;;
             --color-walls|--colour-walls) return ;;
             --color-layers|--colour-layers) return ;;
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
@@ -70,7 +70,7 @@ _cdem_strain() {
             --delay) return ;;
             --interval) return ;;
         esac
-        opts="--increment --color --colour --above-tenth-max --vectors --axes -strain -strain --shear-axes --no-fill --no-colours --no-colors --no-scale-bar --no-colour-bar --no-color-bar --no-label --width --height --zoom --highlight -LAST --color-walls --colour-walls --color-layers --colour-layers -o --output --prefix --format --gif --backward --odd --gif-scale --delay --follow --interval -h --help" ;;
+        opts="--increment --color --colour --above-tenth-max --vectors --axes --shear-axes --no-fill --no-colours --no-colors --no-scale-bar --no-colour-bar --no-color-bar --no-label --width --height --zoom --highlight --color-walls --colour-walls --color-layers --colour-layers -o --output --prefix --format --gif --backward --odd --gif-scale --delay --follow --interval -h --help" ;;
     series)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
@@ -140,10 +140,10 @@ _cdem_strain() {
         opts="--x --y -o --output --labels --columns --legend --width --height -h --help" ;;
     export-sspx)
         case "$prev" in
-            --increments|-B) return ;;
+            --increments) return ;;
             --prefix) return ;;
         esac
-        opts="--increments -B --prefix -h --help" ;;
+        opts="--increments --prefix -h --help" ;;
     export-biaxial)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;

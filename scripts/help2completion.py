@@ -28,8 +28,10 @@ def options_of(lists):
         if heading != "Options":
             continue
         for key, _ in items:
-            names = re.findall(r"(--?[A-Za-z0-9][-A-Za-z0-9]*)", key)
-            rest = re.sub(r"(--?[A-Za-z0-9][-A-Za-z0-9]*)(,\s*)?", "", key).strip()
+            # an option name starts a word: the hyphen inside a value such as
+            # `incr-strain|total-strain` or `FIRST-LAST` does not start one
+            names = re.findall(r"(?<![\w-])(--?[A-Za-z0-9][-A-Za-z0-9]*)", key)
+            rest = re.sub(r"(?<![\w-])(--?[A-Za-z0-9][-A-Za-z0-9]*)(,\s*)?", "", key).strip()
             out.append((names, rest or None))
     return out
 

@@ -31,7 +31,7 @@ static const cdem_cli_help help = {
     .about = "Fault zones picked from a strain field: the free elements' values are binned on "
              "a square grid, runs of cells at or above the threshold in each row are linked "
              "from the top down into zones, and a line through each zone gives its dip and "
-             "dip direction (analysis/measure/faults.h, docs/analysis.md \"Faults\"). CSV, one row "
+             "dip direction (analysis/measure/faults.h, docs/analysis.md \"Fault zones\"). CSV, one row "
              "per zone ordered by x at its top: zone, x_top, y_top, x_bottom, y_bottom (m), "
              "dip (degrees), dips (left or right), rows, mean and max value. A summary line "
              "goes to standard error.",

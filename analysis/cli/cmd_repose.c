@@ -23,7 +23,7 @@ static const cdem_cli_help help = {
     .program = "cdem-strain repose",
     .forms = repose_forms,
     .about = "Angle of repose: the slope of the free surface of a repose-collapse run, fitted "
-             "on each flank (docs/analysis.md).",
+             "on each flank (docs/rendering.md, \"cdem-strain repose\").",
     .options = repose_options,
 };
 
