@@ -481,6 +481,67 @@ static void test_format_inconsistent_datasets(void **state) {
     remove_pair(path);
 }
 
+/* Extends a chunked dataset of group "increments" (not the index) to *(hsize_t *)rows rows,
+ * with no storage written: as a forged file can. */
+static herr_t extend_dataset(hid_t g, const char *name, const H5L_info_t *info, void *rows) {
+    (void)info;
+    if (strcmp(name, "index") == 0)
+        return 0;
+    hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+    assert_true(ds >= 0);
+    hid_t cp = H5Dget_create_plist(ds);
+    if (H5Pget_layout(cp) == H5D_CHUNKED) /* the element datasets; not the virtual xy view */
+        assert_true(H5Dset_extent(ds, (const hsize_t *)rows) >= 0);
+    H5Pclose(cp);
+    H5Dclose(ds);
+    return 0;
+}
+
+/* A version-2 file whose index claims 25 million elements for an increment, behind extents
+ * that were declared but never written (an 89 kB file can): refused before allocating, as
+ * version-1 files are (test_bad_input_h5_forged_element_count), naming the increment. */
+static void test_format_forged_element_count_v2(void **state) {
+    (void)state;
+    char path[1024];
+    scratch_path(path, sizeof path, "forged-count.h5");
+    write_small(path, 2, 1);
+    const int64_t claim = 25000000;
+    hid_t f = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+    assert_true(f >= 0);
+    /* index row 1: its offset, and n raised to the claim */
+    hid_t ix = H5Dopen2(f, "increments/index", H5P_DEFAULT);
+    hid_t nt = H5Tcreate(H5T_COMPOUND, 2 * sizeof(int64_t));
+    H5Tinsert(nt, "offset", 0, H5T_NATIVE_INT64);
+    H5Tinsert(nt, "n", sizeof(int64_t), H5T_NATIVE_INT64);
+    int64_t row[2][2];
+    assert_true(H5Dread(ix, nt, H5S_ALL, H5S_ALL, H5P_DEFAULT, row) >= 0);
+    assert_int_equal(row[1][1], 40);
+    row[1][1] = claim;
+    assert_true(H5Dwrite(ix, nt, H5S_ALL, H5S_ALL, H5P_DEFAULT, row) >= 0);
+    H5Tclose(nt);
+    H5Dclose(ix);
+    /* the element datasets extended to hold those rows, with nothing written */
+    hid_t g = H5Gopen2(f, "increments", H5P_DEFAULT);
+    hsize_t rows = (hsize_t)(row[1][0] + claim);
+    assert_true(H5Literate(g, H5_INDEX_NAME, H5_ITER_NATIVE, NULL, extend_dataset, &rows) >= 0);
+    H5Gclose(g);
+    H5Fclose(f);
+    assert_true(file_size(path) < 1000000); /* the extents hold no data */
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    cdem_state s;
+    memset(&s, 0, sizeof s);
+    assert_int_equal(cdem_h5_reader_load_increment(r, 0, &s, NULL, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_load_increment(r, 1, &s, NULL, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "increment 1 claims 25000000 elements"));
+    assert_non_null(strstr(err.msg, "refuses more than 20000000"));
+    cdem_state_free(&s);
+    cdem_h5_reader_close(r);
+    remove_pair(path);
+}
+
 /* Caller errors are reported, not crashed on. */
 static void test_format_invalid_arguments(void **state) {
     (void)state;
@@ -2547,6 +2608,7 @@ int main(void) {
         cmocka_unit_test(test_format_variable_element_counts),
         cmocka_unit_test(test_format_missing_optional_stress),
         cmocka_unit_test(test_format_inconsistent_datasets),
+        cmocka_unit_test(test_format_forged_element_count_v2),
         cmocka_unit_test(test_format_invalid_arguments),
         cmocka_unit_test(test_format_read_while_writing),
         cmocka_unit_test(test_format_version_mismatch),

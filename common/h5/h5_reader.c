@@ -443,6 +443,16 @@ cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *s
 static cdem_status load_v2(cdem_h5_reader *r, const incr_entry *e, cdem_state *s, cdem_error *err) {
     const hsize_t n = (hsize_t)e->info.n_elements;
     const int stress = e->info.has_stress != 0;
+    /* n comes from the index, checked only against the datasets' extents; an extent can be
+     * declared with no storage behind it (HDF5 then returns fill values), so a forged file
+     * could make the reader allocate for 2^31 elements: the cap of version-1 files, before
+     * allocating */
+    if (n > READER_MAX_ELEMENTS)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: increment %d claims %llu elements; this reader refuses more than "
+                         "%llu (corrupt file?)",
+                         r->path, (int)e->info.number, (unsigned long long)n,
+                         (unsigned long long)READER_MAX_ELEMENTS);
     cdem_state_free(s);
     CDEM_TRY(cdem_state_init(s, n ? (size_t)n : 1, stress, err));
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
