@@ -1,5 +1,7 @@
-/* Tests of the man pages man/cdem-run.1 and man/cdem-strain.1: they are generated from the
- * programs' --help text by scripts/help2roff.py (`make man`), and must not go stale.
+/* Tests of the generated docs: the man pages man/cdem-run.1 and man/cdem-strain.1 and the
+ * bash completion, generated from the programs' --help text (scripts/help2roff.py and
+ * help2completion.py: `make man completion`), and docs/errors.md, generated from the
+ * sources (scripts/error_catalogue.py); none may go stale.
  * Runs from the repository root (tests/run_tests.sh); programs in $CDEM_BUILD (default
  * build/); scratch files in $CDEM_TEST_TMP. */
 #include <setjmp.h>
@@ -245,9 +247,34 @@ static void test_man_completion_fresh_and_working(void **state) {
     }
 }
 
+/* docs/errors.md is generated from the sources' CDEM_FAIL messages (with their file:line)
+ * by scripts/error_catalogue.py and must not go stale: a changed message, or code moved
+ * above one, makes it differ. */
+static void test_man_error_catalogue_fresh(void **state) {
+    man_ctx *c = *state;
+    char cmd[2400], generated[2100], msg[2400];
+    snprintf(generated, sizeof generated, "%s/errors.md", c->scratch.dir);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 scripts/error_catalogue.py > '%s'", generated);
+    assert_int_equal(run(cmd), 0);
+    char *a = slurp("docs/errors.md"), *b = slurp(generated);
+    assert_non_null(a);
+    assert_non_null(b);
+    if (strcmp(a, b) != 0)
+        snprintf(msg, sizeof msg,
+                 "docs/errors.md is stale against the sources: run `/usr/bin/python3 "
+                 "scripts/error_catalogue.py > docs/errors.md` and commit it");
+    else
+        msg[0] = '\0';
+    free(a);
+    free(b);
+    if (msg[0])
+        fail_msg("%s", msg);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_man_completion_fresh_and_working, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_man_error_catalogue_fresh, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_pages_match_help, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_lists_every_option_and_command, setup, teardown),
         cmocka_unit_test_setup_teardown(test_man_detects_a_stale_page, setup, teardown),
