@@ -38,11 +38,11 @@ typedef struct {
  * Geometry from p (width, height, unit_scaling, wall_height_multiplier, seed), radii and
  * masses from m (radius[], mass[]). Appends the internal elements first (ids 0..n-1, layer
  * 0, flags 0, born 0, sorted row-major by cells of 2 x max radius, bottom row first), then
- * the wall elements (flag CDEM_FLAG_WALL, layer 0): the base from left to right, then the
- * left wall and the right wall from bottom to top. info may be NULL (zeroed on failure).
- * Fails with CDEM_ERR_INVALID (non-empty state, NULL arguments), CDEM_ERR_RANGE (sizes or
- * radii not finite and positive, radii not ascending, an assembly too small for the largest
- * disc or too large to allocate) or CDEM_ERR_NOMEM; s is then left empty. */
+ * the wall elements (flag CDEM_FLAG_WALL, the base also CDEM_FLAG_BASE; layer 0): the base from
+ * left to right, then the left wall and the right wall from bottom to top. info may be NULL (zeroed
+ * on failure). Fails with CDEM_ERR_INVALID (non-empty state, NULL arguments), CDEM_ERR_RANGE (sizes
+ * or radii not finite and positive, radii not ascending, an assembly too small for the largest disc
+ * or too large to allocate) or CDEM_ERR_NOMEM; s is then left empty. */
 cdem_status cdem_assembly_build(const cdem_params *p, const cdem_model *m, cdem_state *s,
                                 cdem_assembly_info *info, cdem_error *err);
 
