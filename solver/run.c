@@ -375,8 +375,8 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         CDEM_TRY(run_write_increment(r, err));
     char detail[256];
     snprintf(detail, sizeof detail,
-             "%ld steps, %d increments, %ld escaping elements removed, %ld eroded", r->step,
-             r->next_inc - 1, r->removed, r->eroded);
+             "%ld steps, %d increments (0..%d), %ld escaping elements removed, %ld eroded", r->step,
+             r->next_inc, r->next_inc - 1, r->removed, r->eroded);
     r->finished = 1;
     r->stop_kind = "completed";
     return r->w ? cdem_h5_writer_set_stop_reason(r->w, "completed", detail, err) : CDEM_OK;

@@ -351,6 +351,9 @@ static void test_run_output_default_file_size(void **state) {
     cdem_snapshot *snap = NULL;
     int32_t inc = -1;
     assert_int_equal(cdem_h5_reader_open(out, &r, &e), CDEM_OK);
+    /* the stop detail counts the increments the file holds (it said 282: the last number) */
+    assert_non_null(
+        strstr(cdem_h5_reader_stop_detail(r), "70961 steps, 283 increments (0..282), "));
     assert_int_equal(cdem_snapshot_alloc(&snap, &e), CDEM_OK);
     assert_int_equal(cdem_h5_reader_read_checkpoint(r, snap, &inc, &e), CDEM_ERR_NOTFOUND);
     assert_non_null(strstr(e.msg, "checkpoints were dropped"));
