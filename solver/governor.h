@@ -35,6 +35,10 @@
 #define GOVERNOR_MAX_S            30.0 /* s between probes at most */
 #define GOVERNOR_CHECK_EVERY      16   /* steps between clock reads */
 
+/* Why 1 thread can measure faster than N, as the help and the run log say it (one text). */
+#define GOVERNOR_WHY_ONE                                                                           \
+    "other processes using the cores, or a model too small to gain from threads"
+
 typedef enum {
     CDEM_GOVERNOR_RUN,   /* on the chosen count until the next probe */
     CDEM_GOVERNOR_TIME,  /* timing the chosen count (first window of a probe) */

@@ -15,6 +15,7 @@
 #include "runlock.h"
 #include "summary.h"
 #include "cli_help.h"
+#include "governor.h"
 #include "parallel.h"
 #include "threads.h"
 
@@ -84,8 +85,7 @@ static const cdem_cli_option run_options[] = {
      "run on N threads (default: OMP_NUM_THREADS, else one per core); results are identical "
      "for any N. Idle threads sleep at once (OMP_WAIT_POLICY=passive; OMP_WAIT_POLICY or "
      "GOMP_SPINCOUNT, when set, decide instead), and a run that measures 1 thread faster than "
-     "N (other processes using the cores, or a model too small to gain from threads) goes on "
-     "with 1 until N is faster again "
+     "N (" GOVERNOR_WHY_ONE ") goes on with 1 until N is faster again "
      "(CDEM_THREAD_GOVERNOR=off keeps N)"},
     {"--par-min", "N",
      "run loops of more than N items on several threads (default " CDEM_PAR_MIN_STR "; results "

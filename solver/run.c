@@ -235,10 +235,9 @@ static void log_thread_change(run_ctx *r, long step) {
         return;
     run_end_progress_line(r);
     fprintf(r->opt->log,
-            "cdem-run: step %ld: 1 thread runs faster than %d now (other processes are using "
-            "the cores, or the model is too small to gain from threads); the run goes on with 1 "
-            "and measures again from time to time (results are the same for any thread "
-            "count)\n",
+            "cdem-run: step %ld: 1 thread runs faster than %d now (" GOVERNOR_WHY_ONE
+            "); the run goes on with 1 and measures again from time to time (results are the "
+            "same for any thread count)\n",
             step, r->gov.allowed);
 }
 

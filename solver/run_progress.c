@@ -133,8 +133,7 @@ void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
     int len = snprintf(threads, sizeof threads, "%d thread%s", nthreads, nthreads == 1 ? "" : "s");
     if (r->gov_started && r->gov.steps_on_one > 0 && steps > 0)
         snprintf(threads + len, sizeof threads - (size_t)len,
-                 ", 1 for %.0f %% of the steps, where 1 measured faster (a busy core, or a "
-                 "model too small to gain from threads)",
+                 ", 1 for %.0f %% of the steps, where 1 measured faster (" GOVERNOR_WHY_ONE ")",
                  100.0 * (double)r->gov.steps_on_one / (double)steps);
     fprintf(r->opt->log,
             "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "

@@ -542,6 +542,19 @@ static void test_format_forged_element_count_v2(void **state) {
     remove_pair(path);
 }
 
+/* In a forked child: a writer of path with default parameters; the child exits with status
+ * 2 when it cannot be created. */
+static cdem_h5_writer *child_writer(const char *path) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, "text", "summary", "v", "cdem-run"};
+    cdem_h5_writer *w = NULL;
+    cdem_error err;
+    if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
+        _exit(2);
+    return w;
+}
+
 /* Writes 3 increments with 50 series samples each (150 samples: series chunks 0..127 and
  * 128..), closing the writer when close_it, else leaving the file as a killed writer does
  * (the child exits without closing); then flips a byte inside the newest chunk of
@@ -551,13 +564,8 @@ static void series_with_bad_newest_chunk(const char *path, int close_it) {
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        cdem_params p;
-        cdem_params_defaults(&p);
-        cdem_run_meta meta = {&p, "text", "summary", "v", "cdem-run"};
-        cdem_h5_writer *w = NULL;
+        cdem_h5_writer *w = child_writer(path);
         cdem_error err;
-        if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
-            _exit(2);
         cdem_state st;
         make_state(&st, 40, 5, 0);
         for (int k = 0; k < 3; k++) {
@@ -1031,13 +1039,8 @@ static void test_format_killed_writer_keeps_increments(void **state) {
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        cdem_params p;
-        cdem_params_defaults(&p);
-        cdem_run_meta meta = {&p, "text", "summary", "v", "cdem-run"};
-        cdem_h5_writer *w = NULL;
+        cdem_h5_writer *w = child_writer(path);
         cdem_error err;
-        if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
-            _exit(2);
         for (int k = 0; k < N; k++) {
             cdem_state s;
             if (cdem_state_init(&s, 10, 0, &err) != CDEM_OK)
@@ -1108,13 +1111,8 @@ static void test_format_writer_killed_mid_increment(void **state) {
         assert_true(pid >= 0);
         if (pid == 0) {
             close(fds[0]);
-            cdem_params p;
-            cdem_params_defaults(&p);
-            cdem_run_meta meta = {&p, "text", "summary", "v", "cdem-run"};
-            cdem_h5_writer *w = NULL;
+            cdem_h5_writer *w = child_writer(path);
             cdem_error err;
-            if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
-                _exit(2);
             cdem_state s;
             make_state(&s, 3000, 5, 1);
             for (int k = 0;; k++) {

@@ -105,17 +105,6 @@ static int read_rows_retrying(const cdem_h5_reader *r, hid_t ds, hid_t mt, hsize
     }
 }
 
-/* The rows of one chunk of a chunked 1-D dataset, 0 when it is not chunked. */
-static hsize_t chunk_rows_of(hid_t ds) {
-    hid_t cp = H5Dget_create_plist(ds);
-    hsize_t rows = 0;
-    if (cp >= 0 && (H5Pget_layout(cp) != H5D_CHUNKED || H5Pget_chunk(cp, 1, &rows) != 1))
-        rows = 0;
-    if (cp >= 0)
-        H5Pclose(cp);
-    return rows;
-}
-
 /* Version 2: (re)reads the index and the stop reason. In SWMR-read mode every dataset is
  * refreshed first: the index before the element datasets, so that the element datasets are
  * at least as long as the rows the index lists (the writer writes them in the other order).
@@ -603,8 +592,8 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
          * writer did not close, the series then ends before that chunk: the samples of every
          * committed increment lie in the chunks before it (a new chunk is begun only by
          * samples after the last commit). One chunk only: damage further back is an error. */
-        const hsize_t chunk = bad && r->unclosed ? chunk_rows_of(ds[c]) : 0;
-        if (chunk > 0 && len > 0 && len == full) {
+        const hsize_t chunk = bad && r->unclosed && len == full ? h5i_chunk_rows_of(ds[c]) : 0;
+        if (chunk > 0) {
             H5Eclear2(H5E_DEFAULT);
             const hsize_t shorter = (len - 1) / chunk * chunk;
             if (shorter == 0 || h5i_read_all_rows(ds[c], mt, shorter, col) == 0) {
