@@ -341,6 +341,93 @@ static void test_format_roundtrip_all_fields(void **state) {
 }
 
 /* Elements removed and added between increments keep their ids. */
+/* An increment's rows are stored by ascending id whatever the state's order (docs/format.md,
+ * "Element datasets"): a shuffled state with ids across the whole int32 range (negative,
+ * above 2^22 and 2^11: every pass of the writer's radix sort) reads back sorted, each row
+ * carrying its own element's values (stress included), and byte for byte as the same state
+ * given in id order. */
+static void test_format_rows_by_id(void **state) {
+    (void)state;
+    enum { N = 300 };
+    cdem_state in, sorted;
+    make_state(&in, N, 77, 1);
+    make_state(&sorted, N, 77, 1);
+    /* ids: a permutation of values spread over int32, rows in shuffled order */
+    uint64_t seed = 5;
+    int32_t ids[N];
+    for (size_t i = 0; i < N; i++)
+        ids[i] = (int32_t)((int64_t)i * 7158278 - 2000000000);
+    for (size_t i = N - 1; i > 0; i--) { /* Fisher-Yates: row i gets the id of row j */
+        const size_t j = (size_t)(rng_next(&seed) % (i + 1));
+        const int32_t t = ids[i];
+        ids[i] = ids[j];
+        ids[j] = t;
+    }
+    for (size_t i = 0; i < N; i++)
+        in.id[i] = ids[i];
+    /* the same elements in ascending id order */
+    size_t order[N];
+    for (size_t i = 0; i < N; i++)
+        order[i] = i;
+    for (size_t i = 1; i < N; i++) /* insertion sort of the rows by id */
+        for (size_t k = i; k > 0 && ids[order[k - 1]] > ids[order[k]]; k--) {
+            const size_t t = order[k];
+            order[k] = order[k - 1];
+            order[k - 1] = t;
+        }
+    for (size_t r = 0; r < N; r++) {
+        const size_t i = order[r];
+        sorted.id[r] = in.id[i];
+        sorted.x[r] = in.x[i];
+        sorted.y[r] = in.y[i];
+        sorted.radius[r] = in.radius[i];
+        sorted.layer[r] = in.layer[i];
+        sorted.flags[r] = in.flags[i];
+        sorted.born[r] = in.born[i];
+        sorted.sxx[r] = in.sxx[i];
+        sorted.syy[r] = in.syy[i];
+        sorted.sxy[r] = in.sxy[i];
+    }
+    char path[2][1024];
+    scratch_path(path[0], sizeof path[0], "rows_shuffled.h5");
+    scratch_path(path[1], sizeof path[1], "rows_sorted.h5");
+    cdem_params p;
+    cdem_params_defaults(&p);
+    cdem_run_meta meta = {&p, "", "", "9.9.9", "cdem-run"};
+    cdem_error err;
+    for (int f = 0; f < 2; f++) {
+        cdem_h5_writer *w = NULL;
+        assert_int_equal(cdem_h5_writer_create(path[f], &meta, &w, &err), CDEM_OK);
+        cdem_increment_info info = make_info(0, CDEM_PHASE_DEFORMATION);
+        assert_int_equal(cdem_h5_writer_write_increment(w, &info, f ? &sorted : &in, &err),
+                         CDEM_OK);
+        assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+    }
+    /* the caller's state is not reordered */
+    for (size_t i = 0; i < N; i++)
+        assert_int_equal(in.id[i], ids[i]);
+    cdem_state back[2];
+    for (int f = 0; f < 2; f++) {
+        cdem_h5_reader *r = NULL;
+        assert_int_equal(cdem_h5_reader_open(path[f], &r, &err), CDEM_OK);
+        assert_int_equal(cdem_state_init(&back[f], 1, 0, &err), CDEM_OK);
+        cdem_increment_info info;
+        assert_int_equal(cdem_h5_reader_load_increment(r, 0, &back[f], &info, &err), CDEM_OK);
+        cdem_h5_reader_close(r);
+    }
+    assert_same_elements(&back[0], &sorted);
+    assert_same_elements(&back[1], &sorted);
+    for (size_t r = 1; r < N; r++)
+        assert_true(back[0].id[r - 1] < back[0].id[r]);
+    assert_true(back[0].id[0] < 0 && back[0].id[N - 1] > (1 << 22));
+    for (int f = 0; f < 2; f++) {
+        cdem_state_free(&back[f]);
+        remove_pair(path[f]);
+    }
+    cdem_state_free(&in);
+    cdem_state_free(&sorted);
+}
+
 static void test_format_variable_element_counts(void **state) {
     (void)state;
     char path[1024];
@@ -2693,6 +2780,7 @@ static void test_format_one_writer_and_replace_policy(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_format_roundtrip_all_fields),
+        cmocka_unit_test(test_format_rows_by_id),
         cmocka_unit_test(test_format_variable_element_counts),
         cmocka_unit_test(test_format_missing_optional_stress),
         cmocka_unit_test(test_format_inconsistent_datasets),

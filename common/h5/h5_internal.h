@@ -239,6 +239,9 @@ struct cdem_h5_writer {
     int sync;                       /* 1: sync (fdatasync) every commit (_set_sync) */
     int placed;                     /* 1 once the file is at path (before: PATH.creating) */
     int completed;                  /* 1: the last stop reason recorded is "completed" */
+    size_t *row_order;              /* an increment's rows by ascending id (write_increment) */
+    void *row_buf;                  /* one field's values in that order, 8 bytes a row */
+    size_t row_cap;                 /* rows allocated in row_order and row_buf */
 };
 
 /* h5_create.c */

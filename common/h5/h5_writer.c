@@ -9,7 +9,12 @@
  * append_series is called from the time-step loop: it never allocates (fixed buffer).
  * After a failed write (disk full) the writer refuses further writes and close leaves the
  * file as a killed writer would (closing would rewrite the superblock with an end-of-file
- * the disk cannot hold). */
+ * the disk cannot hold).
+ * An increment's rows are written in ascending id order, whatever order the state holds
+ * them in (the solver's is spatial and changes at every re-sort): row k of one increment
+ * and row k of the next are the same element unless elements were removed or added before
+ * it, the stored file does not depend on the solver's memory order, and the id column (a
+ * run of increasing numbers) deflates to almost nothing (docs/format.md, "Size"). */
 #include "h5_internal.h"
 #include "outfile.h"
 
@@ -143,6 +148,8 @@ void h5i_writer_release(cdem_h5_writer *w) {
     free(w->entries);
     free(w->ckpt_buf);
     free(w->ckpt_zbuf);
+    free(w->row_order);
+    free(w->row_buf);
     free(w);
 }
 
@@ -156,6 +163,74 @@ cdem_status h5i_grow_entries(cdem_h5_writer *w, cdem_error *err) {
     w->entries = e;
     w->cap_entries = cap;
     return CDEM_OK;
+}
+
+/* The state's rows by ascending id into w->row_order (w->row_buf is grown to n rows of 8
+ * bytes for put_rows). Sets *sorted = 1 when they already are in that order. A stable LSD
+ * radix sort of (id, row) keys, three passes of 11 bits over the id: linear in n. */
+static cdem_status order_rows_by_id(cdem_h5_writer *w, const cdem_state *s, int *sorted,
+                                    cdem_error *err) {
+    const size_t n = s->n;
+    *sorted = 1;
+    for (size_t i = 1; i < n && *sorted; i++)
+        *sorted = s->id[i - 1] < s->id[i];
+    if (*sorted)
+        return CDEM_OK;
+    if (n > UINT32_MAX)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "%s: %zu elements in one increment (at most %lu)",
+                         w->path, n, (unsigned long)UINT32_MAX);
+    if (w->row_cap < n) {
+        const size_t c = n + n / 4 + 64;
+        size_t *o = realloc(w->row_order, c * sizeof *o);
+        if (o)
+            w->row_order = o;
+        void *b = o ? realloc(w->row_buf, c * 2 * sizeof(uint64_t)) : NULL;
+        if (!b)
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                             "%s: out of memory ordering the %zu rows of an increment by id",
+                             w->path, n);
+        w->row_buf = b;
+        w->row_cap = c;
+    }
+    /* keys: the id with its sign bit flipped (so that unsigned order is the ids' order) in
+     * the high half, the row in the low half; sorted through row_buf's two halves */
+    uint64_t *a = w->row_buf, *b = a + w->row_cap;
+    for (size_t i = 0; i < n; i++)
+        a[i] = ((uint64_t)((uint32_t)s->id[i] ^ 0x80000000u) << 32) | (uint64_t)i;
+    enum { BITS = 11, DIGITS = 1 << BITS };
+    for (int shift = 32; shift < 64; shift += BITS) {
+        size_t count[DIGITS + 1] = {0};
+        for (size_t i = 0; i < n; i++)
+            count[((a[i] >> shift) & (DIGITS - 1)) + 1]++;
+        for (size_t d = 0; d < DIGITS; d++)
+            count[d + 1] += count[d];
+        for (size_t i = 0; i < n; i++)
+            b[count[(a[i] >> shift) & (DIGITS - 1)]++] = a[i];
+        uint64_t *t = a;
+        a = b;
+        b = t;
+    }
+    for (size_t i = 0; i < n; i++)
+        w->row_order[i] = (size_t)(a[i] & 0xffffffffu);
+    return CDEM_OK;
+}
+
+/* The values of field k of the state in w->row_order's order, in w->row_buf. */
+static const void *put_rows(cdem_h5_writer *w, const cdem_state *s, size_t k) {
+    const size_t n = s->n, *restrict order = w->row_order;
+    const void *src = h5i_element_array(s, k);
+    if (h5i_element_fields[k].type == CDEM_FIELD_F64) {
+        const double *restrict v = src;
+        double *restrict out = w->row_buf;
+        for (size_t i = 0; i < n; i++)
+            out[i] = v[order[i]];
+    } else { /* int32, uint32: 4 bytes */
+        const uint32_t *restrict v = src;
+        uint32_t *restrict out = w->row_buf;
+        for (size_t i = 0; i < n; i++)
+            out[i] = v[order[i]];
+    }
+    return w->row_buf;
 }
 
 cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increment_info *info,
@@ -188,13 +263,15 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
     /* The data first, then (after a flush) the index row: the index is the commit record. */
     const hsize_t n = s->n;
     const int stress = s->has_stress && n > 0;
+    int sorted = 1;
+    CDEM_TRY(order_rows_by_id(w, s, &sorted, err));
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
         const element_field *fd = &h5i_element_fields[k];
         if (fd->optional && !stress)
             continue;
         hsize_t start = fd->optional ? w->stress_len : w->data_len;
-        if (h5i_write_rows(w->data[k], h5i_el_mem_type(fd->type), start, n,
-                           h5i_element_array(s, k)) < 0) {
+        const void *rows = sorted ? h5i_element_array(s, k) : put_rows(w, s, k);
+        if (h5i_write_rows(w->data[k], h5i_el_mem_type(fd->type), start, n, rows) < 0) {
             w->failed = 1;
             return H5FAIL(err, CDEM_ERR_IO,
                           "%s: cannot write increment %d to /increments/%s (%llu values; disk "
