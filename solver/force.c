@@ -378,11 +378,12 @@ static void update_shares(cdem_force *f, int nchunk) {
 
 /* Splits the elements into nchunk ranges of about equal work (element_work) and lists the
  * cross pairs of each chunk. A pair is evaluated by the chunk of its pj: its own pairs and
- * the cross pairs coming in from earlier chunks, e.g. every element-wall pair goes to the
- * chunk of the walls, which are sorted to the end; cutting at equal pair counts by pi
- * instead overloaded that chunk (20 % more pairs at 9,000 elements), and equal pair counts
- * by pj still left the lower chunk, with more touching pairs and free elements, 10 % more
- * to do. The cut does not change any result (every element sum has the same additions in
+ * the cross pairs coming in from earlier chunks. (When the walls were sorted after the free
+ * elements, every element-wall pair went to the chunk of the walls: cutting at equal pair
+ * counts by pi overloaded that chunk by 20 % at 9,000 elements, and equal pair counts by pj
+ * still left 10 % more to the lower chunk; the element order is now by cell, walls
+ * included, neighbour.c, and the work estimate still weighs what each element costs.) The
+ * cut does not change any result (every element sum has the same additions in
  * the same order for any cut). Falls back to one chunk when the buffer is too small (never
  * after a list build: the stepper calls cdem_force_reserve after each). */
 static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t *flags, size_t n,

@@ -431,14 +431,21 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         cell_of[i] = (int32_t)cdem_grid_cell(&g, px[i], py[i]);
     int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
     if (do_sort && n > 1) {
-        /* stable counting sort by (boundary element?, cell): free elements first in cell
-         * order, then the boundary elements in cell order, so the loops over elements see
-         * long runs of one kind (predictable branches); new index k holds old index perm[k].
-         * The keys live in scratch, the sorted indices in cell_items (both free here). */
+        /* stable counting sort by cell, walls among the free elements of their cells, the
+         * cells taken along the grid's short side first: column by column in a model wider
+         * than high (row by row in a higher one). The force pass cuts the elements into
+         * index ranges, one per thread, so the cut between two chunks then runs across the
+         * short side, and the walls of each side belong to its chunk: the fewest pairs
+         * across the cut, whose cache lines the two cores must exchange every step
+         * (docs/performance.md, "Element order"). New index k holds old index perm[k]. The
+         * keys live in scratch, the sorted indices in cell_items (both free here). */
         int32_t *key = (int32_t *)nb->scratch;
-        for (size_t i = 0; i < n; i++)
-            key[i] = nb->cell_of[i] + ((s->flags[i] & CDEM_FLAGS_BOUNDARY) ? (int32_t)ncells : 0);
-        cdem_grid_sort(key, n, 2 * ncells, nb->cell_start, nb->cell_items);
+        const int columns = g.nx > g.ny;
+        for (size_t i = 0; i < n; i++) {
+            const size_t c = (size_t)nb->cell_of[i];
+            key[i] = (int32_t)(columns ? (c % g.nx) * g.ny + c / g.nx : c);
+        }
+        cdem_grid_sort(key, n, ncells, nb->cell_start, nb->cell_items);
         size_t *perm = nb->perm;
         for (size_t k = 0; k < n; k++)
             perm[k] = (size_t)nb->cell_items[k];
