@@ -23,18 +23,22 @@ static double rnd(uint64_t *s) {
 
 static const double radii[4] = {50.0, 75.0, 100.0, 125.0};
 
-/* n random elements in [0, L]^2; every 10th is a wall element. */
-static void make_cloud(cdem_state *s, size_t n, double L, uint64_t seed) {
+/* n random elements in [0, W] x [0, H]; every 10th is a wall element. */
+static void make_box(cdem_state *s, size_t n, double W, double H, uint64_t seed) {
     cdem_error err;
     assert_int_equal(cdem_state_init(s, n, 0, &err), CDEM_OK);
     uint64_t g = seed;
     for (size_t i = 0; i < n; i++) {
         double r = radii[(int)(rnd(&g) * 4.0) % 4];
         uint32_t fl = (i % 10 == 0) ? CDEM_FLAG_WALL : 0u;
-        assert_int_equal(
-            cdem_state_append(s, -1, rnd(&g) * L, rnd(&g) * L, r, 1.0, 0, fl, 0, NULL, &err),
-            CDEM_OK);
+        const double x = rnd(&g) * W, y = rnd(&g) * H;
+        assert_int_equal(cdem_state_append(s, -1, x, y, r, 1.0, 0, fl, 0, NULL, &err), CDEM_OK);
     }
+}
+
+/* n random elements in [0, L]^2; every 10th is a wall element. */
+static void make_cloud(cdem_state *s, size_t n, double L, uint64_t seed) {
+    make_box(s, n, L, L, seed);
 }
 
 static int cmp_u64(const void *a, const void *b) {
@@ -199,6 +203,43 @@ static void test_neighbour_history_survives_resort_and_removal(void **st) {
     cdem_state_free(&s);
 }
 
+/* The re-sort orders the elements by cell along the grid's short side first (neighbour.c),
+ * so that the threads' chunks, index ranges, are cut across it: in a wide cloud the first
+ * half of the indices lies left of the second (up to one cell), in a high one below it, and
+ * the walls are spread over both halves (they used to be sorted after the free elements). */
+static void test_neighbour_order_along_short_side(void **st) {
+    (void)st;
+    for (int high = 0; high < 2; high++) {
+        cdem_state s;
+        make_box(&s, 1200, high ? 2000.0 : 8000.0, high ? 8000.0 : 2000.0, 7);
+        cdem_neighbour nb;
+        cdem_error err;
+        const double skin = 12.5;
+        assert_int_equal(cdem_neighbour_init(&nb, skin, 1.0, 5, &err), CDEM_OK);
+        assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 1, &err), CDEM_OK);
+        const size_t n = s.n, half = n / 2;
+        double max_lo = -INFINITY, min_hi = INFINITY;
+        size_t walls = 0, walls_lo = 0;
+        for (size_t i = 0; i < n; i++) {
+            const double along = high ? s.y[i] : s.x[i];
+            if (i < half)
+                max_lo = fmax(max_lo, along);
+            else
+                min_hi = fmin(min_hi, along);
+            if (s.flags[i] & CDEM_FLAG_WALL) {
+                walls++;
+                walls_lo += i < half;
+            }
+        }
+        const double cell = 2.0 * 125.0 + skin; /* the largest reach and the skin */
+        assert_true(max_lo <= min_hi + cell);
+        assert_true(walls == 120);
+        assert_true(walls_lo > 40 && walls_lo < 80);
+        cdem_neighbour_free(&nb);
+        cdem_state_free(&s);
+    }
+}
+
 static void test_neighbour_rejects_bad_input(void **st) {
     (void)st;
     cdem_neighbour nb;
@@ -300,6 +341,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_neighbour_matches_brute_force),
         cmocka_unit_test(test_neighbour_history_survives_resort_and_removal),
+        cmocka_unit_test(test_neighbour_order_along_short_side),
         cmocka_unit_test(test_neighbour_rejects_bad_input),
         cmocka_unit_test(test_neighbour_threaded_build_same_list),
     };
