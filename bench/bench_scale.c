@@ -9,6 +9,18 @@
  *     the other in the same process, so that 1 and 2 threads are interleaved and see the
  *     same load and nearly the same model. One "BENCH_SCALE" line per timed run.
  *
+ *   bench_scale twins WIDTH HEIGHT HALF SETTLE ELSTEPS REPS
+ *     The machine's 2-core ceiling for this work, measured in the same process and minute as
+ *     the 2-thread run it bounds: two models (A, B) are built and settled; then, REPS times,
+ *     A alone on 1 thread, A and B at once ("twins": each stepped by a thread of its own, on
+ *     1 OpenMP thread; they share nothing), A on 2 OpenMP threads, and A alone again. The
+ *     ceiling is what the two cores gave the twins, in lone runs: lone/twin_A + lone/twin_B
+ *     (lone: the mean of the two lone runs around them); the efficiency is the 2-thread
+ *     speed-up over the ceiling (1: the threads lose nothing to sharing one model). One
+ *     "BENCH_TWINS" line per repetition. The vCPUs of a shared virtual machine change speed
+ *     independently from second to second, so a speed-up alone says little; the efficiency
+ *     says how much of what the cores gave the solver's threads used.
+ *
  *   bench_scale full WIDTH HEIGHT HALF
  *     The model's whole schedule on the current OMP_NUM_THREADS: equilibration (the
  *     model's equil_steps, walls still), cohesion, deformation to total_steps. Prints one
@@ -26,6 +38,7 @@
 #include "model.h"
 
 #include <omp.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -144,6 +157,75 @@ static int mode_scale(int argc, char **argv) {
     return 0;
 }
 
+/* One twin's run: `steps` deformation steps of its model on 1 OpenMP thread, timed. */
+typedef struct {
+    bench *b;
+    long steps;
+    double seconds;
+    cdem_status status;
+    cdem_error err;
+} twin_run;
+
+static void *twin_main(void *arg) {
+    twin_run *t = arg;
+    omp_set_num_threads(1); /* this thread's own setting */
+    const double t0 = clock_s(CLOCK_MONOTONIC);
+    t->status = deform(t->b, t->steps, &t->err);
+    t->seconds = clock_s(CLOCK_MONOTONIC) - t0;
+    return NULL;
+}
+
+static int mode_twins(int argc, char **argv) {
+    if (argc < 8) {
+        fprintf(stderr, "usage: bench_scale twins WIDTH HEIGHT HALF SETTLE ELSTEPS REPS\n");
+        return 2;
+    }
+    static bench b[2];
+    cdem_error err;
+    omp_set_num_threads(1);
+    for (int k = 0; k < 2; k++)
+        if (setup(&b[k], atof(argv[2]), atof(argv[3]), atoi(argv[4]), &err) ||
+            settle(&b[k], atol(argv[5]), &err))
+            return fail(&err);
+    long nsteps = (long)(atof(argv[6]) / (double)b[0].s.n);
+    if (nsteps < 20)
+        nsteps = 20;
+    const int reps = atoi(argv[7]);
+    for (int r = 0; r < reps; r++) {
+        twin_run t[2] = {{.b = &b[0], .steps = nsteps}, {.b = &b[1], .steps = nsteps}};
+        twin_main(&t[0]);
+        const double lone0 = t[0].seconds;
+        pthread_t th[2];
+        for (int k = 0; k < 2; k++)
+            if (pthread_create(&th[k], NULL, twin_main, &t[k]) != 0) {
+                fprintf(stderr, "bench_scale: cannot start a thread\n");
+                return 1;
+            }
+        for (int k = 0; k < 2; k++)
+            pthread_join(th[k], NULL);
+        for (int k = 0; k < 2; k++)
+            if (t[k].status != CDEM_OK)
+                return fail(&t[k].err);
+        const double twin0 = t[0].seconds, twin1 = t[1].seconds;
+        omp_set_num_threads(2);
+        const double c0 = clock_s(CLOCK_MONOTONIC);
+        if (deform(&b[0], nsteps, &err))
+            return fail(&err);
+        const double two = clock_s(CLOCK_MONOTONIC) - c0;
+        twin_main(&t[0]);
+        const double lone1 = t[0].seconds, lone = 0.5 * (lone0 + lone1);
+        const double ceiling = lone / twin0 + lone / twin1, speedup = lone / two;
+        printf("BENCH_TWINS rep %d N %zu steps %ld lone_s %.4f %.4f twins_s %.4f %.4f "
+               "two_threads_s %.4f ceiling %.3f speedup %.3f efficiency %.3f\n",
+               r, b[0].s.n, nsteps, lone0, lone1, twin0, twin1, two, ceiling, speedup,
+               speedup / ceiling);
+        fflush(stdout);
+    }
+    for (int k = 0; k < 2; k++)
+        teardown(&b[k]);
+    return 0;
+}
+
 static int mode_full(int argc, char **argv) {
     if (argc < 5) {
         fprintf(stderr, "usage: bench_scale full WIDTH HEIGHT HALF\n");
@@ -191,9 +273,11 @@ static int mode_full(int argc, char **argv) {
 int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[1], "scale") == 0)
         return mode_scale(argc, argv);
+    if (argc > 1 && strcmp(argv[1], "twins") == 0)
+        return mode_twins(argc, argv);
     if (argc > 1 && strcmp(argv[1], "full") == 0)
         return mode_full(argc, argv);
-    fprintf(stderr, "usage: bench_scale scale|full ... (see the comment at the top of "
+    fprintf(stderr, "usage: bench_scale scale|twins|full ... (see the comment at the top of "
                     "bench/bench_scale.c)\n");
     return 2;
 }

@@ -5,8 +5,9 @@
 #   1. Solver scaling: ns per element-step at ~2k, ~9k, ~35k and ~125k elements (the 100 x
 #      7.5 half-radii assembly), 1 and 2 threads interleaved in one process, medians of REPS,
 #      wall clock and CPU time, 2-thread speed-up (bench/bench_scale.c, "scale"); beside it
-#      the machine's ceiling for that speed-up at that size and moment: two 1-thread copies
-#      of the same run at once, their joint rate against one alone.
+#      the machine's ceiling for that speed-up at that size and moment ("twins": two models
+#      stepped at once by one thread each in one process, against one alone) and the share of
+#      it the 2-thread run reached (bench/bench_scale.c, "twins").
 #   2. Long run: element-steps/s in each tenth of the default model's full schedule, first
 #      vs last tenth (bench/bench_scale.c, "full").
 #   3. Against LAMMPS on the same run (bench/lammps_bench.sh; installs Debian's lammps).
@@ -78,8 +79,8 @@ if has scale; then
     echo
     echo "== 1. Solver scaling (deformation of the default planar normal fault after $SETTLE settling steps;"
     echo "      N = all elements incl. walls; median of $REPS runs of ~$ELSTEPS element-steps; 1 and 2 threads interleaved)"
-    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s %8s | %s\n' size N pairs builds \
-        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "2 copies" "load during"
+    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s %7s %8s | %s\n' size N pairs builds \
+        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "twins" "2t/twins" "load during"
     for size in $SIZES; do
         w=$(echo "$size" | cut -d: -f1)
         h=$(echo "$size" | cut -d: -f2)
@@ -98,27 +99,24 @@ if has scale; then
         # speed-up per repetition (1t and 2t of the same repetition are adjacent in time)
         sp=$(awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="seconds") a[$3]=$(i+1)}
                   /threads 2 / {for (i=1;i<NF;i++) if ($i=="seconds") if (a[$3] > 0) print a[$3]/$(i+1)}' "$out" | median)
-        # the ceiling: two independent 1-thread copies at once, each on its own core (no
-        # sharing, no synchronisation), their joint rate against one copy run alone just
-        # before (this machine's speed drifts over minutes: the two are measured adjacent)
-        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.alone"
-        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy1" &
-        copy=$!
-        OMP_NUM_THREADS=1 "$BUILD/bench_scale" scale "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" 1 >"$out.copy2"
-        wait "$copy"
-        wc=$(cat "$out.copy1" "$out.copy2" | awk '/threads 1 / {for (i=1;i<NF;i++) if ($i=="ns_per_el_step") print $(i+1)}' | median)
-        wa=$(field ns_per_el_step "threads 1 " "$out.alone" | median)
-        cp=$(awk -v a="$wa" -v b="$wc" 'BEGIN {print 2 * a / b}')
+        # the ceiling: two independent models stepped at once, one thread each, in one
+        # process (no sharing, no synchronisation), against one alone around them; and in the
+        # same repetition the 2-thread run, as a share of that ceiling (the VM's vCPUs change
+        # speed independently: the two are measured adjacent, repetition by repetition)
+        "$BUILD/bench_scale" twins "$w" "$h" "$hr" "$SETTLE" "$ELSTEPS" "$REPS" >"$out.twins"
+        cp=$(field ceiling "BENCH_TWINS" "$out.twins" | median)
+        ef=$(field efficiency "BENCH_TWINS" "$out.twins" | median)
         ld=$(field load "" "$out" | sort -g | awk 'NR==1 {lo=$1} {hi=$1} END {print lo "-" hi}')
-        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %7.2fx | %s\n' \
-            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ld"
+        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %6.2fx %8.2f | %s\n' \
+            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ef" "$ld"
     done
     echo "   ns/el = wall-clock ns per element-step (linear scaling = the same figure at every size);"
     echo "   cpu = process CPU ns per element-step (2t: both threads, so cpu 2t ~ cpu 1t when the threads do no extra work);"
     echo "   ns/cont = 1-thread wall ns per touching pair per step; builds = list rebuilds per timed run; 2t/1t = speed-up"
-    echo "   (median of the per-repetition ratios); 2 copies = two 1-thread runs of the same size at once, their joint"
-    echo "   element-steps/s over one such run's alone just before (medians): what the 2 cores give independent work"
-    echo "   now, the ceiling of 2t/1t; raw lines in $WORK/scale_*.out(.alone, .copy1, .copy2)"
+    echo "   (median of the per-repetition ratios); twins = two models of this size stepped at once in one process, one"
+    echo "   thread each, their joint rate over one alone (median): what the 2 cores give work that shares nothing, now,"
+    echo "   the ceiling of 2t/1t; 2t/twins = the 2-thread speed-up over that ceiling in the same repetition (median;"
+    echo "   1 = the threads lose nothing to sharing one model); raw lines in $WORK/scale_*.out(.twins)"
 fi
 
 if has full; then
