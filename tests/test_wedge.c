@@ -132,6 +132,42 @@ static void test_wedge_moved_but_not_thickened(void **state) {
     cdem_state_free(&cur);
 }
 
+/* The wall face 9 m into a column, with one small element squeezed at the wall's foot in
+ * that sliver (examples/wedge, every fifth increment): the sliver's top is not the wedge's
+ * surface and stays out of the taper fit, which keeps the triangle's exact slope. */
+static void test_wedge_taper_ignores_sliver_at_wall(void **state) {
+    (void)state;
+    cdem_state ref = {0}, lifted = {0}, cur = {0};
+    cdem_error err;
+    make_lattice(&ref, 40, 10);
+    assert_int_equal(cdem_state_copy(&lifted, &ref, &err), CDEM_OK);
+    lift_triangle(&lifted, 40, 20, 1000.0); /* slope 0.5 over columns 20..39 */
+    /* the wall moved 991 m left: face at 3009; the free elements beyond it are gone */
+    assert_int_equal(cdem_state_init(&cur, lifted.n, 0, &err), CDEM_OK);
+    for (size_t i = 0; i < lifted.n; i++) {
+        const uint32_t f = lifted.flags[i];
+        const double x = (f & CDEM_FLAG_MOVING) ? lifted.x[i] - 991.0 : lifted.x[i];
+        if (!(f & CDEM_FLAGS_BOUNDARY) && x > 3000.0)
+            continue;
+        assert_int_equal(cdem_state_append(&cur, lifted.id[i], x, lifted.y[i], lifted.radius[i],
+                                           1.0, lifted.layer[i], f, 0, NULL, &err),
+                         CDEM_OK);
+    }
+    assert_int_equal(cdem_state_append(&cur, -1, 3004.0, 5.0, 4.0, 1.0, 1, 0, 0, NULL, &err),
+                     CDEM_OK);
+    cdem_wedge_options opt = {.threshold = 1.0};
+    cdem_wedge_ref r;
+    cdem_wedge_row row;
+    assert_int_equal(cdem_wedge_reference(&ref, &opt, &r, &err), CDEM_OK);
+    assert_int_equal(cdem_wedge_measure(&r, &ref, &cur, &row, &err), CDEM_OK);
+    assert_near(row.wall_x, 3009.0, 1e-9);
+    assert_near(row.taper_deg, atan(0.5) / deg, 1e-9);
+    assert_int_equal(row.n_fitted, 10); /* columns 20..29, not the sliver of column 30 */
+    cdem_state_free(&ref);
+    cdem_state_free(&lifted);
+    cdem_state_free(&cur);
+}
+
 static void test_wedge_flat_state_zero(void **state) {
     (void)state;
     cdem_state ref = {0};
@@ -556,6 +592,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_wedge_triangle_exact),
         cmocka_unit_test(test_wedge_moved_but_not_thickened),
+        cmocka_unit_test(test_wedge_taper_ignores_sliver_at_wall),
         cmocka_unit_test(test_wedge_flat_state_zero),
         cmocka_unit_test(test_wedge_uniform_thickening),
         cmocka_unit_test(test_wedge_errors_name_the_problem),

@@ -206,8 +206,12 @@ cdem_status cdem_wedge_measure(const cdem_wedge_ref *r, const cdem_state *ref,
         size_t m = 0;
         if (!fy)
             st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "wedge: no memory for %zu columns", nc);
+        /* the column the wall face cuts counts only when at least half of it lies left of
+         * the face: in a sliver of it the top is whatever element is squeezed at the wall's
+         * foot (examples/wedge: a top near the base, 3 degrees off the taper) */
+        const double half = 0.5 * r->column_width;
         for (size_t c = front_t; c < nc && fy; c++)
-            if (top[c] != SIZE_MAX) {
+            if (top[c] != SIZE_MAX && wall - (r->x_left + (double)c * r->column_width) >= half) {
                 fx[m] = cur->x[top[c]];
                 fy[m] = cur->y[top[c]] + cur->radius[top[c]];
                 m++;
