@@ -104,6 +104,13 @@ static void teardown(bench *b) {
     cdem_state_free(&b->s);
 }
 
+/* Deformation steps of a timed run: about elsteps element-steps of an n-element model, at
+ * least 20. */
+static long timed_steps(double elsteps, size_t n) {
+    const long steps = (long)(elsteps / (double)n);
+    return steps < 20 ? 20 : steps;
+}
+
 static int mode_scale(int argc, char **argv) {
     if (argc < 9) {
         fprintf(stderr, "usage: bench_scale scale WIDTH HEIGHT HALF SETTLE ELSTEPS REPS "
@@ -117,9 +124,7 @@ static int mode_scale(int argc, char **argv) {
         return fail(&err);
     const double elsteps = atof(argv[6]);
     const int reps = atoi(argv[7]);
-    long nsteps = (long)(elsteps / (double)b.s.n);
-    if (nsteps < 20)
-        nsteps = 20;
+    const long nsteps = timed_steps(elsteps, b.s.n);
     for (int r = 0; r < reps; r++) {
         char list[256];
         snprintf(list, sizeof list, "%s", argv[8]);
@@ -187,9 +192,7 @@ static int mode_twins(int argc, char **argv) {
         if (setup(&b[k], atof(argv[2]), atof(argv[3]), atoi(argv[4]), &err) ||
             settle(&b[k], atol(argv[5]), &err))
             return fail(&err);
-    long nsteps = (long)(atof(argv[6]) / (double)b[0].s.n);
-    if (nsteps < 20)
-        nsteps = 20;
+    const long nsteps = timed_steps(atof(argv[6]), b[0].s.n);
     const int reps = atoi(argv[7]);
     for (int r = 0; r < reps; r++) {
         twin_run t[2] = {{.b = &b[0], .steps = nsteps}, {.b = &b[1], .steps = nsteps}};

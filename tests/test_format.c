@@ -33,6 +33,20 @@ static void remove_pair(const char *h5) {
     remove(xmf);
 }
 
+/* The whole time series of the file at path (caller frees), *n samples; fails the test
+ * with the reader's message when the file or its series cannot be read. */
+static cdem_series_sample *series_of(const char *path, size_t *n) {
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    cdem_series_sample *smp = NULL;
+    if (cdem_h5_reader_read_series(r, &smp, n, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    cdem_h5_reader_close(r);
+    return smp;
+}
+
 /* splitmix64: a seeded generator for the synthetic data. */
 static uint64_t rng_next(uint64_t *s) {
     uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
@@ -704,22 +718,17 @@ static void test_format_unclosed_series_newest_chunk(void **state) {
     char path[1024];
     scratch_path(path, sizeof path, "series-chunk.h5");
     series_with_bad_newest_chunk(path, 0);
-    cdem_error err;
-    cdem_h5_reader *r = NULL;
-    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
-        fail_msg("%s", err.msg);
-    cdem_series_sample *smp = NULL;
     size_t ns = 0;
-    if (cdem_h5_reader_read_series(r, &smp, &ns, &err) != CDEM_OK)
-        fail_msg("unclosed file: %s", err.msg);
-    assert_int_equal(ns, 128); /* the chunk before the damaged one, whole */
+    cdem_series_sample *smp = series_of(path, &ns); /* the unclosed file */
+    assert_int_equal(ns, 128);                      /* the chunk before the damaged one, whole */
     for (size_t i = 0; i < ns; i++)
         assert_int_equal(smp[i].step, make_sample(i).step);
     free(smp);
-    cdem_h5_reader_close(r);
     remove_pair(path);
 
     series_with_bad_newest_chunk(path, 1);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
     assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_ERR_FORMAT);
     assert_non_null(strstr(err.msg, "/series/step is damaged or unreadable"));
@@ -1682,14 +1691,8 @@ static void test_format_series_without_wall_columns(void **state) {
     for (size_t c = 0; c < 4; c++)
         assert_true(H5Ldelete(f, cols[c], H5P_DEFAULT) >= 0);
     H5Fclose(f);
-    cdem_error err;
-    cdem_h5_reader *r = NULL;
-    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
-        fail_msg("%s", err.msg);
-    cdem_series_sample *smp = NULL;
     size_t n = 0;
-    if (cdem_h5_reader_read_series(r, &smp, &n, &err) != CDEM_OK)
-        fail_msg("%s", err.msg);
+    cdem_series_sample *smp = series_of(path, &n);
     assert_int_equal(n, 12);
     for (size_t i = 0; i < n; i++) {
         cdem_series_sample ex = make_sample(i);
@@ -1702,7 +1705,6 @@ static void test_format_series_without_wall_columns(void **state) {
         assert_same_sample(&smp[i], &ex);
     }
     free(smp);
-    cdem_h5_reader_close(r);
 }
 
 /* A file written before the chunks shrank (tests/data/format_v2_chunk8192.h5: element chunks
