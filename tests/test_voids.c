@@ -65,7 +65,8 @@ static void test_voids_intact_block(void **state) {
     assert_int_equal(r.n_voids, 0);
     assert_near(r.min_clearance, 125.0, 0.0);
     assert_near(r.window, 1000.0, 0.0);
-    assert_near(r.column_width, 250.0, 1e-9);
+    /* a sliding column of 17 cells of 1000 / 64 m: 2 r_max and a cell */
+    assert_near(r.column_width, 17.0 * 1000.0 / 64.0, 1e-9);
     assert_true(r.largest_clearance < r.min_clearance); /* pores and pockets of the packing */
     assert_true(r.steepest_deg < 10.0);                 /* a flat top */
     assert_near(r.void_min_room, M_PI * 125.0 * 125.0 / 16.0, 1e-6);
@@ -92,6 +93,71 @@ static void test_voids_cliff(void **state) {
     /* 2 km down over 1 km: atan(2) = 63.4 degrees, less a column's rounding */
     assert_true(r.steepest_deg > 58.0 && r.steepest_deg < 66.0);
     assert_true(r.steepest_x0 < 4000.0 && r.steepest_x1 > 4000.0);
+    assert_near(r.steepest_x1 - r.steepest_x0, 1000.0, 1e-9); /* exactly the window */
+}
+
+/* A flat lattice block, 80 x 25 elements of radius 50 m (top 2500 m, free extent 0-8000 m),
+ * with `n_foot` elements of radius 10 m at its right foot, from x = 8010 m: as at a moving
+ * wall, where a few small elements are pressed under the wall's foot. (Cells of 6.25 m,
+ * the sliding column 17 of them: 106.25 m.) */
+static cdem_voids_result lattice_with_foot(int n_foot) {
+    cdem_state s = {0};
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&s, 2100, 0, &err), CDEM_OK);
+    for (int j = 0; j < 25; j++)
+        for (int i = 0; i < 80; i++)
+            assert_int_equal(cdem_state_append(&s, -1, 50.0 + 100.0 * i, 50.0 + 100.0 * j, 50.0,
+                                               1.0, 0, 0, 0, NULL, &err),
+                             CDEM_OK);
+    for (int k = 0; k < n_foot; k++)
+        assert_int_equal(
+            cdem_state_append(&s, -1, 8010.0 + 20.0 * k, 10.0, 10.0, 1.0, 0, 0, 0, NULL, &err),
+            CDEM_OK);
+    cdem_voids_result r;
+    assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_OK);
+    cdem_state_free(&s);
+    return r;
+}
+
+static void test_voids_no_false_cliff_at_the_foot(void **state) {
+    (void)state;
+    /* fixed columns of exactly 2 r_max = 100 m from x = 0 made the last one [8000, 8100) m,
+     * holding only the small elements at the foot: a false cliff of atan(2480 / 1000) = 68
+     * degrees. A column wholly inside the extent always holds some of the block's edge. */
+    for (int n_foot = 1; n_foot <= 2; n_foot++) {
+        const cdem_voids_result r = lattice_with_foot(n_foot);
+        print_message("%d element(s) at the foot: steepest %.2f deg, columns %.3f m\n", n_foot,
+                      r.steepest_deg, r.column_width);
+        assert_near(r.column_width, 106.25, 1e-9);
+        assert_near(r.steepest_deg, 0.0, 1e-9); /* the lattice's top is flat */
+    }
+}
+
+/* The slope is taken over exactly the window, wherever the elements fall: a 500 m step reads
+ * atan(500 / 1000). (One element of radius 40 m every 70 m. With fixed columns of 80 m from
+ * the extent's start, the slope taken to the first column at least 1000 m away, it read less:
+ * atan(500 / 1040) when that column was 1040 m away.) */
+static void test_voids_slope_over_exact_window(void **state) {
+    (void)state;
+    for (int shift = 0; shift < 4; shift++) {
+        cdem_state s = {0};
+        cdem_error err;
+        assert_int_equal(cdem_state_init(&s, 256, 0, &err), CDEM_OK);
+        for (int k = 0; k < 86; k++) {
+            const double x = 70.0 * k + 23.0 * shift, top = x < 3000.0 ? 1000.0 : 1500.0;
+            assert_int_equal(
+                cdem_state_append(&s, -1, x, top - 40.0, 40.0, 1.0, 0, 0, 0, NULL, &err), CDEM_OK);
+        }
+        cdem_voids_result r;
+        assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_OK);
+        print_message("shift %d: steepest %.3f deg from x = %.1f to %.1f m\n", shift,
+                      r.steepest_deg, r.steepest_x0, r.steepest_x1);
+        assert_near(r.steepest_deg, atan(0.5) * 180.0 / M_PI, 1e-9);
+        assert_near(r.steepest_x1 - r.steepest_x0, 1000.0, 1e-9);
+        /* the step lies between the slope's ends */
+        assert_true(r.steepest_x0 < 3000.0 && r.steepest_x1 >= 3000.0);
+        cdem_state_free(&s);
+    }
 }
 
 static void test_voids_open_slot(void **state) {
@@ -128,9 +194,13 @@ static void test_voids_bad_input(void **state) {
 
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_voids_intact_block), cmocka_unit_test(test_voids_enclosed_cavity),
-        cmocka_unit_test(test_voids_cliff),        cmocka_unit_test(test_voids_open_slot),
+        cmocka_unit_test(test_voids_intact_block),
+        cmocka_unit_test(test_voids_enclosed_cavity),
+        cmocka_unit_test(test_voids_cliff),
+        cmocka_unit_test(test_voids_open_slot),
         cmocka_unit_test(test_voids_bad_input),
+        cmocka_unit_test(test_voids_no_false_cliff_at_the_foot),
+        cmocka_unit_test(test_voids_slope_over_exact_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -40,7 +40,7 @@ int cdem_cmd_plot_voids(int argc, char **argv) {
         st = cdem_voids_measure(&s, a.window > 0.0 ? a.window : 1000.0, &res, &err);
     if (st == CDEM_OK) {
         printf("increment %d\n", (int)info.number);
-        printf("steepest surface slope = %.2f deg over %.4g m (columns at x = %.6g and %.6g m)\n",
+        printf("steepest surface slope = %.2f deg over %.4g m (from x = %.6g to %.6g m)\n",
                res.steepest_deg, res.window, res.steepest_x0, res.steepest_x1);
         printf("voids = %zu (closed-off room for the largest element, radius %.4g m), their room "
                "%.4g m^2\n",

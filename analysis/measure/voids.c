@@ -11,33 +11,71 @@
 /* Raster cells at most (the cell grows beyond a quarter radius for huge models). */
 #define VOIDS_MAX_CELLS 40000000.0
 
-static void steepest_slope(const cdem_state *s, double xmin, double xmax, double rmax,
-                           cdem_voids_result *res, size_t *top) {
-    const double cw = 2.0 * rmax;
-    const size_t nc = (size_t)floor((xmax - xmin) / cw) + 1;
-    cdem_surface_column_tops(s, xmin, cw, nc, -INFINITY, INFINITY, top);
-    res->column_width = cw;
-    size_t b = 0;
-    for (size_t a = 0; a < nc; a++) {
-        if (top[a] == SIZE_MAX)
+/* Sample cells of the surface at most (the cell grows beyond r_max / 8 for huge models). */
+#define VOIDS_MAX_SURFACE_CELLS 10000000.0
+
+/* The steepest slope (voids.h). The surface is sampled in narrow cells of width h, about
+ * r_max / 8, h dividing `window` (common/surface.h: each cell's highest top). Its envelope
+ * at cell k is the highest top in cells k - m .. k + m (a column of about 2 r_max centred
+ * there, slid along the model rather than fixed in place), and its height at k the mean of
+ * the envelope over those cells. The mean smooths the envelope's steps where a single high
+ * element enters or leaves the column; without it, the steepest reading picked the one
+ * placement of many where a high element and a notch a kilometre apart lined up (5 degrees
+ * on Fig. 11B's flat growth surface, 3 with it). Only columns wholly inside the free
+ * elements' extent [xmin, xmax] count. The slope is taken between heights exactly `window`
+ * apart. So the reading depends neither on where fixed columns would fall nor on a column
+ * cut short by the extent's end. (Fixed columns of exactly 2 r_max from xmin, the slope
+ * taken between their highest tops to the first column at least `window` away, read 59
+ * degrees at Fig. 12B's moving wall, where the last column held only the few elements
+ * pressed under the wall's foot, and moved by up to 3 degrees with the columns' places
+ * elsewhere.) Returns -1 when out of memory. */
+static int steepest_slope(const cdem_state *s, double xmin, double xmax, double rmax,
+                          cdem_voids_result *res) {
+    const double window = res->window, span = xmax - xmin;
+    double per = ceil(window / (rmax / 8.0)); /* cells per window */
+    if (span / (window / per) > VOIDS_MAX_SURFACE_CELLS)
+        per = fmax(1.0, floor(VOIDS_MAX_SURFACE_CELLS * window / span));
+    const double h = window / per;
+    const long q = (long)per, m = (long)floor(rmax / h), nc = (long)floor(span / h) + 1;
+    res->column_width = (double)(2 * m + 1) * h;
+    size_t *top = malloc((size_t)nc * sizeof *top);
+    double *envelope = malloc((size_t)nc * sizeof *envelope);
+    double *height = malloc((size_t)nc * sizeof *height);
+    if (!top || !envelope || !height) {
+        free(top);
+        free(envelope);
+        free(height);
+        return -1;
+    }
+    cdem_surface_column_tops(s, xmin, h, (size_t)nc, -INFINITY, INFINITY, top);
+    /* -INFINITY: a column reaching beyond the extent, or empty */
+    for (long k = 0; k < nc; k++) {
+        envelope[k] = -INFINITY;
+        for (long c = k - m; c <= k + m && k >= m && k + m < nc; c++)
+            if (top[c] != SIZE_MAX)
+                envelope[k] = fmax(envelope[k], s->y[top[c]] + s->radius[top[c]]);
+    }
+    for (long k = 0; k < nc; k++) {
+        double sum = 0.0;
+        for (long c = k - m; c <= k + m && isfinite(sum); c++)
+            sum = c < 0 || c >= nc ? -INFINITY : sum + envelope[c];
+        height[k] = sum / (double)(2 * m + 1);
+    }
+    for (long k = 0; k + q < nc; k++) {
+        const double ya = height[k], yb = height[k + q];
+        if (!isfinite(ya) || !isfinite(yb))
             continue;
-        const double xa = xmin + (a + 0.5) * cw;
-        if (b <= a)
-            b = a + 1;
-        while (b < nc && (top[b] == SIZE_MAX || xmin + (b + 0.5) * cw - xa < res->window))
-            b++;
-        if (b >= nc)
-            break;
-        const double xb = xmin + (b + 0.5) * cw;
-        const double ya = s->y[top[a]] + s->radius[top[a]];
-        const double yb = s->y[top[b]] + s->radius[top[b]];
-        const double deg = atan(fabs(yb - ya) / (xb - xa)) * 180.0 / M_PI;
+        const double deg = atan(fabs(yb - ya) / window) * 180.0 / M_PI;
         if (deg > res->steepest_deg) {
             res->steepest_deg = deg;
-            res->steepest_x0 = xa;
-            res->steepest_x1 = xb;
+            res->steepest_x0 = xmin + ((double)k + 0.5) * h;
+            res->steepest_x1 = res->steepest_x0 + window;
         }
     }
+    free(top);
+    free(envelope);
+    free(height);
+    return 0;
 }
 
 /* Marks the cells whose centre lies inside disc (x, y, r) with value v. */
@@ -243,12 +281,8 @@ cdem_status cdem_voids_measure(const cdem_state *s, double window, cdem_voids_re
     if (!(rmax > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "voids: the increment has no free element");
     res->min_clearance = rmax;
-    const size_t ncol = (size_t)floor((xmax - xmin) / (2.0 * rmax)) + 1;
-    size_t *top = malloc(ncol * sizeof *top);
-    if (!top)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "voids: out of memory for %zu columns", ncol);
-    steepest_slope(s, xmin, xmax, rmax, res, top);
-    free(top);
+    if (steepest_slope(s, xmin, xmax, rmax, res) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "voids: out of memory for the surface's columns");
 
     const double fx0 = xmin, fx1 = xmax, fy0 = ymin, fy1 = ymax; /* the free elements' box */
     /* the raster spans every element (walls and faults too) with a margin of 3 rmax + 2 cells

@@ -1,12 +1,15 @@
 /* voids: open space that a granular rock mass should not hold, in one increment.
  *
  * Two measures, each of the free (non-boundary) elements:
- *   - the steepest surface slope: the free surface is sampled in columns of width 2 x the
- *     largest free radius (common/surface.h: the highest element top of each column); for
- *     every column, the slope to the first column at least `window` metres to its right is
- *     atan(|top difference| / x distance), and the steepest of these is reported. A graben
- *     flank or a repose slope gives a few tens of degrees; a standing cliff or the wall of
- *     an open chasm, 60-80 degrees over a kilometre.
+ *   - the steepest surface slope: the surface's envelope at x is the highest element top
+ *     among the free elements whose centres lie in a column of about 2 x the largest free
+ *     radius centred at x (common/surface.h), the column slid along the model in steps of
+ *     about an eighth of that radius and kept wholly inside the free elements' extent; the
+ *     surface's height at x is the envelope's mean over that column (the steps where a
+ *     single high element enters or leaves the column smoothed). The slope between two heights
+ * exactly `window` metres apart is atan(|height difference| / window), and the steepest of these is
+ * reported. A graben flank or a repose slope gives a few tens of degrees; a standing cliff or the
+ *     wall of an open chasm, 60-80 degrees over a kilometre.
  *   - voids: the elements are rasterised (cells of a quarter of the smallest free radius;
  *     wall, fault and other boundary elements count as solid). The clearance of an empty cell
  *     is its distance to the nearest solid cell (a chamfer distance transform, within 8 % of
@@ -36,10 +39,10 @@
 #include <stddef.h>
 
 typedef struct {
-    double window;                   /* m, horizontal span of the slope measure, > 0 */
-    double column_width;             /* m, 2 x the largest free radius */
-    double steepest_deg;             /* degrees, 0..90: steepest slope over `window` */
-    double steepest_x0, steepest_x1; /* m, centres of the two columns of that slope */
+    double window;       /* m, horizontal span of the slope measure, > 0 */
+    double column_width; /* m, the sliding column's width: ~2 x the largest free radius */
+    double steepest_deg; /* degrees, 0..90: steepest slope over `window` */
+    double steepest_x0, steepest_x1; /* m, that slope's ends (the columns' centres) */
     double cell;                     /* m, raster cell size */
     double min_clearance;            /* m, clearance that makes a void: largest free radius */
     double void_min_room;            /* m^2, the smallest room that counts (pi r_max^2 / 16) */
