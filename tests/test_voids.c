@@ -98,8 +98,8 @@ static void test_voids_cliff(void **state) {
 
 /* A flat lattice block, 80 x 25 elements of radius 50 m (top 2500 m, free extent 0-8000 m),
  * with `n_foot` elements of radius 10 m at its right foot, from x = 8010 m: as at a moving
- * wall, where a few small elements are pressed under the wall's foot. (Cells of 6.25 m,
- * the sliding column 17 of them: 106.25 m.) */
+ * wall, where a few small elements low against the wall's face reach a little further than
+ * the rest. (Cells of 6.25 m, the sliding column 17 of them: 106.25 m.) */
 static cdem_voids_result lattice_with_foot(int n_foot) {
     cdem_state s = {0};
     cdem_error err;

@@ -26,9 +26,9 @@
  * apart. So the reading depends neither on where fixed columns would fall nor on a column
  * cut short by the extent's end. (Fixed columns of exactly 2 r_max from xmin, the slope
  * taken between their highest tops to the first column at least `window` away, read 59
- * degrees at Fig. 12B's moving wall, where the last column held only the few elements
- * pressed under the wall's foot, and moved by up to 3 degrees with the columns' places
- * elsewhere.) Returns -1 when out of memory. */
+ * degrees at Fig. 12B's moving wall, where the last column, 29 m wide, held only five
+ * small elements against the wall's face, the highest 3 km below the surface, and moved by
+ * up to 3 degrees with the columns' places elsewhere.) Returns -1 when out of memory. */
 static int steepest_slope(const cdem_state *s, double xmin, double xmax, double rmax,
                           cdem_voids_result *res) {
     const double window = res->window, span = xmax - xmin;
