@@ -16,7 +16,7 @@
 #                  passive   OMP_WAIT_POLICY=passive
 #                  spin:N    GOMP_SPINCOUNT=N
 #   MODEL="-s assembly.width=20 -s assembly.half_radii=on"  (16,700 elements)
-#   STEPS=10000  REPS=3 (medians)  WORK=/tmp/cdem_bench  (runs of 3-6 s: shorter ones were
+#   STEPS=10000  REPS=3 (pairs; medians)  WORK=/tmp/cdem_bench  (runs of 3-6 s: shorter ones were
 #                  dominated by start-up and by the governor's first probes)
 BUILD=${1:-build}
 WAITS=${WAITS:-cdem}
@@ -45,8 +45,25 @@ timed() {
     awk -v a="$s" -v b="$e" 'BEGIN {printf "%.3f\n", b - a}'
 }
 
-measure() { # wait, threads: median wall time of REPS runs
-    for r in $(seq "$REPS"); do timed "$1" "$2"; done | median
+# wait: REPS pairs of runs on 1 and 2 threads back to back, the order swapped every pair, so
+# that the machine's drift (this VM's vCPUs change speed by up to 1.6x from minute to minute,
+# docs/performance.md) falls on both counts of a pair. Prints the median 1-thread time, the
+# median 2-thread time and the median of the pairs' ratios 2t / 1t. (Three runs of one count
+# and then three of the other once gave a 1-thread time 30 % apart between two settings
+# that run the same code on one thread.)
+measure_pairs() {
+    : >"$WORK/contended.pairs"
+    for r in $(seq "$REPS"); do
+        if [ $((r % 2)) = 1 ]; then
+            a=$(timed "$1" 1) && b=$(timed "$1" 2)
+        else
+            b=$(timed "$1" 2) && a=$(timed "$1" 1)
+        fi || { echo "contended.sh: cdem-run failed ($1)" >&2; exit 1; }
+        echo "$a $b" >>"$WORK/contended.pairs"
+    done
+    echo "$(cut -d' ' -f1 "$WORK/contended.pairs" | median)" \
+        "$(cut -d' ' -f2 "$WORK/contended.pairs" | median)" \
+        "$(awk '{print $2 / $1}' "$WORK/contended.pairs" | median)"
 }
 
 # the competitor: a CPU-bound shell loop, one core's worth
@@ -54,15 +71,19 @@ start_competitor() { sh -c 'while :; do :; done' & COMP=$!; }
 stop_competitor() { kill "$COMP" 2>/dev/null; wait "$COMP" 2>/dev/null; }
 trap 'stop_competitor' EXIT INT TERM
 
-echo "   model: $MODEL, $STEPS steps ($("$BUILD/cdem-run" --summary $MODEL | awk '/free elements:/ {print $3}') free elements); median of $REPS runs; load before $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "   model: $MODEL, $STEPS steps ($("$BUILD/cdem-run" --summary $MODEL | awk '/free elements:/ {print $3}') free elements); $REPS pairs of 1- and 2-thread runs, medians; load before $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '   %-14s | %8s %8s %8s | %8s %8s %8s\n' wait "idle 1t" "idle 2t" "speed-up" "busy 1t" "busy 2t" "2t / 1t"
 for w in $WAITS; do
-    i1=$(measure "$w" 1); i2=$(measure "$w" 2)
+    set -- $(measure_pairs "$w")
+    [ -n "$3" ] || exit 1
+    i1=$1 i2=$2 iq=$3
     start_competitor
-    b1=$(measure "$w" 1); b2=$(measure "$w" 2)
+    set -- $(measure_pairs "$w")
+    [ -n "$3" ] || exit 1
+    b1=$1 b2=$2 bq=$3
     stop_competitor
     printf '   %-14s | %7.2fs %7.2fs %7.2fx | %7.2fs %7.2fs %7.2fx\n' "$w" "$i1" "$i2" \
-        "$(awk -v a="$i1" -v b="$i2" 'BEGIN {print a / b}')" "$b1" "$b2" \
-        "$(awk -v a="$b1" -v b="$b2" 'BEGIN {print b / a}')"
+        "$(awk -v q="$iq" 'BEGIN {print 1 / q}')" "$b1" "$b2" "$bq"
 done
-echo "   idle speed-up = idle 1t / idle 2t; busy 2t / 1t = the slowdown threads cause with one core busy (goal <= 1.15)"
+echo "   idle speed-up = 1 / median of the idle pairs' 2t / 1t; busy 2t / 1t = median of the busy pairs' ratios: the"
+echo "   slowdown threads cause with one core busy (goal <= 1.15); the times are the medians of each count's runs"

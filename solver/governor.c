@@ -28,48 +28,48 @@ void cdem_governor_finish(cdem_governor *g) {
         use(g, g->allowed);
 }
 
-/* The end of a window at (step, now): its time per step, or a negative value when it is
- * still too short. */
-static double window_per_step(const cdem_governor *g, long step, double now) {
-    const long steps = step - g->step_window;
-    const double t = now - g->t_window;
-    if (steps < GOVERNOR_WINDOW_MIN_STEPS || t < GOVERNOR_WINDOW_S)
+/* Adds a timed step to the open window; returns the window's time per step once it is long
+ * enough, a negative value before. */
+static double window_per_step(cdem_governor *g, double step_seconds) {
+    if (!(step_seconds >= 0.0))
+        return -1.0; /* not timed (cannot happen while a window is open) */
+    g->window_seconds += step_seconds;
+    g->window_steps++;
+    if (g->window_steps < GOVERNOR_WINDOW_MIN_STEPS || g->window_seconds < GOVERNOR_WINDOW_S)
         return -1.0;
-    return t / (double)steps;
+    return g->window_seconds / (double)g->window_steps;
 }
 
-static void start_window(cdem_governor *g, long step, double now) {
-    g->t_window = now;
-    g->step_window = step;
+static void start_window(cdem_governor *g) {
+    g->window_seconds = 0.0;
+    g->window_steps = 0;
 }
 
-int cdem_governor_after_step(cdem_governor *g, long step, double now) {
+int cdem_governor_after_step(cdem_governor *g, long step, double now, double step_seconds) {
     if (!g->enabled)
         return 0;
     if (g->chosen == 1 && g->current == 1) /* by choice, not in a probe of one thread */
         g->steps_on_one += step - g->step_last;
     g->step_last = step;
-    if (now < 0.0)
-        return 0;
     switch (g->phase) {
     case CDEM_GOVERNOR_RUN:
-        if (now >= g->t_next_probe) {
+        if (now >= 0.0 && now >= g->t_next_probe) {
             g->phase = CDEM_GOVERNOR_TIME;
-            start_window(g, step, now);
+            start_window(g);
         }
         return 0;
     case CDEM_GOVERNOR_TIME: {
-        const double a = window_per_step(g, step, now);
+        const double a = window_per_step(g, step_seconds);
         if (a < 0.0)
             return 0;
         g->per_step_chosen = a;
         g->phase = CDEM_GOVERNOR_PROBE;
         use(g, g->chosen == 1 ? g->allowed : 1);
-        start_window(g, step, now);
+        start_window(g);
         return 0;
     }
     case CDEM_GOVERNOR_PROBE: {
-        const double b = window_per_step(g, step, now);
+        const double b = window_per_step(g, step_seconds);
         if (b < 0.0)
             return 0;
         g->probes++;

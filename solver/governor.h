@@ -13,11 +13,18 @@
  * How: a probe is two back-to-back windows of at least GOVERNOR_WINDOW_S seconds and
  * GOVERNOR_WINDOW_MIN_STEPS steps each, first on the current count, then on the other; the
  * other is kept when its time per step is below GOVERNOR_SWITCH_RATIO times the current's
- * (so noise does not flip the choice). The first probe comes GOVERNOR_FIRST_S into the run;
- * while the choice stands the interval between probes doubles, up to GOVERNOR_MAX_S; after a
- * change it starts again at GOVERNOR_MIN_S. On an idle 2-core machine a probe costs its one
+ * (so noise does not flip the choice). A window times the steps only: the caller times each
+ * step while a window is open (cdem_governor_times_steps) and passes its seconds, so the
+ * run's own serial work between steps (an increment's or a checkpoint's write and sync, a
+ * sample, a deposit) does not count. (When the windows were spans of the clock, a write in
+ * the first window made the N threads look slower than the one of the second: on an idle
+ * machine a run of 16,700 elements that wrote an increment every 1000 steps switched to one
+ * thread at step 3024 and ran 11 % of its steps there.) The first probe comes GOVERNOR_FIRST_S into
+ * the run; while the choice stands the interval between probes doubles, up to GOVERNOR_MAX_S; after
+ * a change it starts again at GOVERNOR_MIN_S. On an idle 2-core machine a probe costs its one
  * window on one thread, about a third of GOVERNOR_WINDOW_S, so well under 1 % of a run. The
- * clock is read every GOVERNOR_CHECK_EVERY steps, never for results.
+ * clock is read every GOVERNOR_CHECK_EVERY steps, and around each step of a window, never
+ * for results.
  *
  * CDEM_THREAD_GOVERNOR=off in the environment keeps the N threads throughout (benchmarks of
  * the threads' scaling). A run on one allowed thread has nothing to choose.
@@ -51,8 +58,8 @@ typedef struct {
     int chosen;                /* the count kept between probes (1 or N) */
     int current;               /* the count in use now */
     cdem_governor_phase phase; /* where the probe cycle is */
-    double t_window;           /* s, clock at the start of the current window */
-    long step_window;          /* step at the start of the current window */
+    double window_seconds;     /* s, the steps' time in the current window so far */
+    long window_steps;         /* steps in the current window so far */
     double per_step_chosen;    /* s per step of the chosen count in the probe's first window */
     double interval;           /* s, the next gap between probes */
     double t_next_probe;       /* s, clock at which the next probe starts */
@@ -66,14 +73,23 @@ typedef struct {
  * omp_get_max_threads() as N; reads CDEM_THREAD_GOVERNOR. */
 void cdem_governor_init(cdem_governor *g, double now, long step);
 
-/* After a completed step: may end a window and change the thread count for the next steps.
- * `now` is read by the caller only every GOVERNOR_CHECK_EVERY steps (pass a negative value
- * otherwise: nothing is decided then). Returns 1 when the chosen count changed. */
-int cdem_governor_after_step(cdem_governor *g, long step, double now);
+/* After a completed step: may start or end a window and change the thread count for the next
+ * steps. `now` (s, monotonic) is read by the caller after every step that
+ * cdem_governor_times_steps said to time and every GOVERNOR_CHECK_EVERY steps
+ * (cdem_governor_wants_clock; pass a negative value otherwise); `step_seconds` is the time
+ * of that timed step's stepping alone (negative for a step not timed). Returns 1 when the
+ * chosen count changed. */
+int cdem_governor_after_step(cdem_governor *g, long step, double now, double step_seconds);
 
 /* Gives the calling thread back the N threads it had at init (a later run in the same
  * process starts from them). */
 void cdem_governor_finish(cdem_governor *g);
+
+/* 1 when the caller should time the next step (a window is open): read the clock just
+ * before and just after the stepping, without the run's writes. */
+static inline int cdem_governor_times_steps(const cdem_governor *g) {
+    return g->enabled && g->phase != CDEM_GOVERNOR_RUN;
+}
 
 /* 1 when the clock should be read after this step (every GOVERNOR_CHECK_EVERY steps). */
 static inline int cdem_governor_wants_clock(const cdem_governor *g, long step) {

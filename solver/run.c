@@ -278,14 +278,17 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
         r->it.equilibrating = step <= equil;
         r->it.damping_factor = deforming ? p->deformation_damping : 1.0;
         r->ckpt.boundary_forces = (step % interval == 0) || eq_moves;
+        /* the governor's windows time the stepping alone, not the writes below (governor.h) */
+        const int timed = cdem_governor_times_steps(&r->gov);
+        const double t_before = timed ? run_now() : 0.0;
         cdem_status st =
             cdem_integrator_step(&r->it, &r->s, (deforming || eq_moves) ? &r->bc : NULL,
                                  deforming ? r->k_def : 0, r->m.displacement_per_step, err);
         if (st != CDEM_OK)
             return st;
         r->step = step;
-        if (cdem_governor_after_step(&r->gov, step,
-                                     cdem_governor_wants_clock(&r->gov, step) ? run_now() : -1.0))
+        const double now = timed || cdem_governor_wants_clock(&r->gov, step) ? run_now() : -1.0;
+        if (cdem_governor_after_step(&r->gov, step, now, timed ? now - t_before : -1.0))
             log_thread_change(r, step);
         CDEM_TRY(check_unstable(r, err));
         log_removed(r);
