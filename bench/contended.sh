@@ -24,6 +24,12 @@ MODEL=${MODEL:-"-s assembly.width=20 -s assembly.half_radii=on"}
 STEPS=${STEPS:-10000}
 REPS=${REPS:-3}
 WORK=${WORK:-/tmp/cdem_bench}
+case $REPS in
+'' | *[!0-9]* | 0)
+    echo "contended.sh: REPS=$REPS: must be a whole number >= 1" >&2
+    exit 2
+    ;;
+esac
 mkdir -p "$WORK"
 median() { sort -g | awk '{a[NR]=$1} END {if (NR % 2) print a[(NR+1)/2]; else print (a[NR/2]+a[NR/2+1])/2}'; }
 
@@ -48,9 +54,9 @@ timed() {
 # wait: REPS pairs of runs on 1 and 2 threads back to back, the order swapped every pair, so
 # that the machine's drift (this VM's vCPUs change speed by up to 1.6x from minute to minute,
 # docs/performance.md) falls on both counts of a pair. Prints the median 1-thread time, the
-# median 2-thread time and the median of the pairs' ratios 2t / 1t. (Three runs of one count
-# and then three of the other once gave a 1-thread time 30 % apart between two settings
-# that run the same code on one thread.)
+# median 2-thread time and the medians of the pairs' ratios 2t / 1t and 1t / 2t. (Three runs
+# of one count and then three of the other once gave a 1-thread time 30 % apart between two
+# settings that run the same code on one thread.)
 measure_pairs() {
     : >"$WORK/contended.pairs"
     for r in $(seq "$REPS"); do
@@ -63,7 +69,8 @@ measure_pairs() {
     done
     echo "$(cut -d' ' -f1 "$WORK/contended.pairs" | median)" \
         "$(cut -d' ' -f2 "$WORK/contended.pairs" | median)" \
-        "$(awk '{print $2 / $1}' "$WORK/contended.pairs" | median)"
+        "$(awk '{print $2 / $1}' "$WORK/contended.pairs" | median)" \
+        "$(awk '{print $1 / $2}' "$WORK/contended.pairs" | median)"
 }
 
 # the competitor: a CPU-bound shell loop, one core's worth
@@ -75,15 +82,15 @@ echo "   model: $MODEL, $STEPS steps ($("$BUILD/cdem-run" --summary $MODEL | awk
 printf '   %-14s | %8s %8s %8s | %8s %8s %8s\n' wait "idle 1t" "idle 2t" "speed-up" "busy 1t" "busy 2t" "2t / 1t"
 for w in $WAITS; do
     set -- $(measure_pairs "$w")
-    [ -n "$3" ] || exit 1
-    i1=$1 i2=$2 iq=$3
+    [ -n "$4" ] || exit 1
+    i1=$1 i2=$2 is=$4
     start_competitor
     set -- $(measure_pairs "$w")
-    [ -n "$3" ] || exit 1
+    [ -n "$4" ] || exit 1
     b1=$1 b2=$2 bq=$3
     stop_competitor
     printf '   %-14s | %7.2fs %7.2fs %7.2fx | %7.2fs %7.2fs %7.2fx\n' "$w" "$i1" "$i2" \
-        "$(awk -v q="$iq" 'BEGIN {print 1 / q}')" "$b1" "$b2" "$bq"
+        "$is" "$b1" "$b2" "$bq"
 done
-echo "   idle speed-up = 1 / median of the idle pairs' 2t / 1t; busy 2t / 1t = median of the busy pairs' ratios: the"
+echo "   idle speed-up = median of the idle pairs' 1t / 2t; busy 2t / 1t = median of the busy pairs' 2t / 1t: the"
 echo "   slowdown threads cause with one core busy (goal <= 1.15); the times are the medians of each count's runs"

@@ -83,7 +83,9 @@ int cdem_governor_after_step(cdem_governor *g, long step, double now, double ste
             g->interval = g->interval * 2.0 > GOVERNOR_MAX_S ? GOVERNOR_MAX_S : g->interval * 2.0;
         }
         g->phase = CDEM_GOVERNOR_RUN;
-        g->t_next_probe = now + g->interval;
+        /* (now is read after every timed step, so it is known here; a caller that did not
+         * read it gets the next probe as soon as it does) */
+        g->t_next_probe = now >= 0.0 ? now + g->interval : 0.0;
         return change;
     }
     }

@@ -116,9 +116,10 @@ static void test_governor_writes_do_not_count(void **st) {
     (void)st;
     cdem_governor g;
     sim s;
-    /* idle, 2 threads 1.6x faster: most windows hold a write. Timed by the clock's span, a
-     * window of 80 steps on N threads (50 ms) with a write took 1.1 ms a step against one
-     * thread's 1 ms, and in this minute the run changed its count 8 times. */
+    /* idle, 2 threads 1.6x faster: most windows hold a write. Timed by the clock's span (the
+     * governor of 65e799e, whose windows ended at the clock reads: 64 or 96 steps), a window
+     * on N threads with a write read 1.04-1.25 ms a step against one thread's 1 ms, and in
+     * this minute the run changed its count 6 times. */
     minute_with_writes(&g, &s, 0.625e-3, 1.0e-3);
     assert_int_equal(g.changes, 0);
     assert_int_equal(g.chosen, 2);

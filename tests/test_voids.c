@@ -187,8 +187,18 @@ static void test_voids_bad_input(void **state) {
     assert_int_equal(cdem_voids_measure(&s, 0.0, &r, &err), CDEM_ERR_INVALID);
     assert_non_null(strstr(err.msg, "window = 0"));
     assert_int_equal(cdem_voids_measure(&s, NAN, &r, &err), CDEM_ERR_INVALID);
+    /* a window shorter than the largest element's diameter (100 m) */
+    assert_int_equal(cdem_voids_measure(&s, 99.0, &r, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "window = 99 m: must be at least the largest element's "
+                                    "diameter (100 m)"));
     assert_int_equal(cdem_voids_measure(&s, 1000.0, &r, &err), CDEM_OK); /* one element */
     assert_int_equal(r.n_voids, 0);
+    /* no two heights a window apart: no slope, whatever the window (1e20 m overflowed the
+     * cell count once) */
+    assert_near(r.steepest_deg, 0.0, 0.0);
+    assert_near(r.steepest_x1, r.steepest_x0, 0.0);
+    assert_int_equal(cdem_voids_measure(&s, 1e20, &r, &err), CDEM_OK);
+    assert_near(r.steepest_deg, 0.0, 0.0);
     cdem_state_free(&s);
 }
 

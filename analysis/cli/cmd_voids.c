@@ -13,7 +13,9 @@ static const char *const voids_forms[] = {"RUN.h5 [--increment K|last|equil|firs
                                           NULL};
 static const cdem_cli_option voids_options[] = {
     {"--increment", "K|last|equil|first", "the increment (default last)"},
-    {"--window", "M", "horizontal span of the steepest-slope measure in m (default 1000)"},
+    {"--window", "M",
+     "horizontal span of the steepest-slope measure in m (default 1000; at least the largest "
+     "element's diameter)"},
     {NULL, NULL, NULL}};
 static const cdem_cli_help help = {
     .program = "cdem-strain voids",
@@ -36,12 +38,20 @@ int cdem_cmd_plot_voids(int argc, char **argv) {
     cdem_increment_info info;
     cdem_voids_result res;
     cdem_status st = cdem_cmd_plot_open_increment(&a, &r, &s, &info, &err);
-    if (st == CDEM_OK)
+    if (st == CDEM_OK) {
         st = cdem_voids_measure(&s, a.window > 0.0 ? a.window : 1000.0, &res, &err);
+        if (st != CDEM_OK) /* the measure's message, with the run it was asked of */
+            cdem_error_prefix(&err, "%s, increment %d", a.files[0], (int)info.number);
+    }
     if (st == CDEM_OK) {
         printf("increment %d\n", (int)info.number);
-        printf("steepest surface slope = %.2f deg over %.4g m (from x = %.6g to %.6g m)\n",
-               res.steepest_deg, res.window, res.steepest_x0, res.steepest_x1);
+        if (res.steepest_x1 > res.steepest_x0)
+            printf("steepest surface slope = %.2f deg over %.4g m (from x = %.6g to %.6g m)\n",
+                   res.steepest_deg, res.window, res.steepest_x0, res.steepest_x1);
+        else /* measure.py and the examples read the number: it stays */
+            printf("steepest surface slope = 0.00 deg over %.4g m (none measured: the free "
+                   "elements' surface is not a window and a column long)\n",
+                   res.window);
         printf("voids = %zu (closed-off room for the largest element, radius %.4g m), their room "
                "%.4g m^2\n",
                res.n_voids, res.min_clearance, res.void_area);

@@ -32,7 +32,9 @@
 static int steepest_slope(const cdem_state *s, double xmin, double xmax, double rmax,
                           cdem_voids_result *res) {
     const double window = res->window, span = xmax - xmin;
-    double per = ceil(window / (rmax / 8.0)); /* cells per window */
+    if (!(span > window))
+        return 0; /* no two heights a window apart (and no huge cell counts below) */
+    double per = ceil(window / (rmax / 8.0)); /* cells per window (window >= 2 rmax: >= 16) */
     if (span / (window / per) > VOIDS_MAX_SURFACE_CELLS)
         per = fmax(1.0, floor(VOIDS_MAX_SURFACE_CELLS * window / span));
     const double h = window / per;
@@ -280,6 +282,13 @@ cdem_status cdem_voids_measure(const cdem_state *s, double window, cdem_voids_re
     }
     if (!(rmax > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "voids: the increment has no free element");
+    /* a slope over less than an element's diameter is the shape of one element, and would
+     * make the surface's cells (h <= window) and columns (r_max / h cells) unbounded */
+    if (window < 2.0 * rmax)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "voids: window = %g m: must be at least the largest element's diameter "
+                         "(%g m)",
+                         window, 2.0 * rmax);
     res->min_clearance = rmax;
     if (steepest_slope(s, xmin, xmax, rmax, res) != 0)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "voids: out of memory for the surface's columns");

@@ -4,12 +4,16 @@
  *   - the steepest surface slope: the surface's envelope at x is the highest element top
  *     among the free elements whose centres lie in a column of about 2 x the largest free
  *     radius centred at x (common/surface.h), the column slid along the model in steps of
- *     about an eighth of that radius and kept wholly inside the free elements' extent; the
+ *     about an eighth of that radius and kept inside the free elements' extent; the
  *     surface's height at x is the envelope's mean over that column (the steps where a
- *     single high element enters or leaves the column smoothed). The slope between two heights
- * exactly `window` metres apart is atan(|height difference| / window), and the steepest of these is
- * reported. A graben flank or a repose slope gives a few tens of degrees; a standing cliff or the
- *     wall of an open chasm, 60-80 degrees over a kilometre.
+ *     single high element enters or leaves the column smoothed). The slope between two
+ *     heights exactly `window` metres apart is atan(|height difference| / window), and the
+ *     steepest of these is reported. A graben flank or a repose slope gives a few tens of
+ *     degrees; a standing cliff, or the wall of a chasm with rubble on its floor, 60-80
+ *     degrees over a kilometre. Where a stretch of about 2 x that radius holds no free
+ *     element (a bare floor), no height is defined near it and no slope is taken there;
+ *     when the extent is shorter than the window and about four radii, none is (0 degrees,
+ *     x0 = x1 = 0).
  *   - voids: the elements are rasterised (cells of a quarter of the smallest free radius;
  *     wall, fault and other boundary elements count as solid). The clearance of an empty cell
  *     is its distance to the nearest solid cell (a chamfer distance transform, within 8 % of
@@ -56,8 +60,9 @@ typedef struct {
     double fissure_x, fissure_y;     /* m, its column and bottom */
 } cdem_voids_result;
 
-/* Measures state s with slope window `window` (m, > 0). Fails with CDEM_ERR_INVALID when s
- * has no free element or window is not a positive number, CDEM_ERR_NOMEM when the raster
+/* Measures state s with slope window `window` (m, at least the largest free element's
+ * diameter). Fails with CDEM_ERR_INVALID when s has no free element or window is not a
+ * number of at least that diameter, CDEM_ERR_NOMEM when the raster
  * cannot be allocated. */
 cdem_status cdem_voids_measure(const cdem_state *s, double window, cdem_voids_result *res,
                                cdem_error *err);
