@@ -16,8 +16,15 @@
 
 #include "params.h"
 
-#define CDEM_NUM_RADII 4
+#define CDEM_NUM_RADII        4
 #define CDEM_PREGROWTH_LAYERS 24
+
+/* The radius classes' number shares, smallest first (4:3:2:1, the original program's): the
+ * assembly's composition (solver/assembly.c) and the deposits' draws (solver/sediment.c). An
+ * initializer for an int array of CDEM_NUM_RADII, and the shares' sum. */
+#define CDEM_RADIUS_SHARES                                                                         \
+    { 4, 3, 2, 1 }
+#define CDEM_RADIUS_SHARES_TOTAL 10
 
 /* Boundary speed of the original program: v = CDEM_BOUNDARY_ACCEL * dt, in m/s. */
 #define CDEM_BOUNDARY_ACCEL 25.0

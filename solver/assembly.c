@@ -23,12 +23,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Radius classes are drawn from a shuffled "bag" holding each class this many times
- * (number fractions 4:3:2:1, smallest first): the composition is then exact to within one
+/* Radius classes are drawn from a shuffled "bag" holding each class as many times as its
+ * share (CDEM_RADIUS_SHARES, common/model.h): the composition is then exact to within one
  * bag instead of carrying binomial noise (about 2 % in the element count of a 10 x 5 unit
  * assembly with independent draws). */
-static const int bag_counts[CDEM_NUM_RADII] = {4, 3, 2, 1};
-#define ASM_BAG_SIZE 10
+static const int bag_counts[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;
+#define ASM_BAG_SIZE CDEM_RADIUS_SHARES_TOTAL
 
 /* Consecutive discarded drops that end the filling: at least ASM_MIN_FAILS, and
  * ASM_FAILS_PER_DIAMETER per smallest diameter of width (so a wide box is tried as

@@ -109,10 +109,15 @@ static cdem_status grow_i32(int32_t **a, size_t *cap, size_t need, cdem_error *e
     return CDEM_OK;
 }
 
-/* Radius class with number fractions 4:3:2:1 (smallest first). */
+/* A radius class drawn with the classes' number shares (CDEM_RADIUS_SHARES, common/model.h):
+ * one uniform draw below the shares' sum, placed among their running sums. */
 static int draw_class(gsl_rng *rng) {
-    const unsigned long u = gsl_rng_uniform_int(rng, 10);
-    return u < 4 ? 0 : u < 7 ? 1 : u < 9 ? 2 : 3;
+    static const int shares[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;
+    unsigned long u = gsl_rng_uniform_int(rng, CDEM_RADIUS_SHARES_TOTAL);
+    int k = 0;
+    while (k + 1 < CDEM_NUM_RADII && u >= (unsigned long)shares[k])
+        u -= (unsigned long)shares[k++];
+    return k;
 }
 
 cdem_status cdem_sediment_deposit(cdem_sediment *sd, cdem_state *s, double sea_level, int32_t layer,
