@@ -14,16 +14,30 @@
 #   Timing: element-steps/s = N (all elements, walls included) x NTIME / time of one timed
 #   run (cdem: clock around the step loop; LAMMPS: its "Loop time"), median of REPS; the
 #   ratio cdem/LAMMPS; peak memory (/usr/bin/time -v "Maximum resident set size").
+#   Rounds: the 1-core ratio is measured again in ROUNDS - 1 further rounds of the cdem run and
+#   the LAMMPS 1-rank run, the order swapped every round, and printed per round with its
+#   median: this VM runs the two programs at different speeds from one minute to the next
+#   (2026-11-27: 2.69x and 3.01x at 2,395 elements in two make benches of the same programs,
+#   4.33-4.44x the day before; docs/performance.md).
 # Usage: sh bench/lammps_bench.sh [BUILD]
 #   env: SIZES="10:0 10:1 40:1" (width_units:half_radii[:height_units, default 5]: ~2,500,
 #        ~9,100 and ~35,000 elements; 40:1 is most of the 3-4 minutes, mostly cdem's
 #        equilibration; add 100:1:7.5 for ~125,000 elements, about 6 more minutes), REPS=3,
+#        ROUNDS=3 (1: the first pair of runs only; each further round repeats cdem's
+#        equilibration, about a minute at 40:1),
 #        NPHYS=2000, WORK=/tmp/cdem_lammps_bench, ELSTEPS=2e7 (element-steps per timed
 #        run), KE_TOL=0.02, OV_TOL=0.01
 # Installs Debian's lammps (and time) with apt-get when missing (needs root).
 BUILD=${1:-build}
 SIZES=${SIZES:-"10:0 10:1 40:1"}
 REPS=${REPS:-3}
+ROUNDS=${ROUNDS:-3}
+case $ROUNDS in
+'' | *[!0-9]* | 0)
+    echo "lammps_bench: ROUNDS=$ROUNDS: must be a whole number >= 1" >&2
+    exit 2
+    ;;
+esac
 NPHYS=${NPHYS:-2000}
 WORK=${WORK:-/tmp/cdem_lammps_bench}
 ELSTEPS=${ELSTEPS:-2e7}
@@ -142,6 +156,25 @@ for size in $SIZES; do
     echo "     per CPU-second, 1 core: cdem $u1 s $(rate "$u1") el-steps/s, LAMMPS $v1 s $(rate "$v1") el-steps/s"
     echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x (against LAMMPS' faster: $l2how)"
     echo "     speed-up 1 -> 2 cores: cdem $(ratio "$c2" "$c1")x, LAMMPS $(ratio "$l2" "$l1")x"
+    # further rounds of the 1-core pair, the order swapped every round (see the top)
+    rounds="$(ratio "$c1" "$l1")"
+    r=2
+    while [ "$r" -le "$ROUNDS" ]; do
+        cdem_round() {
+            OMP_NUM_THREADS=2 "$BUILD/export_lammps" "$dir" "$width" "$half" "$NPHYS" "$ntime" \
+                "$REPS" "" "$height" >"$dir/cdem.r$r.out"
+        }
+        lmp_round() {
+            OMP_NUM_THREADS=1 lmp -in bench/lammps_bench.in -var dir "$dir" -var nphys "$NPHYS" \
+                -var ntime "$ntime" -var reps "$REPS" -log "$dir/lmp1.r$r.log" -screen none
+        }
+        if [ $((r % 2)) = 0 ]; then lmp_round; cdem_round; else cdem_round; lmp_round; fi
+        rc1=$(awk '/^CDEM_TIME threads 1/ {print $11}' "$dir/cdem.r$r.out" | median)
+        rl1=$(grep '^Loop time' "$dir/lmp1.r$r.log" | tail -n "$REPS" | awk '{print $4}' | median)
+        rounds="$rounds $(ratio "$rc1" "$rl1")"
+        r=$((r + 1))
+    done
+    echo "     ratio cdem/LAMMPS on 1 core in $ROUNDS rounds (the first above; then the order swapped each round): $rounds; median $(echo "$rounds" | tr ' ' '\n' | median)x"
     echo "     load average after the size: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
     echo "   peak memory: cdem $(peak_mb "$dir/cdem.time") MB (whole process incl. equilibration)," \
         "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)," \

@@ -18,7 +18,7 @@
 #   5. Threads on a busy machine (bench/contended.sh): 1 and 2 threads, idle and with one
 #      CPU-bound competitor process that the script starts and stops, with cdem-run's own
 #      wait policy and with libgomp's default, in the same run.
-# Usage: sh bench/run_bench.sh [BUILD]   (make bench; about 7 minutes on an idle 2-core box)
+# Usage: sh bench/run_bench.sh [BUILD]   (make bench; about 10 minutes on an idle 2-core box)
 # Environment:
 #   SIZES="10:5:0 10:5:1 40:5:1 100:7.5:1"  width:height:half_radii of the scaling table
 #   LARGE=1     adds 200 x 7.5 half radii (~250,000 elements; ~1.5 more minutes)
