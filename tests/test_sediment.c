@@ -119,6 +119,19 @@ static void test_sediment_deposit_below_sea_level_without_overlap(void **st) {
     cdem_sediment_free(NULL);
 }
 
+/* The radius shares' stated sum (the deposits' draw and the assembly's bag use it as the
+ * range and the bag size) is the sum of the shares. */
+static void test_sediment_radius_shares_total(void **st) {
+    (void)st;
+    static const int shares[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;
+    int sum = 0;
+    for (int k = 0; k < CDEM_NUM_RADII; k++) {
+        assert_true(shares[k] > 0);
+        sum += shares[k];
+    }
+    assert_int_equal(sum, CDEM_RADIUS_SHARES_TOTAL);
+}
+
 static void test_sediment_deposit_is_deterministic(void **st) {
     (void)st;
     cdem_params p = small_params();
@@ -381,6 +394,7 @@ static void test_sediment_end_to_end_reproducible(void **st) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sediment_deposit_below_sea_level_without_overlap),
+        cmocka_unit_test(test_sediment_radius_shares_total),
         cmocka_unit_test(test_sediment_deposit_is_deterministic),
         cmocka_unit_test(test_sediment_sea_level_and_schedule),
         cmocka_unit_test(test_sediment_refuses_bad_input),

@@ -53,7 +53,9 @@ static int steepest_slope(const cdem_state *s, double xmin, double xmax, double 
     /* -INFINITY: a column reaching beyond the extent, or empty */
     for (long k = 0; k < nc; k++) {
         envelope[k] = -INFINITY;
-        for (long c = k - m; c <= k + m && k >= m && k + m < nc; c++)
+        if (k < m || k + m >= nc)
+            continue;
+        for (long c = k - m; c <= k + m; c++)
             if (top[c] != SIZE_MAX)
                 envelope[k] = fmax(envelope[k], s->y[top[c]] + s->radius[top[c]]);
     }
