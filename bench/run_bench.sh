@@ -10,7 +10,8 @@
 #      it the 2-thread run reached (bench/bench_scale.c, "twins").
 #   2. Long run: element-steps/s in each tenth of the default model's full schedule, first
 #      vs last tenth (bench/bench_scale.c, "full").
-#   3. Against LAMMPS on the same run (bench/lammps_bench.sh; installs Debian's lammps).
+#   3. Against LAMMPS on the same run (bench/lammps_bench.sh; installs Debian's lammps); the
+#      1-core ratio also in ROUNDS rounds with the order swapped, and their median.
 #   4. Analysis path: the default run's HDF5 file (size per element-increment against the
 #      original program's 10.1 MB), reading every increment (bench/bench_io.c), strain and
 #      rendering with cdem-strain on that file, the synthetic strain benchmark beside its
