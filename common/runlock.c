@@ -116,12 +116,10 @@ cdem_status cdem_runlock_acquire(const char *path, const char *program, cdem_run
             l->locked = 0; /* no locks on this filesystem: run unprotected */
             break;
         }
-        /* Held by another writer. It writes its line right after locking: give it a moment,
-         * up to 2 s (a virtual machine's vCPU can stall a process for longer than the 200 ms
-         * this once waited: a refusal then lacked the holder's pid, in tests/test_run_output
-         * on 2026-11-27). The wait ends as soon as the line is there. */
+        /* Held by another writer. It writes its line right after locking: give it a moment
+         * (runlock.h, CDEM_RUNLOCK_NAME_WAIT_MS), in 10 ms looks that end with the line. */
         char holder[512] = "";
-        for (int k = 0; k < 200 && !holder[0]; k++) {
+        for (int k = 0; k < CDEM_RUNLOCK_NAME_WAIT_MS / 10 && !holder[0]; k++) {
             read_holder(l->fd, holder, sizeof holder);
             if (!holder[0]) {
                 struct timespec ts = {0, 10 * 1000 * 1000};

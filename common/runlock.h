@@ -29,11 +29,18 @@
 
 typedef struct cdem_runlock cdem_runlock;
 
+/* How long a refused writer waits for the holder's line before it refuses without naming the
+ * holder, in milliseconds. The holder writes the line right after it takes the lock, but a
+ * virtual machine's vCPU can stall it: 200 ms was once not enough (tests/test_run_output,
+ * 2026-11-27). */
+#define CDEM_RUNLOCK_NAME_WAIT_MS 2000
+
 /* Takes the lock of the run file path (the lock file is path + ".lock"), recording program,
- * this process's id, the time and the host in it. Fails at once, without waiting, with
+ * this process's id, the time and the host in it. Fails without waiting for the lock, with
  * CDEM_ERR_CONFLICT when another process (or another handle of this one) holds it, the
- * message naming path and the holder; with CDEM_ERR_IO when the lock file cannot be made
- * (its folder missing or not writable: the message says which). */
+ * message naming path and the holder (when the holder has not yet written its line, it waits
+ * for the line, up to CDEM_RUNLOCK_NAME_WAIT_MS); with CDEM_ERR_IO when the lock file cannot be
+ * made (its folder missing or not writable: the message says which). */
 cdem_status cdem_runlock_acquire(const char *path, const char *program, cdem_runlock **out,
                                  cdem_error *err);
 
