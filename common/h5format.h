@@ -90,6 +90,9 @@ typedef struct {
     const char *summary;         /* the model summary text */
     const char *program_version; /* e.g. CDEM_VERSION */
     const char *source;          /* "cdem-run" or "cdem2d-import:<folder>" */
+    long max_increments;         /* the most increments the file will hold at any time (the
+                                    capacity of its commit record, /increments/commit); 0:
+                                    1024. Writing more fails (CDEM_ERR_RANGE). */
 } cdem_run_meta;
 
 /* ---------------------------------------------------------------- writer */
@@ -140,7 +143,16 @@ typedef struct {
     uint64_t bytes_before; /* file size before compacting (0: not tried) */
     uint64_t bytes_after;  /* file size after (= before when not compacted) */
     char note[640];        /* why a completed run's file kept its checkpoints, else "" */
+    int dropped_replaced;  /* 1: PATH.replaced, the completed run this one replaced, was
+                              removed (cdem_h5_writer_kept_aside) */
 } cdem_h5_close_report;
+
+/* A run that replaces a completed run (CDEM_H5_REPLACE_CDEM: cdem-run --force) keeps that
+ * run as PATH.replaced until it completes itself: close then removes PATH.replaced (also in
+ * a resumed run's close); a run killed, interrupted or failed before leaves it, so a result
+ * is never lost to a replacement that did not finish. Returns that path (owned by the
+ * writer) when this writer kept one aside, else NULL. */
+const char *cdem_h5_writer_kept_aside(const cdem_h5_writer *w);
 
 /* cdem_h5_writer_close, also reporting the compaction (rep may be NULL). */
 cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report *rep,

@@ -66,7 +66,8 @@ static const cdem_cli_option run_options[] = {
      "writing is refused"},
     {"--force", NULL,
      "replace an existing OUT.h5 that is a cdem run file (never any other file, nor the "
-     "parameter or fault file)"},
+     "parameter or fault file); a completed run it replaces is kept as OUT.h5.replaced until "
+     "the new run completes, so a new run that is killed or fails loses nothing"},
     {"-s", "section.key=value", "override one parameter (repeatable; applied after the file)"},
     {"-q, --quiet", NULL, "quiet: no summary, no progress"},
     {"--summary", NULL, "validate, print the model summary and exit"},

@@ -194,6 +194,9 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
         .summary = r->summary,
         .program_version = CDEM_VERSION,
         .source = "cdem-run",
+        /* every scheduled increment, and one more written when a run stops between them
+         * (a resume drops it again) */
+        .max_increments = (long)r->m.n_increments_total + 2,
     };
     if (r->opt->output_path && !r->opt->ignore_free_space) {
         /* A full disk is reported now, not hours into the run: the file, its checkpoint
@@ -216,6 +219,10 @@ static cdem_status start_fresh(run_ctx *r, cdem_error *err) {
         CDEM_TRY(
             cdem_h5_writer_create_checked(r->opt->output_path, &meta, r->opt->replace, &r->w, err));
         cdem_h5_writer_set_sync(r->w, !r->opt->no_fsync);
+        if (cdem_h5_writer_kept_aside(r->w) && run_logging(r))
+            fprintf(r->opt->log,
+                    "cdem-run: the completed run %s held is kept as %s until this run completes\n",
+                    r->opt->output_path, cdem_h5_writer_kept_aside(r->w));
     }
     r->step = 0;
     r->next_inc = 0;
@@ -498,6 +505,9 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
         r->w = NULL;
         if (rep.note[0] && run_logging(r)) /* the file is complete, only larger */
             fprintf(r->opt->log, "cdem-run: note: %s\n", rep.note);
+        if (rep.dropped_replaced && run_logging(r))
+            fprintf(r->opt->log, "cdem-run: removed %s.replaced, the run this one replaced\n",
+                    r->opt->output_path);
         if (cst == CDEM_OK)
             run_log_wrote(r, st, had_writer);
     }

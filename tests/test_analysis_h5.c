@@ -60,7 +60,7 @@ static void make_run(cdem_state *st, cdem_increment_info *info) {
 
 static void write_run(const char *path, cdem_state *st, cdem_increment_info *info,
                       const cdem_params *p) {
-    cdem_run_meta meta = {p, "", "test run", "0", "test"};
+    cdem_run_meta meta = {p, "", "test run", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);

@@ -93,7 +93,7 @@ static void test_durability_every_commit_reaches_the_disk(void **state) {
     snprintf(xmf, sizeof xmf, "%.*s.xmf", (int)(strlen(path) - 3), path);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run", 0};
     cdem_error err;
     cdem_h5_writer *w = NULL;
     reset();

@@ -65,7 +65,7 @@ static void make_state(cdem_state *s, size_t n, int k) {
 static void write_run(const char *path, const char *reason, cdem_h5_close_report *rep) {
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "a = 1\n", "summary", "v", "cdem-run"};
+    cdem_run_meta meta = {&p, "a = 1\n", "summary", "v", "cdem-run", 0};
     cdem_error err;
     cdem_h5_writer *w = NULL;
     if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
@@ -311,7 +311,7 @@ static void test_format_compact_only_completed(void **state) {
     path_in(state, "late.h5", path, sizeof path);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run"};
+    cdem_run_meta meta = {&p, NULL, "s", "v", "cdem-run", 0};
     cdem_error err;
     cdem_h5_writer *w = NULL;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);

@@ -162,7 +162,7 @@ static void write_biaxial_run(const char *path, double sigma3, double q, cdem_mo
     cdem_params_defaults(&p);
     p.mode = mode;
     p.confining_pressure = sigma3;
-    cdem_run_meta meta = {&p, "", "biaxial test", "0", "test"};
+    cdem_run_meta meta = {&p, "", "biaxial test", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);

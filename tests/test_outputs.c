@@ -76,7 +76,7 @@ static int write_run(const char *path) {
     make_packing(&s, 80, 2000.0, 1200.0, 3);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "", "outputs test", "0", "test"};
+    cdem_run_meta meta = {&p, "", "outputs test", "0", "test", 0};
     cdem_h5_writer *w;
     if (cdem_h5_writer_create(path, &meta, &w, &err) != CDEM_OK)
         return -1;

@@ -122,7 +122,7 @@ static void test_plot_column_extraction(void **state) {
 static void write_series_file(const char *path) {
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "", "plot test", "0", "test"};
+    cdem_run_meta meta = {&p, "", "plot test", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);

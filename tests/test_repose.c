@@ -108,7 +108,7 @@ static void test_repose_command_prints_and_draws(void **state) {
     make_pile(&s, wedge_surface, 11);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "", "repose test", "0", "test"};
+    cdem_run_meta meta = {&p, "", "repose test", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(h5, &meta, &w, &err), CDEM_OK);

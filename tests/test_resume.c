@@ -18,6 +18,8 @@
 #include <cmocka.h>
 
 #include "h5format.h"
+
+#include <hdf5.h>
 #include "snapshot.h"
 #include "scratch.h"
 
@@ -290,7 +292,14 @@ static int file_has(const char *path, const char *needle) {
  * log to name.log, sends sig as soon as the log reports the end of equilibration (several
  * increments and at least one checkpoint are in the file by then; a third of the run is
  * left) and returns its wait status. */
+static int start_and_signal_force(const rs_ctx *c, const char *name, int sig, int force);
+
 static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
+    return start_and_signal_force(c, name, sig, 0);
+}
+
+/* The same, with --force when force. */
+static int start_and_signal_force(const rs_ctx *c, const char *name, int sig, int force) {
     char log[1200], out[1200], base[64];
     snprintf(base, sizeof base, "%s.log", name);
     path_of(c, base, log, sizeof log);
@@ -302,10 +311,23 @@ static int start_and_signal(const rs_ctx *c, const char *name, int sig) {
         FILE *f = freopen(log, "wb", stderr);
         if (!f || chdir(c->scratch.dir) != 0)
             _exit(99);
-        execl(c->bin, c->bin, "-o", out, "-s", "output.checkpoint_interval=2", "-s",
-              "assembly.width=10", "-s", "assembly.height=2.5", "-s", "time.equilibration=100",
-              "-s", "time.runtime=150", "-s", "output.series_interval=50", "-s",
-              "physics.calculate_stress=on", (char *)NULL);
+        char *argv[24];
+        int k = 0;
+        const char *args[] = {"-o", out,
+                              "-s", "output.checkpoint_interval=2",
+                              "-s", "assembly.width=10",
+                              "-s", "assembly.height=2.5",
+                              "-s", "time.equilibration=100",
+                              "-s", "time.runtime=150",
+                              "-s", "output.series_interval=50",
+                              "-s", "physics.calculate_stress=on"};
+        argv[k++] = (char *)c->bin;
+        for (size_t i = 0; i < sizeof args / sizeof args[0]; i++)
+            argv[k++] = (char *)args[i];
+        if (force)
+            argv[k++] = (char *)"--force";
+        argv[k] = NULL;
+        execv(c->bin, argv);
         _exit(98);
     }
     int sent = 0;
@@ -438,6 +460,184 @@ static void test_resume_refusals(void **state) {
     cdem_h5_reader_close(r);
 }
 
+/* A run stopped by a file size limit (ulimit -f: its writes past the limit fail, the file
+ * ends where the limit cut it although its superblock records more) is resumed, once the
+ * limit is lifted, to the file of an uninterrupted run (issue 35, item 3: it was refused as
+ * "truncated"). */
+static void test_resume_after_file_size_limit_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, KEEP, "-q -o whole.h5 -s output.checkpoint_interval=2 " SMALL), 0);
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && bash -c 'ulimit -f 1000; exec env OMP_WAIT_POLICY=passive %s \"%s\" -q "
+             "-o limited.h5 -s output.checkpoint_interval=2 %s' 2>'%s/err.txt'",
+             c->scratch.dir, KEEP, c->bin, SMALL, c->scratch.dir);
+    int st = system(cmd);
+    assert_true(WIFEXITED(st) && WEXITSTATUS(st) == 1);
+    expect_err(c, "limited.h5");
+    char pw[1200], pl[1200];
+    path_of(c, "whole.h5", pw, sizeof pw);
+    path_of(c, "limited.h5", pl, sizeof pl);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    assert_int_equal(cdem_h5_reader_open(pl, &r, &err), CDEM_OK);
+    assert_string_equal(cdem_h5_reader_stop_reason(r), "write-failure");
+    const size_t kept = cdem_h5_reader_increment_count(r);
+    cdem_h5_reader_close(r);
+    assert_true(kept > 2);
+    struct stat sb;
+    assert_int_equal(stat(pl, &sb), 0);
+    assert_true(sb.st_size <= 1000 * 1024);
+    if (run(c, KEEP, "-q --resume limited.h5") != 0) {
+        char *e = slurp(c, "err.txt");
+        fail_msg("the resume of a run stopped by a size limit failed:\n%s", e);
+    }
+    compare_files(pw, pl);
+    compare_checkpoints(pw, pl);
+}
+
+/* The file offset of chunk `chunk` of dataset name in the killed run's file at path. */
+static long chunk_at(const char *path, const char *name, hsize_t chunk) {
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    hbool_t yes = 1; /* a killed writer's file: read it as the reader does */
+    H5Pset(fapl, "clear_status_flags", &yes);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
+    assert_true(f >= 0);
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    hid_t sp = H5Dget_space(ds);
+    hsize_t offset = 0, size = 0;
+    unsigned mask = 0;
+    haddr_t addr = HADDR_UNDEF;
+    assert_true(H5Dget_chunk_info(ds, sp, chunk, &offset, &mask, &addr, &size) >= 0);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    H5Fclose(f);
+    return (long)addr + (long)size / 2;
+}
+
+/* The file of issue 35, item 1 (tests/data/k20_torn_index.h5.gz): a run of the default model
+ * at assembly.height = 2.5, equilibration 600 s, runtime 2000 s, SIGKILLed 2.87 s in, while
+ * it rewrote the single chunk of /increments/index: rows 0..30 in the chunk, the checksum
+ * that of the 30-row chunk. Every reader and --resume refused the whole file ("no increment
+ * of this file can be trusted"). Its 30 increments read back (the stored checksum is
+ * recomputed over the rows it covered), and the resume ends with the file of an
+ * uninterrupted run. */
+static void test_resume_torn_index_evidence(void **state) {
+    const rs_ctx *c = *state;
+    const char *data = getenv("CDEM_TEST_DATA");
+    char cmd[3000], p[1200];
+    path_of(c, "k20.h5", p, sizeof p);
+    snprintf(cmd, sizeof cmd, "gzip -dc '%s/k20_torn_index.h5.gz' > '%s'",
+             data && *data ? data : "tests/data", p);
+    assert_int_equal(system(cmd), 0);
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    if (cdem_h5_reader_open(p, &r, &err) != CDEM_OK)
+        fail_msg("the torn file does not open: %s", err.msg);
+    assert_int_equal(cdem_h5_reader_increment_count(r), 30);
+    for (size_t k = 0; k < 30; k++) {
+        cdem_state s;
+        memset(&s, 0, sizeof s);
+        cdem_increment_info in;
+        if (cdem_h5_reader_load_increment(r, k, &s, &in, &err) != CDEM_OK)
+            fail_msg("increment %zu: %s", k, err.msg);
+        assert_int_equal(in.number, (int)k);
+        assert_int_equal(s.n, 1288);
+        cdem_state_free(&s);
+    }
+    cdem_h5_reader_close(r);
+    assert_int_equal(run(c, NULL, "-q --resume k20.h5"), 0);
+    assert_int_equal(run(c, NULL,
+                         "-q -o k20fresh.h5 -s assembly.height=2.5 -s time.equilibration=600 -s "
+                         "time.runtime=2000"),
+                     0);
+    char fresh[1200];
+    path_of(c, "k20fresh.h5", fresh, sizeof fresh);
+    compare_files(fresh, p);
+}
+
+/* Stop reason and increment count of the run file at path. */
+static void stop_and_count(const char *path, char *stop, size_t cap, size_t *n) {
+    cdem_h5_reader *r = NULL;
+    cdem_error err;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s", err.msg);
+    snprintf(stop, cap, "%s", cdem_h5_reader_stop_reason(r));
+    *n = cdem_h5_reader_increment_count(r);
+    cdem_h5_reader_close(r);
+}
+
+/* --force over a completed run, and the new run killed: the completed run is still there,
+ * as NAME.replaced, until the new run completes (issue 35, item 5: killing the new run 3 s in
+ * left a 49-increment partial and the 284-increment run gone). A second --force over the
+ * partial keeps it; the completed resumed run removes it. */
+static void test_resume_force_keeps_the_replaced_run_until_done(void **state) {
+    const rs_ctx *c = *state;
+    assert_int_equal(run(c, NULL, "-q -o forced.h5 " SMALL), 0);
+    char p[1200], aside[1300], stop[64];
+    path_of(c, "forced.h5", p, sizeof p);
+    snprintf(aside, sizeof aside, "%s.replaced", p);
+    size_t done = 0, n = 0;
+    stop_and_count(p, stop, sizeof stop, &done);
+    assert_string_equal(stop, "completed");
+    int st = start_and_signal_force(c, "forced", SIGKILL, 1);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    char log[1200];
+    path_of(c, "forced.log", log, sizeof log);
+    assert_true(file_has(log, "is kept as"));
+    assert_true(file_has(log, "forced.h5.replaced until this run completes"));
+    stop_and_count(aside, stop, sizeof stop, &n);
+    assert_string_equal(stop, "completed");
+    assert_int_equal(n, done);
+    stop_and_count(p, stop, sizeof stop, &n);
+    assert_string_equal(stop, "running"); /* the killed replacement */
+    assert_true(n < done);
+    /* --force again, over the killed partial: the completed run stays aside */
+    st = start_and_signal_force(c, "forced", SIGKILL, 1);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    stop_and_count(aside, stop, sizeof stop, &n);
+    assert_string_equal(stop, "completed");
+    assert_int_equal(n, done);
+    /* the replacement resumed to its end: now it stands in for the old run */
+    assert_int_equal(run(c, NULL, "--resume forced.h5"), 0);
+    expect_err(c, "removed ");
+    expect_err(c, "forced.h5.replaced, the run this one replaced");
+    assert_int_equal(access(aside, F_OK), -1);
+    stop_and_count(p, stop, sizeof stop, &n);
+    assert_string_equal(stop, "completed");
+    assert_int_equal(n, done);
+}
+
+/* A killed run's file with one byte of a kept increment's data changed: the resume is refused
+ * naming that increment, and the file is left byte for byte as it was (issue 35, item 4:
+ * --resume reported "completed" over it, and `compute` failed its checksum later). */
+static void test_resume_refuses_a_damaged_kept_increment(void **state) {
+    const rs_ctx *c = *state;
+    int st = start_and_signal(c, "damaged", SIGKILL);
+    assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+    char p[1200], copy[1300], cmd[3000];
+    path_of(c, "damaged.h5", p, sizeof p);
+    snprintf(copy, sizeof copy, "%s.before", p);
+    /* increment 1 starts at row 4096 of /increments/x: chunk 1 */
+    const long at = chunk_at(p, "increments/x", 1);
+    FILE *f = fopen(p, "r+b");
+    assert_non_null(f);
+    assert_int_equal(fseek(f, at, SEEK_SET), 0);
+    int byte = fgetc(f);
+    assert_int_equal(fseek(f, at, SEEK_SET), 0);
+    fputc(byte ^ 0x01, f);
+    assert_int_equal(fclose(f), 0);
+    snprintf(cmd, sizeof cmd, "cp '%s' '%s'", p, copy);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(run(c, NULL, "-q --resume damaged.h5"), 1);
+    expect_err(c, "damaged.h5: cannot be resumed: increment 1 does not read back");
+    expect_err(c, "it was not changed");
+    expect_err(c, "increments 0..0 read back");
+    snprintf(cmd, sizeof cmd, "cmp -s '%s' '%s'", p, copy);
+    assert_int_equal(system(cmd), 0);
+}
+
 /* A killed run's file cut short afterwards (a full disk, an interrupted copy): the resume is
  * refused saying so, and the file is left as it was. Once the message asked "is its writer
  * still running?" (issue 19, item 7); the writer's lock now tells that no writer runs. */
@@ -452,7 +652,8 @@ static void test_resume_truncated_killed_file(void **state) {
     const off_t cut = sb.st_size * 9 / 10;
     assert_int_equal(truncate(p, cut), 0);
     assert_int_equal(run(c, NULL, "-q --resume cut.h5"), 1);
-    expect_err(c, "cut.h5: cannot be resumed: the file is truncated");
+    expect_err(c, "cut.h5: cannot be resumed: ");
+    expect_err(c, "the file is truncated");
     expect_err(c, "it was not changed");
     char *e = slurp(c, "err.txt");
     assert_null(strstr(e, "still running"));
@@ -505,6 +706,10 @@ int main(void) {
         cmocka_unit_test(test_resume_after_sigkill_is_bit_identical),
         cmocka_unit_test(test_resume_after_max_steps_is_bit_identical),
         cmocka_unit_test(test_resume_refusals),
+        cmocka_unit_test(test_resume_after_file_size_limit_is_bit_identical),
+        cmocka_unit_test(test_resume_refuses_a_damaged_kept_increment),
+        cmocka_unit_test(test_resume_torn_index_evidence),
+        cmocka_unit_test(test_resume_force_keeps_the_replaced_run_until_done),
         cmocka_unit_test(test_resume_truncated_killed_file),
         cmocka_unit_test(test_resume_refused_while_running),
     };

@@ -319,9 +319,9 @@ static void test_run_output_space_estimate(void **state) {
 }
 
 /* The default run's file (issue 18, item 10; docs/format.md, "Size"): at most 10.1 MB, the
- * original program's (MB = 10^6 bytes, as everywhere in the docs; 9.26 MB measured). The run
- * completes, so close drops its two checkpoint slots (0.53 MB that only a resume needs) and
- * compacts the file; with them it is 9.79 MB. */
+ * original program's (MB = 10^6 bytes, as everywhere in the docs; docs/measured.md has the
+ * size). The run completes, so close drops its two checkpoint slots (0.53 MB that only a
+ * resume needs) and the paged file space's slack, and compacts the file. */
 #define DEFAULT_RUN_FILE_LIMIT 10100000.0
 static void test_run_output_default_file_size(void **state) {
     scratch_dir *c = *state;

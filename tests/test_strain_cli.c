@@ -51,7 +51,7 @@ static int setup(void **state) {
     make_packing(&st[0], 120, 2000.0, 1200.0, 5);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "", "CLI test summary", "0", "test"};
+    cdem_run_meta meta = {&p, "", "CLI test summary", "0", "test", 0};
     cdem_h5_writer *w;
     if (cdem_h5_writer_create(g_run, &meta, &w, &err) != CDEM_OK)
         return -1;
@@ -248,7 +248,7 @@ static void test_strain_cli_export_biaxial(void **state) {
     cdem_params p;
     cdem_params_defaults(&p);
     p.mode = CDEM_MODE_BIAXIAL;
-    cdem_run_meta meta = {&p, "", "biaxial", "0", "test"};
+    cdem_run_meta meta = {&p, "", "biaxial", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
     assert_int_equal(cdem_h5_writer_create(path, &meta, &w, &err), CDEM_OK);

@@ -33,7 +33,7 @@ static cdem_status write_sink(void *user, const cdem_increment_info *info, const
         char source[CDEM_PATH_MAX + 32];
         snprintf(source, sizeof source, "cdem2d-import:%s", c->dir);
         cdem_run_meta rm = {&c->p, c->meta->params_text, c->meta->params_text, CDEM_VERSION,
-                            source};
+                            source, (long)c->meta->n_increments};
         CDEM_TRY(cdem_h5_writer_create(c->out, &rm, &c->w, err));
     }
     return cdem_h5_writer_write_increment(c->w, info, s, err);

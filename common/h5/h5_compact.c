@@ -164,13 +164,15 @@ static int write_compacted(const char *src_path, const char *tmp, int sync, cdem
     return rc;
 }
 
-void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep) {
+void h5i_compact_completed(const char *path, int sync, int has_checkpoints,
+                           cdem_h5_close_report *rep) {
+    /* what the note says stays as it was when the file is not compacted */
+    const char *kept = has_checkpoints ? "keeps its checkpoints" : "is not compacted";
     rep->compacted = 0;
     rep->note[0] = '\0';
     const char *keep = getenv("CDEM_KEEP_CHECKPOINTS");
     if (keep && *keep && strcmp(keep, "0") != 0) {
-        snprintf(rep->note, sizeof rep->note,
-                 "%s keeps its checkpoints: CDEM_KEEP_CHECKPOINTS is set", path);
+        snprintf(rep->note, sizeof rep->note, "%s %s: CDEM_KEEP_CHECKPOINTS is set", path, kept);
         return;
     }
     struct stat sb;
@@ -182,15 +184,14 @@ void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep
     size_t n = strlen(path) + 12;
     char *tmp = malloc(n);
     if (!tmp) {
-        snprintf(rep->note, sizeof rep->note, "%s keeps its checkpoints: out of memory", path);
+        snprintf(rep->note, sizeof rep->note, "%s %s: out of memory", path, kept);
         return;
     }
     snprintf(tmp, n, "%s.compacting", path);
     /* a crashed compaction's leftover (under the lock nobody else owns it) */
     if (unlink(tmp) != 0 && errno != ENOENT) {
-        snprintf(rep->note, sizeof rep->note,
-                 "%s keeps its checkpoints: cannot remove the leftover %s: %s", path, tmp,
-                 strerror(errno));
+        snprintf(rep->note, sizeof rep->note, "%s %s: cannot remove the leftover %s: %s", path,
+                 kept, tmp, strerror(errno));
         free(tmp);
         return;
     }
@@ -200,9 +201,9 @@ void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep
     struct statvfs vs;
     if (statvfs(dir, &vs) == 0 && (uint64_t)vs.f_bavail * vs.f_frsize < (uint64_t)sb.st_size) {
         snprintf(rep->note, sizeof rep->note,
-                 "%s keeps its checkpoints: too little free space for a compacted copy (%.1f MB "
-                 "free, %.1f MB needed)",
-                 path, (double)vs.f_bavail * vs.f_frsize / 1e6, (double)sb.st_size / 1e6);
+                 "%s %s: too little free space for a compacted copy (%.1f MB free, %.1f MB "
+                 "needed)",
+                 path, kept, (double)vs.f_bavail * vs.f_frsize / 1e6, (double)sb.st_size / 1e6);
         free(tmp);
         return;
     }
@@ -210,8 +211,8 @@ void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep
     cdem_error_clear(&e);
     if (write_compacted(path, tmp, sync, &e) != 0) {
         remove(tmp);
-        snprintf(rep->note, sizeof rep->note,
-                 "%s keeps its checkpoints: compacting it failed: %.400s", path, e.msg);
+        snprintf(rep->note, sizeof rep->note, "%s %s: compacting it failed: %.400s", path, kept,
+                 e.msg);
         free(tmp);
         return;
     }
@@ -219,9 +220,8 @@ void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep
     if (rename(tmp, path) != 0) {
         int en = errno;
         remove(tmp);
-        snprintf(rep->note, sizeof rep->note,
-                 "%s keeps its checkpoints: cannot rename the compacted copy over it: %s", path,
-                 strerror(en));
+        snprintf(rep->note, sizeof rep->note, "%s %s: cannot rename the compacted copy over it: %s",
+                 path, kept, strerror(en));
         free(tmp);
         return;
     }

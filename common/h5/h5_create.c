@@ -111,6 +111,10 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
             H5Dclose(xy);
         w->has_xy = xy >= 0;
     }
+    if (st == CDEM_OK && (w->commit = h5i_commit_create(gi, w->commit_capacity)) < 0)
+        st = H5FAIL(err, CDEM_ERR_IO,
+                    "%s: cannot create the commit record /increments/commit (%llu rows)", w->path,
+                    (unsigned long long)w->commit_capacity);
     hid_t ft = -1;
     if (st == CDEM_OK) {
         ft = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 1);
@@ -156,6 +160,10 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
 hid_t h5i_writer_fapl(void) {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
+    /* No sieve buffer: a write to a contiguous dataset (the commit record) goes to the file
+     * as it is made, alone; with one, --resume's row-by-row blanking of the record, last row
+     * first, would reach the file as one write in ascending order (h5_commit.c). */
+    H5Pset_sieve_buf_size(fapl, 0);
     return fapl;
 }
 
@@ -181,13 +189,39 @@ static int put_in_place(const char *tmp, const char *path, int replace) {
     return unlink(tmp) == 0 || errno == ENOENT ? 0 : -1;
 }
 
+/* A completed run that this one replaces (--force) is not lost when this one is killed:
+ * it is kept as PATH.replaced (a second name for the same file, or a rename where the file
+ * system has no hard links) until this run completes (cdem_h5_writer_close). An older
+ * PATH.replaced is given up only for a newer completed run. 0 or -1 (errno). */
+static int keep_aside(cdem_h5_writer *w) {
+    char *aside = h5i_replaced_path(w->path);
+    if (!aside)
+        return -1;
+    if ((unlink(aside) != 0 && errno != ENOENT) ||
+        (link(w->path, aside) != 0 && rename(w->path, aside) != 0)) {
+        free(aside);
+        return -1;
+    }
+    if (w->sync)
+        h5i_sync_folder_of(w->path);
+    w->kept_aside = aside;
+    return 0;
+}
+
 /* The file is built under a temporary name (tmp) and renamed to w->path once its layout
  * is complete and SWMR writing has started: whatever is found at w->path opens.
- * replace: 1 when a file at w->path may be replaced (it was checked under the lock). */
+ * replace: 1 when a file at w->path may be replaced (it was checked under the lock);
+ * aside: 1 when that file is a completed run to keep aside until this one completes. */
 static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, const char *tmp,
-                                int replace, cdem_error *err) {
+                                int replace, int aside, cdem_error *err) {
     hid_t fapl = h5i_writer_fapl();
     hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    /* Paged file space (FILE_SPACE_PAGE): nothing the writer rewrites in place (object
+     * headers, chunk indexes, the index's and the series' chunks) crosses a page boundary, so
+     * a kill cannot tear it (docs/format.md, "HDF5 settings"; 10 % more file while the run
+     * goes on, nothing once it completes: the compacted copy is not paged). */
+    H5Pset_file_space_strategy(fcpl, H5F_FSPACE_STRATEGY_PAGE, 0, 1);
+    H5Pset_file_space_page_size(fcpl, FILE_SPACE_PAGE);
     /* EXCL: the stale tmp of a killed run was removed under the lock; anything there now is
      * not ours to truncate */
     w->file = H5Fcreate(tmp, H5F_ACC_EXCL, fcpl, fapl);
@@ -220,6 +254,11 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, co
     CDEM_TRY(h5i_flush_file(w, err));
     CDEM_TRY(h5i_start_swmr(w, err));
     CDEM_TRY(h5i_commit_flush(w, err));
+    if (aside && keep_aside(w) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: cannot keep the completed run it holds as %s.replaced while the "
+                         "new run is written: %s; nothing was replaced",
+                         w->path, w->path, strerror(errno));
     if (put_in_place(tmp, w->path, replace) != 0) {
         int e = errno;
         return CDEM_FAIL(err, CDEM_ERR_IO,
@@ -240,6 +279,8 @@ cdem_status h5i_writer_alloc(const char *path, cdem_h5_writer **out, cdem_error 
     if (!w)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
     w->file = w->index = w->index_mtype = w->stop_reason = w->stop_detail = -1;
+    w->commit = w->commit_mtype = -1;
+    w->commit_capacity = COMMIT_DEFAULT_CAPACITY;
     w->ckpt_data[0] = w->ckpt_data[1] = w->ckpt_index = w->ckpt_mtype = -1;
     for (size_t c = 0; c < N_SERIES; c++)
         w->series[c] = -1;
@@ -254,8 +295,9 @@ cdem_status h5i_writer_alloc(const char *path, cdem_h5_writer **out, cdem_error 
     w->column = malloc(SERIES_BUFFER * 8);
     w->index_mtype = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
     w->ckpt_mtype = h5i_make_compound(h5i_ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 0);
+    w->commit_mtype = h5i_commit_type(0);
     if (!w->path || !w->xmf_path || !w->buf || !w->column || w->index_mtype < 0 ||
-        w->ckpt_mtype < 0) {
+        w->ckpt_mtype < 0 || w->commit_mtype < 0) {
         h5i_writer_release(w);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
     }
@@ -278,9 +320,15 @@ cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta 
     if (!path || !*path || !meta || !meta->params || !out)
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "cdem_h5_writer_create: path, meta, meta->params and out are required");
+    if (meta->max_increments < 0)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "cdem_h5_writer_create: max_increments = %ld must be >= 0 (0: %d)",
+                         meta->max_increments, COMMIT_DEFAULT_CAPACITY);
     h5i_writer_hdf5_init();
     cdem_h5_writer *w = NULL;
     CDEM_TRY(h5i_writer_alloc(path, &w, err));
+    if (meta->max_increments > 0)
+        w->commit_capacity = (hsize_t)meta->max_increments;
     size_t n = strlen(path) + 10;
     char *tmp = malloc(n);
     if (!tmp) {
@@ -290,11 +338,11 @@ cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta 
     snprintf(tmp, n, "%s.creating", path);
     /* One writer per path for the writer's whole life: a second run of the same output would
      * otherwise remove this one's temporary file and rename its own over this one's. */
-    int locked = 0, replace = 0;
+    int locked = 0, replace = 0, completed = 0;
     cdem_status st = cdem_runlock_acquire(path, meta->source, &w->lock, err);
     if (st == CDEM_OK) {
         locked = 1;
-        st = h5i_check_replace(path, replace_policy, &replace, err);
+        st = h5i_check_replace(path, replace_policy, &replace, &completed, err);
     }
     /* a killed run's leftover (we hold the lock, so no live writer owns it) */
     if (st == CDEM_OK && unlink(tmp) != 0 && errno != ENOENT)
@@ -311,7 +359,8 @@ cdem_status cdem_h5_writer_create_checked(const char *path, const cdem_run_meta 
         }
     }
     if (st == CDEM_OK)
-        st = writer_setup(w, meta, tmp, replace, err);
+        st = writer_setup(w, meta, tmp, replace,
+                          replace && completed && replace_policy == CDEM_H5_REPLACE_CDEM, err);
     if (st != CDEM_OK) {
         if (locked)
             remove(tmp); /* ours: removed while the lock is still held */

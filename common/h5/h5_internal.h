@@ -46,8 +46,16 @@
 #define SERIES_CHUNK       128
 #define SERIES_BUFFER      256
 #define XMF_EVERY_LIMIT    1000
-#define INDEX_CHUNK        64        /* rows of /increments/index per chunk (76 bytes each) */
-#define CKPT_CHUNK         (1 << 12) /* bytes of a checkpoint slot per chunk (h5_checkpoint.c) */
+#define INDEX_CHUNK        48 /* rows of /increments/index per chunk (84 bytes each) */
+/* Rows of /increments/commit (the commit record, h5_commit.c) a writer reserves when its
+ * caller does not say how many increments the run will write (cdem_run_meta). */
+#define COMMIT_DEFAULT_CAPACITY 1024
+/* The file-space page (docs/format.md, "HDF5 settings"): every piece of metadata and every
+ * raw chunk smaller than a page lies inside one page, so no write that rewrites something
+ * in place crosses a page boundary, the only place where a killed writer's write can stop
+ * (the kernel copies a write into the page cache page by page). */
+#define FILE_SPACE_PAGE 4096
+#define CKPT_CHUNK      (1 << 12) /* bytes of a checkpoint slot per chunk (h5_checkpoint.c) */
 /* Largest element count a reader accepts (ids are int32). */
 #define MAX_ELEMENTS ((hsize_t)INT32_MAX)
 /* Largest element count an increment may have to be loaded (~2 GB of state; cdem-run's
@@ -168,6 +176,17 @@ typedef struct {
 #define N_INDEX_MEMBERS 12
 extern const index_member h5i_index_members[N_INDEX_MEMBERS];
 
+/* One row of /increments/commit, the commit record (h5_commit.c): an index row and the
+ * FNV-1a 64 checksum of its packed little-endian members and of its position. */
+typedef struct {
+    index_row row;     /* the increment, as in /increments/index */
+    uint64_t checksum; /* h5i_commit_checksum(&row, position); 0 in a row never written */
+} commit_row;
+
+/* The memory (native, padded) or file (little-endian, packed: the index members, then the
+ * checksum as uint64) compound type of commit_row. */
+hid_t h5i_commit_type(int file);
+
 /* One row of /checkpoint/index (one per slot). */
 typedef struct {
     int64_t sequence;  /* 0: slot never written; larger = newer */
@@ -188,6 +207,31 @@ const char *h5i_bad_index_row(const index_row *row, const index_row *prev, hsize
 hsize_t h5i_chunk_end(hsize_t rows, hsize_t chunk_rows);
 hsize_t h5i_chunk_rows_of(hid_t ds);
 
+/* ------------------------------------------------------------------ h5_commit.c */
+
+uint64_t h5i_commit_checksum(const index_row *row, uint64_t position);
+/* 1 when the row's checksum matches its members and its position. */
+int h5i_commit_row_valid(const commit_row *c, uint64_t position);
+/* 1 when every member and the checksum are 0 (a row never written, or blanked). */
+int h5i_commit_row_blank(const commit_row *c);
+/* The record of a new file: capacity rows of zeros, contiguous, allocated now. */
+hid_t h5i_commit_create(hid_t group, hsize_t capacity);
+/* Writes row at position (mtype: memory type of commit_row); 0 or -1. */
+int h5i_commit_write(hid_t ds, hid_t mtype, hsize_t position, const index_row *row);
+/* Blanks the rows from keep on that are not blank (rows: the record as read), the last first,
+ * one write each; 0 or -1. */
+int h5i_commit_blank_from(hid_t ds, hid_t mtype, hsize_t keep, const commit_row *rows,
+                          hsize_t capacity);
+/* The committed rows of a record read whole: *committed = the length of the prefix of valid
+ * rows; *torn = 1 when the row after them is torn (allowed only when unclosed). NULL, or
+ * what is wrong with row *bad_row (damage). */
+const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, int unclosed,
+                            hsize_t *committed, hsize_t *torn, hsize_t *bad_row);
+/* A file without the record: recovers rows [0, rows) of /increments/index into out when only
+ * its last chunk fails its Fletcher-32 because a kill tore its rewrite (the stored checksum
+ * is that of a shorter prefix of the rows). Returns the rows recovered (0: none). */
+hsize_t h5i_index_recover_torn_chunk(hid_t index, hsize_t rows, index_row *out);
+
 /* ------------------------------------------------------------------ the writer */
 
 typedef struct {
@@ -204,6 +248,10 @@ struct cdem_h5_writer {
     hid_t data[N_ELEMENT_FIELDS];   /* /increments/<field> */
     hid_t index;                    /* /increments/index */
     hid_t index_mtype;              /* memory type of index_row */
+    hid_t commit;                   /* /increments/commit, the commit record (-1: a file
+                                       written before it, resumed: the index alone) */
+    hid_t commit_mtype;             /* memory type of commit_row */
+    hsize_t commit_capacity;        /* rows of /increments/commit */
     hid_t series[N_SERIES];         /* /series/<column> datasets */
     hid_t stop_reason, stop_detail; /* /stop_reason, /stop_detail */
     hid_t ckpt_data[2];             /* /checkpoint/slot0, slot1 */
@@ -239,6 +287,8 @@ struct cdem_h5_writer {
     int sync;                       /* 1: sync (fdatasync) every commit (_set_sync) */
     int placed;                     /* 1 once the file is at path (before: PATH.creating) */
     int completed;                  /* 1: the last stop reason recorded is "completed" */
+    char *kept_aside;               /* PATH.replaced when this writer's file replaced a
+                                       completed run that waits there (else NULL) */
     size_t *row_order;              /* an increment's rows by ascending id (write_increment) */
     void *row_buf;                  /* one field's values in that order, 8 bytes a row */
     size_t row_cap;                 /* rows allocated in row_order and row_buf */
@@ -256,16 +306,25 @@ void h5i_sync_folder_of(const char *path);
 void h5i_writer_release(cdem_h5_writer *w);
 cdem_status h5i_grow_entries(cdem_h5_writer *w, cdem_error *err);
 
-/* h5_compact.c: replaces the closed file at path by a copy without checkpoints (the caller
- * holds the path's lock); never fails the run: rep says what happened. */
-void h5i_compact_completed(const char *path, int sync, cdem_h5_close_report *rep);
+/* h5_compact.c: replaces the closed file at path by a copy without checkpoints and without
+ * the paged file space of a file being written (the caller holds the path's lock); never
+ * fails the run: rep says what happened (has_checkpoints: how its note words it). */
+void h5i_compact_completed(const char *path, int sync, int has_checkpoints,
+                           cdem_h5_close_report *rep);
 
 /* h5_sidecar.c: rewrites the writer's sidecar from its list of increments. */
 cdem_status h5i_write_xmf(cdem_h5_writer *w, cdem_error *err);
 
-/* h5_output.c: the policy for a file already at path (*replace: 1 = replace by a rename). */
+/* h5_output.c: the policy for a file already at path (*replace: 1 = replace by a rename;
+ * *completed: 1 = what is there is a completed cdem run; may be NULL). */
 cdem_status h5i_check_replace(const char *path, cdem_h5_replace policy, int *replace,
-                              cdem_error *err);
+                              int *completed, cdem_error *err);
+/* PATH.replaced: where a completed run replaced with --force waits until the run replacing
+ * it completes (h5_create.c); malloc'd, NULL when out of memory. */
+char *h5i_replaced_path(const char *path);
+/* Removes PATH.replaced when it is there and a cdem run file (the run at path completed);
+ * 1 when it was removed. */
+int h5i_drop_replaced(const char *path);
 
 /* ------------------------------------------------------------------ the reader */
 

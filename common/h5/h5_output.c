@@ -9,9 +9,11 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <unistd.h>
 
 double cdem_h5_estimate_file_size(double n_elements, double n_increments, int with_stress) {
     /* Measured on the default run (docs/format.md): 13.2 bytes per element and increment
@@ -71,9 +73,9 @@ cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem
 /* What is at path, for the messages of h5i_check_replace: *is_cdem becomes 1 for a file the
  * reader opens as a cdem file; desc receives e.g. 'a cdem run file (stop reason
  * "completed", 41 increments)' or 'not an HDF5 file'. */
-static void describe_existing(const char *path, int *is_cdem, int *resumable, char *desc,
-                              size_t cap) {
-    *is_cdem = *resumable = 0;
+static void describe_existing(const char *path, int *is_cdem, int *resumable, int *completed,
+                              char *desc, size_t cap) {
+    *is_cdem = *resumable = *completed = 0;
     cdem_error e;
     cdem_error_clear(&e);
     cdem_h5_reader *r = NULL;
@@ -87,18 +89,22 @@ static void describe_existing(const char *path, int *is_cdem, int *resumable, ch
     }
     *is_cdem = 1;
     const char *stop = cdem_h5_reader_stop_reason(r);
-    *resumable = strcmp(cdem_h5_reader_source(r), "cdem-run") == 0 &&
-                 strcmp(stop, "completed") != 0 && cdem_h5_reader_format_version(r) >= 2;
+    *completed = strcmp(stop, "completed") == 0;
+    *resumable = strcmp(cdem_h5_reader_source(r), "cdem-run") == 0 && !*completed &&
+                 cdem_h5_reader_format_version(r) >= 2;
     snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\", %zu increments",
              cdem_h5_reader_source(r), stop, cdem_h5_reader_increment_count(r));
     cdem_h5_reader_close(r);
 }
 
 /* The policy for a file already at path; *replace becomes 1 when it may be replaced by a
- * rename, 0 when there is nothing there (the writer's rename then refuses to replace). */
+ * rename, 0 when there is nothing there (the writer's rename then refuses to replace).
+ * *completed (may be NULL) becomes 1 when what is there is a cdem run that completed. */
 cdem_status h5i_check_replace(const char *path, cdem_h5_replace policy, int *replace,
-                              cdem_error *err) {
+                              int *completed, cdem_error *err) {
     *replace = 0;
+    if (completed)
+        *completed = 0;
     struct stat sb;
     if (lstat(path, &sb) != 0) {
         if (errno == ENOENT)
@@ -117,9 +123,9 @@ cdem_status h5i_check_replace(const char *path, cdem_h5_replace policy, int *rep
                          "%s already exists and is not a regular file (a link, a device, a "
                          "pipe?); a run never replaces it: choose another output file",
                          path);
-    int is_cdem = 0, resumable = 0;
+    int is_cdem = 0, resumable = 0, done = 0;
     char desc[600];
-    describe_existing(path, &is_cdem, &resumable, desc, sizeof desc);
+    describe_existing(path, &is_cdem, &resumable, &done, desc, sizeof desc);
     if (!is_cdem)
         return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
                          "%s already exists and is not a cdem run file (%s); it is never "
@@ -136,7 +142,31 @@ cdem_status h5i_check_replace(const char *path, cdem_h5_replace policy, int *rep
                                    : "",
                          resumable ? path : "");
     *replace = 1;
+    if (completed)
+        *completed = done;
     return CDEM_OK;
+}
+
+char *h5i_replaced_path(const char *path) {
+    const size_t n = strlen(path) + sizeof ".replaced";
+    char *p = malloc(n);
+    if (p)
+        snprintf(p, n, "%s.replaced", path);
+    return p;
+}
+
+int h5i_drop_replaced(const char *path) {
+    char *aside = h5i_replaced_path(path);
+    int dropped = 0;
+    struct stat sb;
+    if (aside && lstat(aside, &sb) == 0 && S_ISREG(sb.st_mode)) {
+        int is_cdem = 0, resumable = 0, completed = 0;
+        char desc[600];
+        describe_existing(aside, &is_cdem, &resumable, &completed, desc, sizeof desc);
+        dropped = is_cdem && unlink(aside) == 0;
+    }
+    free(aside);
+    return dropped;
 }
 
 cdem_status cdem_h5_output_check(const char *path, cdem_h5_replace replace, cdem_error *err) {
@@ -144,5 +174,5 @@ cdem_status cdem_h5_output_check(const char *path, cdem_h5_replace replace, cdem
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_output_check: no path");
     CDEM_TRY(cdem_runlock_check(path, err));
     int dummy = 0;
-    return h5i_check_replace(path, replace, &dummy, err);
+    return h5i_check_replace(path, replace, &dummy, NULL, err);
 }

@@ -105,33 +105,151 @@ static int read_rows_retrying(const cdem_h5_reader *r, hid_t ds, hid_t mt, hsize
     }
 }
 
-/* Version 2: (re)reads the index and the stop reason. In SWMR-read mode every dataset is
- * refreshed first: the index before the element datasets, so that the element datasets are
- * at least as long as the rows the index lists (the writer writes them in the other order).
- * In a file whose writer did not close it, the list ends before the first row that is not
- * backed by data (a kill mid-append); in a closed file such a row is an error. */
-static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
-    CDEM_TRY(read_text_dataset(r, "stop_reason", &r->stop_reason, err));
-    CDEM_TRY(read_text_dataset(r, "stop_detail", &r->stop_detail, err));
+/* Version 2, a file with the commit record (h5_commit.c): its committed rows into *out
+ * (malloc'd, *rows of them). The dataset is opened for this read alone, so a reader that
+ * follows a running writer reads the rows from the file every time, never from a buffer. */
+static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_t *rows,
+                                      cdem_error *err) {
+    *out = NULL;
+    *rows = 0;
+    hid_t ds = H5Dopen2(r->file, "increments/commit", H5P_DEFAULT);
+    if (ds < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /increments/commit is missing or corrupt",
+                      r->path);
+    const hsize_t capacity = h5i_extent_of(ds);
+    hid_t ft = H5Dget_type(ds), mt = h5i_commit_type(0), want = h5i_commit_type(1);
+    const int type_ok = ft >= 0 && want >= 0 && H5Tequal(ft, want) > 0;
+    commit_row *c = capacity && capacity <= MAX_ELEMENTS ? calloc(capacity, sizeof *c) : NULL;
+    index_row *ix = capacity && capacity <= MAX_ELEMENTS ? malloc(capacity * sizeof *ix) : NULL;
+    cdem_status st = CDEM_OK;
+    if (!type_ok)
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                       "%s: dataset /increments/commit does not have the commit record's type "
+                       "(docs/format.md)",
+                       r->path);
+    else if (capacity == 0 || capacity > MAX_ELEMENTS)
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/commit claims %llu rows", r->path,
+                       (unsigned long long)capacity);
+    else if (!c || !ix || mt < 0)
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the commit record of %s",
+                       r->path);
+    else if (h5i_read_all_rows(ds, mt, capacity, c) < 0)
+        st = H5FAIL(err, CDEM_ERR_FORMAT,
+                    "%s: /increments/commit (the commit record) is unreadable", r->path);
+    hsize_t committed = 0, torn = 0, bad = 0;
+    const char *why =
+        st == CDEM_OK ? h5i_commit_scan(c, capacity, r->unclosed, &committed, &torn, &bad) : NULL;
+    if (why)
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                       "%s: /increments/commit row %llu: %s; rows 0..%lld are valid: damaged file",
+                       r->path, (unsigned long long)bad, why, (long long)committed - 1);
+    if (st == CDEM_OK) {
+        for (hsize_t i = 0; i < committed; i++)
+            ix[i] = c[i].row;
+        *out = ix;
+        *rows = committed;
+        r->n_skipped = (size_t)torn;
+        ix = NULL;
+    }
+    free(ix);
+    free(c);
+    if (mt >= 0)
+        H5Tclose(mt);
+    if (want >= 0)
+        H5Tclose(want);
+    if (ft >= 0)
+        H5Tclose(ft);
+    H5Dclose(ds);
+    return st;
+}
+
+/* Version 2, a file without the commit record (written before it existed): the rows of
+ * /increments/index into *out (malloc'd, *rows of them). In a file whose writer did not
+ * close it, a last chunk whose checksum fails because a kill tore its rewrite gives back the
+ * rows its stored checksum covers (h5i_index_recover_torn_chunk). */
+static cdem_status read_old_index(cdem_h5_reader *r, index_row **out, hsize_t *rows,
+                                  cdem_error *err) {
+    *out = NULL;
+    *rows = 0;
     if (r->index < 0 && (r->index = H5Dopen2(r->file, "increments/index", H5P_DEFAULT)) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /increments/index is missing or corrupt",
                       r->path);
     if (r->swmr && H5Drefresh(r->index) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /increments/index", r->path);
-    hsize_t rows = h5i_extent_of(r->index);
-    if (rows > MAX_ELEMENTS)
+    hsize_t n = h5i_extent_of(r->index);
+    if (n > MAX_ELEMENTS)
         return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/index claims %llu rows", r->path,
-                         (unsigned long long)rows);
+                         (unsigned long long)n);
+    if (n == 0)
+        return CDEM_OK;
+    index_row *ix = malloc(n * sizeof *ix);
+    hid_t mt = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
+    cdem_status st = CDEM_OK;
+    if (!ix || mt < 0) {
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", r->path);
+    } else if (read_rows_retrying(r, r->index, mt, n, ix) < 0) {
+        hsize_t got = r->unclosed ? h5i_index_recover_torn_chunk(r->index, n, ix) : 0;
+        if (got == 0)
+            st = H5FAIL(err, CDEM_ERR_FORMAT,
+                        "%s: /increments/index (the list of increments) is damaged or unreadable: "
+                        "no increment of this file can be trusted",
+                        r->path);
+        else
+            H5Eclear2(H5E_DEFAULT);
+        n = got;
+    }
+    if (mt >= 0)
+        H5Tclose(mt);
+    if (st != CDEM_OK) {
+        free(ix);
+        return st;
+    }
+    *out = ix;
+    *rows = n;
+    return CDEM_OK;
+}
+
+static int all_zero(const void *p, size_t n) {
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++)
+        if (b[i])
+            return 0;
+    return 1;
+}
+
+/* Version 2: (re)reads the list of increments and the stop reason. The list comes from the
+ * commit record (/increments/commit) when the file has one, else from /increments/index;
+ * in SWMR-read mode the element datasets are refreshed after it, so that they are at least
+ * as long as the rows it lists (the writer writes them in the other order). Every row is
+ * checked against the one before and the extents. In a file whose writer did not close it,
+ * an old-layout list ends before a row not backed by data (a kill mid-append, or a follower
+ * that sees the grown extent before the row) when only such rows follow; in a closed file
+ * such a row is an error. */
+static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
+    CDEM_TRY(read_text_dataset(r, "stop_reason", &r->stop_reason, err));
+    CDEM_TRY(read_text_dataset(r, "stop_detail", &r->stop_detail, err));
+    r->n_skipped = 0;
+    const htri_t has_commit = H5Lexists(r->file, "increments/commit", H5P_DEFAULT);
+    if (has_commit < 0)
+        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: the group /increments is missing or corrupt",
+                      r->path);
+    index_row *ix = NULL;
+    hsize_t rows = 0;
+    CDEM_TRY(has_commit ? read_commit_record(r, &ix, &rows, err)
+                        : read_old_index(r, &ix, &rows, err));
     hsize_t data_ext = 0, stress_ext = 0;
     int first_data = 1, first_stress = 1;
-    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++) {
+    cdem_status st = CDEM_OK;
+    for (size_t k = 0; k < N_ELEMENT_FIELDS && st == CDEM_OK; k++) {
         const element_field *fd = &h5i_element_fields[k];
         char name[64];
         snprintf(name, sizeof name, "increments/%s", fd->name);
         if (r->data[k] < 0) {
-            if ((r->data[k] = H5Dopen2(r->file, name, H5P_DEFAULT)) < 0)
-                return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt",
-                              r->path, name);
+            if ((r->data[k] = H5Dopen2(r->file, name, H5P_DEFAULT)) < 0) {
+                st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /%s is missing or corrupt", r->path,
+                            name);
+                break;
+            }
             hid_t t = H5Dget_type(r->data[k]), sp = H5Dget_space(r->data[k]);
             H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
             int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
@@ -140,14 +258,17 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
             if (sp >= 0)
                 H5Sclose(sp);
             H5T_class_t want = fd->type == CDEM_FIELD_F64 ? H5T_FLOAT : H5T_INTEGER;
-            if (cls != want || rank != 1)
-                return CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                                 "%s: dataset /%s has type class %d and rank %d (expected a 1-D "
-                                 "%s dataset)",
-                                 r->path, name, (int)cls, rank,
-                                 want == H5T_FLOAT ? "float" : "integer");
+            if (cls != want || rank != 1) {
+                st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                               "%s: dataset /%s has type class %d and rank %d (expected a 1-D "
+                               "%s dataset)",
+                               r->path, name, (int)cls, rank,
+                               want == H5T_FLOAT ? "float" : "integer");
+                break;
+            }
         } else if (r->swmr && H5Drefresh(r->data[k]) < 0) {
-            return H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /%s", r->path, name);
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /%s", r->path, name);
+            break;
         }
         hsize_t e = h5i_extent_of(r->data[k]);
         if (fd->optional) {
@@ -158,18 +279,6 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
             first_data = 0;
         }
     }
-    index_row *ix = rows ? malloc(rows * sizeof *ix) : NULL;
-    hid_t mt = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
-    cdem_status st = CDEM_OK;
-    if ((rows && !ix) || mt < 0)
-        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", r->path);
-    else if (rows && read_rows_retrying(r, r->index, mt, rows, ix) < 0)
-        st = H5FAIL(err, CDEM_ERR_FORMAT,
-                    "%s: /increments/index (the list of increments) is damaged or unreadable: "
-                    "no increment of this file can be trusted",
-                    r->path);
-    if (mt >= 0)
-        H5Tclose(mt);
     if (st == CDEM_OK && rows > r->cap_incr) {
         incr_entry *e = realloc(r->incr, rows * sizeof *e);
         if (!e)
@@ -181,21 +290,25 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
         }
     }
     r->n_incr = 0;
-    r->n_skipped = 0;
     for (hsize_t i = 0; st == CDEM_OK && i < rows; i++) {
         const char *why = h5i_bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext);
         if (why) {
-            /* A writer that died (or is writing) can leave its last row unwritten, never an
-             * earlier one: a bad row before a good one is damage. */
-            if (r->unclosed && i == rows - 1) {
-                r->n_skipped = 1;
+            /* An old-layout list: a writer that died (or is writing) can leave its last rows
+             * unwritten (fill, all zero), never an earlier one: a bad row before a good one
+             * is damage. A committed row of the commit record is never unwritten. */
+            int only_unwritten_after = 1;
+            for (hsize_t j = i + 1; j < rows && only_unwritten_after; j++)
+                only_unwritten_after = all_zero(&ix[j], sizeof ix[j]);
+            if (!has_commit && r->unclosed && only_unwritten_after) {
+                r->n_skipped = (size_t)(rows - i);
                 break;
             }
             st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                           "%s: /increments/index row %llu (increment %d): %s (step %lld, time "
-                           "%.17g s, net displacement %.17g m): damaged file",
-                           r->path, (unsigned long long)i, (int)ix[i].number, why,
-                           (long long)ix[i].step, ix[i].time, ix[i].net_displacement);
+                           "%s: %s row %llu (increment %d): %s (step %lld, time %.17g s, net "
+                           "displacement %.17g m): damaged file",
+                           r->path, has_commit ? "/increments/commit" : "/increments/index",
+                           (unsigned long long)i, (int)ix[i].number, why, (long long)ix[i].step,
+                           ix[i].time, ix[i].net_displacement);
             break;
         }
         incr_entry *e = &r->incr[r->n_incr++];

@@ -1,21 +1,187 @@
 /* h5_resume: re-opens a run file to go on writing it (cdem-run --resume). Under the path's
- * lock the file's status flags are cleared (what h5clear -s does), increments after the
- * checkpoint's and series samples after its step are dropped (the datasets shrunk to what is
- * kept: the resumed run writes them again, bit for bit), checkpoints of dropped increments
- * are invalidated, the stop reason is set back to "running", and SWMR writing starts again.
- * A truncated or damaged file is refused unchanged. */
+ * lock, in this order:
+ *  - every increment to keep (up to the checkpoint's) and the series are read back through
+ *    the reader, data and checksums: a resume never continues a file that holds an increment
+ *    nobody can read (issue 35, item 4); such a file is refused, naming the increment, before
+ *    anything is written, so it stays byte for byte as it was;
+ *  - a file a size limit cut short (its superblock records more bytes than it has, and its
+ *    writer did not close it) is extended with zeros to the recorded size: the bytes past
+ *    the cut were never written, so nothing committed was there (item 3); if the file then
+ *    still does not open, it is cut back to its size and refused;
+ *  - the file is opened for writing with its status flags cleared (what h5clear -s does) and
+ *    its end of file put after everything it holds;
+ *  - the increments after the checkpoint's are dropped: first their rows of the commit record
+ *    (blanked from the last to the first, h5_commit.c), then the datasets are shrunk to what
+ *    is kept (the resumed run writes them again, bit for bit), and /increments/index is
+ *    rewritten from the record when a kill tore it; checkpoints of dropped increments are
+ *    invalidated, the stop reason is set back to "running", and SWMR writing starts again. */
 #include "h5_internal.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+/* Before anything is written: every increment a resume would keep (numbers up to keep_inc)
+ * and the series read back, through the reader, as a killed run's file.
+ * The file is only read, so a refusal leaves it byte for byte as it was (a writer's open
+ * would already mark it closed). */
+static cdem_status verify_kept(const char *path, int32_t keep_inc, cdem_error *err) {
+    cdem_h5_reader *r = NULL;
+    cdem_status st = cdem_h5_reader_open(path, &r, err);
+    if (st != CDEM_OK) {
+        cdem_error_prefix(err, "%s: cannot be resumed, it was not changed", path);
+        return st;
+    }
+    const size_t n = cdem_h5_reader_increment_count(r);
+    cdem_state s;
+    memset(&s, 0, sizeof s);
+    int32_t first = -1, last_good = -1;
+    for (size_t i = 0; i < n && st == CDEM_OK; i++) {
+        cdem_increment_info in;
+        if (cdem_h5_reader_increment_info(r, i, &in, err) != CDEM_OK || in.number > keep_inc)
+            break;
+        cdem_error e;
+        cdem_error_clear(&e);
+        if (cdem_h5_reader_load_increment(r, i, &s, NULL, &e) != CDEM_OK)
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: cannot be resumed: increment %d does not read back and a resumed "
+                           "run would keep it; it was not changed; increments %d..%d read back "
+                           "(%.500s)",
+                           path, (int)in.number, (int)first, (int)last_good, e.msg);
+        first = first < 0 ? in.number : first;
+        last_good = in.number;
+    }
+    cdem_state_free(&s);
+    cdem_series_sample *q = NULL;
+    size_t nq = 0;
+    cdem_error e;
+    cdem_error_clear(&e);
+    if (st == CDEM_OK && cdem_h5_reader_read_series(r, &q, &nq, &e) != CDEM_OK)
+        st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                       "%s: cannot be resumed: its series does not read back; it was not "
+                       "changed (%.500s)",
+                       path, e.msg);
+    free(q);
+    cdem_h5_reader_close(r);
+    return st;
+}
+
+/* The increments of the file as its commit record (or, in a file written before it, its
+ * index) lists them, into *out (malloc'd, *rows of them; NULL when none). */
+static cdem_status read_rows_to_keep(cdem_h5_writer *w, int unclosed, index_row **out,
+                                     hsize_t *rows, cdem_error *err) {
+    *out = NULL;
+    *rows = 0;
+    if (w->commit >= 0) {
+        const hsize_t cap = w->commit_capacity;
+        commit_row *c = calloc(cap ? cap : 1, sizeof *c);
+        index_row *ix = malloc((cap ? cap : 1) * sizeof *ix);
+        cdem_status st = CDEM_OK;
+        if (!c || !ix)
+            st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the commit record of %s",
+                           w->path);
+        else if (h5i_read_all_rows(w->commit, w->commit_mtype, cap, c) < 0)
+            st = H5FAIL(err, CDEM_ERR_FORMAT,
+                        "%s: cannot be resumed: its commit record /increments/commit is "
+                        "unreadable; it was not changed",
+                        w->path);
+        hsize_t committed = 0, torn = 0, bad = 0;
+        const char *why =
+            st == CDEM_OK ? h5i_commit_scan(c, cap, unclosed, &committed, &torn, &bad) : NULL;
+        if (why)
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: cannot be resumed: /increments/commit row %llu: %s; it was not "
+                           "changed",
+                           w->path, (unsigned long long)bad, why);
+        for (hsize_t i = 0; st == CDEM_OK && i < committed; i++)
+            ix[i] = c[i].row;
+        free(c);
+        if (st != CDEM_OK) {
+            free(ix);
+            return st;
+        }
+        *out = ix;
+        *rows = committed;
+        return CDEM_OK;
+    }
+    hsize_t n = h5i_extent_of(w->index);
+    index_row *ix = n ? malloc(n * sizeof *ix) : NULL;
+    if (n && !ix)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", w->path);
+    if (n && h5i_read_all_rows(w->index, w->index_mtype, n, ix) < 0) {
+        hsize_t got = unclosed ? h5i_index_recover_torn_chunk(w->index, n, ix) : 0;
+        if (got == 0) {
+            free(ix);
+            return H5FAIL(err, CDEM_ERR_FORMAT,
+                          "%s: cannot be resumed: /increments/index is unreadable; it was not "
+                          "changed",
+                          w->path);
+        }
+        n = got;
+    }
+    *out = ix;
+    *rows = n;
+    return CDEM_OK;
+}
+
+/* /increments/index must hold exactly rows[0, keep) and be appendable: a chunk a kill tore
+ * (or a row the commit record does not have) makes HDF5 refuse the next append, so the
+ * dataset is then made anew from the kept rows (before SWMR writing: objects can still be
+ * created). */
+static cdem_status repair_index(cdem_h5_writer *w, const index_row *rows, hsize_t keep,
+                                cdem_error *err) {
+    const hsize_t ext = h5i_extent_of(w->index);
+    index_row *have = ext ? malloc(ext * sizeof *have) : NULL;
+    int sound = !ext || (have && h5i_read_all_rows(w->index, w->index_mtype, ext, have) == 0);
+    H5Eclear2(H5E_DEFAULT);
+    for (hsize_t i = 0; sound && i < keep; i++)
+        sound = i < ext && memcmp(&have[i], &rows[i], sizeof rows[i]) == 0;
+    free(have);
+    if (sound)
+        return CDEM_OK;
+    H5Dclose(w->index);
+    w->index = -1;
+    hid_t ft = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 1);
+    int ok = ft >= 0 && H5Ldelete(w->file, "increments/index", H5P_DEFAULT) >= 0;
+    hid_t g = ok ? H5Gopen2(w->file, "increments", H5P_DEFAULT) : -1;
+    if (g >= 0)
+        w->index = h5i_create_extendible(g, "index", ft, INDEX_CHUNK, FILTER_CHECKSUM);
+    ok = w->index >= 0 && h5i_write_rows(w->index, w->index_mtype, 0, keep, rows) == 0;
+    hid_t es = h5i_keep_errors(!ok);
+    if (g >= 0)
+        H5Gclose(g);
+    if (ft >= 0)
+        H5Tclose(ft);
+    h5i_restore_errors(es);
+    if (!ok)
+        return H5FAIL(err, CDEM_ERR_IO,
+                      "%s: cannot rewrite /increments/index from the commit record", w->path);
+    return CDEM_OK;
+}
 
 static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t keep_step,
-                                cdem_error *err) {
+                                off_t *extended_from, cdem_error *err) {
     w->placed = 1;
     int flags = 0;
     CDEM_TRY(h5i_precheck_superblock(w->path, &flags, err));
+    /* A writer stopped by a file size limit (or a full disk) leaves the superblock's end of
+     * the file past the bytes it could write: those were never written, so zeros stand in
+     * for them. Only in a file its writer did not close; cut back if the resume fails. */
+    struct stat sb;
+    const uint64_t eoa = h5i_superblock_eoa(w->path);
+    if (flags != 0 && stat(w->path, &sb) == 0 && eoa > (uint64_t)sb.st_size) {
+        if (truncate(w->path, (off_t)eoa) != 0)
+            return CDEM_FAIL(err, CDEM_ERR_IO,
+                             "%s: cannot be resumed: the file has %llu bytes, its HDF5 superblock "
+                             "says %llu (cut short by a size limit or a full disk), and it cannot "
+                             "be extended to that size: %s; it was not changed",
+                             w->path, (unsigned long long)sb.st_size, (unsigned long long)eoa,
+                             strerror(errno));
+        *extended_from = sb.st_size;
+    }
     hid_t fapl = h5i_writer_fapl();
     hbool_t clear = 1;
     H5Pset(fapl, "clear_status_flags", &clear); /* what h5clear -s does */
@@ -27,22 +193,29 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         /* The writer holds the file's lock, so no other writer is running: the file itself is
          * the problem. A killed run's file can be cut short (full disk, interrupted copy),
          * and HDF5 opens such a file for writing no more. */
-        struct stat sb;
-        uint64_t eoa = h5i_superblock_eoa(w->path);
         if (stat(w->path, &sb) == 0 && eoa > (uint64_t)sb.st_size) {
             H5Eclear2(H5E_DEFAULT);
             return CDEM_FAIL(err, CDEM_ERR_FORMAT,
                              "%s: cannot be resumed: the file is truncated (it has %llu bytes, "
-                             "its HDF5 superblock says %llu; cut short by a full disk or an "
-                             "interrupted copy?); it was not changed, and the increments that "
-                             "survived the cut can still be read (cdem-strain info)",
+                             "its HDF5 superblock says %llu; cut short by an interrupted copy?); "
+                             "it was not changed, and the increments that survived the cut can "
+                             "still be read (cdem-strain info)",
                              w->path, (unsigned long long)sb.st_size, (unsigned long long)eoa);
         }
         return H5FAIL(err, CDEM_ERR_FORMAT,
                       "%s: cannot be resumed: HDF5 cannot open it for writing (damaged file?); "
-                      "it was not changed",
-                      w->path);
+                      "it was not changed%s",
+                      w->path,
+                      *extended_from >= 0 ? " (it had been cut short by a size limit; zeros in "
+                                            "place of the missing bytes did not make it whole)"
+                                          : "");
     }
+    /* A writer killed inside a flush can have written metadata past the end of the file
+     * its superblock records (the superblock is written last): new space must begin after
+     * everything in the file, or the resumed writer would allocate over it. */
+    if (H5Fincrement_filesize(w->file, 0) < 0)
+        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot be resumed: its end of file cannot be set",
+                      w->path);
     char *fmt = NULL;
     int32_t version = 0;
     int rc = h5i_get_str_attr(w->file, "format", &fmt);
@@ -84,6 +257,13 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         (w->ckpt_data[0] = H5Dopen2(w->file, "checkpoint/slot0", H5P_DEFAULT)) < 0 ||
         (w->ckpt_data[1] = H5Dopen2(w->file, "checkpoint/slot1", H5P_DEFAULT)) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: a version-2 dataset is missing", w->path);
+    /* files written before the commit record have the index alone (and keep it so) */
+    if (H5Lexists(w->file, "increments/commit", H5P_DEFAULT) > 0) {
+        if ((w->commit = H5Dopen2(w->file, "increments/commit", H5P_DEFAULT)) < 0)
+            return H5FAIL(err, CDEM_ERR_FORMAT, "%s: dataset /increments/commit is corrupt",
+                          w->path);
+        w->commit_capacity = h5i_extent_of(w->commit);
+    }
     w->has_xy = H5Lexists(w->file, "/increments/xy", H5P_DEFAULT) > 0; /* older files lack it */
     /* appending continues at the file's own chunk boundaries (8192 rows before 4096), so no
      * compressed chunk is rewritten */
@@ -92,8 +272,8 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/%s is not chunked", w->path,
                       h5i_element_fields[0].name);
 
-    /* Increments to keep: the valid prefix of the index up to keep_inc. */
-    hsize_t rows = h5i_extent_of(w->index), data_ext = h5i_extent_of(w->data[0]),
+    /* Increments to keep: the valid prefix of the record up to keep_inc. */
+    hsize_t data_ext = h5i_extent_of(w->data[0]),
             stress_ext = h5i_extent_of(w->data[h5i_first_stress_field()]);
     for (size_t k = 1; k < N_ELEMENT_FIELDS; k++) {
         hsize_t e = h5i_extent_of(w->data[k]);
@@ -102,18 +282,50 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
         else
             data_ext = e < data_ext ? e : data_ext;
     }
-    index_row *ix = rows ? malloc(rows * sizeof *ix) : NULL;
-    if (rows && !ix)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the index of %s", w->path);
-    if (rows && h5i_read_all_rows(w->index, w->index_mtype, rows, ix) < 0) {
-        free(ix);
-        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /increments/index", w->path);
-    }
+    index_row *ix = NULL;
+    hsize_t rows = 0;
+    CDEM_TRY(read_rows_to_keep(w, flags != 0, &ix, &rows, err));
     hsize_t keep = 0;
     while (keep < rows && ix[keep].number <= keep_inc &&
            !h5i_bad_index_row(&ix[keep], keep ? &ix[keep - 1] : NULL, data_ext, stress_ext))
         keep++;
+    /* Series samples to keep: the leading ones with step <= keep_step. */
+    hsize_t slen = h5i_extent_of(w->series[0]);
+    for (size_t c = 1; c < N_SERIES; c++) {
+        if (w->series[c] < 0)
+            continue;
+        hsize_t e = h5i_extent_of(w->series[c]);
+        slen = e < slen ? e : slen;
+    }
+    int64_t *steps = slen ? malloc(slen * sizeof *steps) : NULL;
     cdem_status st = CDEM_OK;
+    if (slen && !steps)
+        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the series of %s", w->path);
+    else if (slen && h5i_read_rows(w->series[0], H5T_NATIVE_INT64, 0, slen, steps) < 0)
+        st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /series/step", w->path);
+    hsize_t skeep = 0;
+    while (st == CDEM_OK && skeep < slen && steps[skeep] <= keep_step)
+        skeep++;
+    free(steps);
+    /* From here on the file is changed. */
+    if (st == CDEM_OK && w->commit >= 0) {
+        commit_row *c = calloc(w->commit_capacity ? w->commit_capacity : 1, sizeof *c);
+        if (!c)
+            st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+        else if (h5i_read_all_rows(w->commit, w->commit_mtype, w->commit_capacity, c) < 0 ||
+                 h5i_commit_blank_from(w->commit, w->commit_mtype, keep, c, w->commit_capacity) < 0)
+            st = H5FAIL(err, CDEM_ERR_IO,
+                        "%s: cannot drop the increments after %d from the "
+                        "commit record",
+                        w->path, (int)keep_inc);
+        free(c);
+        if (st == CDEM_OK)
+            st = h5i_commit_flush(w, err); /* dropped before anything they point to shrinks */
+        if (st == CDEM_OK)
+            st = repair_index(w, ix, keep, err);
+    } else if (st == CDEM_OK) {
+        st = repair_index(w, ix, keep, err); /* an old file whose torn chunk was recovered */
+    }
     w->data_len = w->stress_len = 0;
     for (hsize_t i = 0; i < keep && st == CDEM_OK; i++) {
         w->data_len = (hsize_t)(ix[i].offset + ix[i].n);
@@ -130,25 +342,6 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     w->last_step = keep ? ix[keep - 1].step : 0;
     free(ix);
     CDEM_TRY(st);
-    /* Series samples to keep: the leading ones with step <= keep_step. */
-    hsize_t slen = h5i_extent_of(w->series[0]);
-    for (size_t c = 1; c < N_SERIES; c++) {
-        if (w->series[c] < 0)
-            continue;
-        hsize_t e = h5i_extent_of(w->series[c]);
-        slen = e < slen ? e : slen;
-    }
-    int64_t *steps = slen ? malloc(slen * sizeof *steps) : NULL;
-    if (slen && !steps)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the series of %s", w->path);
-    if (slen && h5i_read_rows(w->series[0], H5T_NATIVE_INT64, 0, slen, steps) < 0) {
-        free(steps);
-        return H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /series/step", w->path);
-    }
-    hsize_t skeep = 0;
-    while (skeep < slen && steps[skeep] <= keep_step)
-        skeep++;
-    free(steps);
     w->series_len = skeep;
     /* Shrink everything to what is kept. */
     int ok = 1;
@@ -199,10 +392,29 @@ cdem_status cdem_h5_writer_reopen(const char *path, int32_t keep_through_increme
     cdem_h5_writer *w = NULL;
     CDEM_TRY(h5i_writer_alloc(path, &w, err));
     cdem_status st = cdem_runlock_acquire(path, "cdem-run --resume", &w->lock, err);
+    off_t extended_from = -1; /* the size before zeros were added (item 3), -1: none */
     if (st == CDEM_OK)
-        st = reopen_setup(w, keep_through_increment, keep_through_step, err);
+        st = verify_kept(path, keep_through_increment, err);
+    if (st == CDEM_OK)
+        st = reopen_setup(w, keep_through_increment, keep_through_step, &extended_from, err);
     if (st != CDEM_OK) {
+        /* the file closed before its zeros are cut off again, still under the lock */
+        cdem_runlock *lock = w->lock;
+        w->lock = NULL;
         h5i_writer_release(w);
+        if (extended_from >= 0 && truncate(path, extended_from) != 0)
+            errno = 0; /* the zeros stay: the file reads as before (readers skip the end) */
+        struct stat sb;
+        const uint64_t eoa = h5i_superblock_eoa(path);
+        if (err && stat(path, &sb) == 0 && eoa > (uint64_t)sb.st_size &&
+            !strstr(err->msg, "is truncated")) {
+            const size_t len = strlen(err->msg);
+            snprintf(err->msg + len, sizeof err->msg - len,
+                     " (the file is truncated: it has %lld bytes, its HDF5 superblock says %llu; "
+                     "cut short by a size limit, a full disk or an interrupted copy)",
+                     (long long)sb.st_size, (unsigned long long)eoa);
+        }
+        cdem_runlock_release(lock);
         return st;
     }
     *out = w;

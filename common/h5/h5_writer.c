@@ -119,13 +119,14 @@ static cdem_status flush_series(cdem_h5_writer *w, cdem_error *err) {
 }
 
 void h5i_writer_release(cdem_h5_writer *w) {
-    hid_t ds[N_SERIES + N_ELEMENT_FIELDS + 6];
+    hid_t ds[N_SERIES + N_ELEMENT_FIELDS + 7];
     size_t n = 0;
     for (size_t c = 0; c < N_SERIES; c++)
         ds[n++] = w->series[c];
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
         ds[n++] = w->data[k];
     ds[n++] = w->index;
+    ds[n++] = w->commit;
     ds[n++] = w->stop_reason;
     ds[n++] = w->stop_detail;
     ds[n++] = w->ckpt_data[0];
@@ -138,6 +139,8 @@ void h5i_writer_release(cdem_h5_writer *w) {
         H5Tclose(w->index_mtype);
     if (w->ckpt_mtype >= 0)
         H5Tclose(w->ckpt_mtype);
+    if (w->commit_mtype >= 0)
+        H5Tclose(w->commit_mtype);
     if (w->file >= 0)
         H5Fclose(w->file);
     cdem_runlock_release(w->lock); /* last: nothing of ours is touched after this */
@@ -150,6 +153,7 @@ void h5i_writer_release(cdem_h5_writer *w) {
     free(w->ckpt_zbuf);
     free(w->row_order);
     free(w->row_buf);
+    free(w->kept_aside);
     free(w);
 }
 
@@ -258,6 +262,12 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
                          "%s: an earlier write failed; increment %d is not written (the file "
                          "keeps the %llu increments before)",
                          w->path, (int)info->number, (unsigned long long)w->index_len);
+    if (w->commit >= 0 && w->index_len >= w->commit_capacity)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "%s: increment %d is not written: the file was made for at most %llu "
+                         "increments (the rows of its commit record, /increments/commit; "
+                         "cdem_run_meta.max_increments)",
+                         w->path, (int)info->number, (unsigned long long)w->commit_capacity);
     CDEM_TRY(h5i_grow_entries(w, err));
     CDEM_TRY(flush_series(w, err));
     /* The data first, then (after a flush) the index row: the index is the commit record. */
@@ -295,10 +305,13 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
         .has_stress = stress,
         .stress_offset = stress ? (int64_t)w->stress_len : -1,
     };
-    if (h5i_write_rows(w->index, w->index_mtype, w->index_len, 1, &row) < 0) {
+    /* The commit record's row first (contiguous: it reaches the file as it is written),
+     * then the same row appended to /increments/index for HDF5 tools, one flush for both. */
+    if ((w->commit >= 0 && h5i_commit_write(w->commit, w->commit_mtype, w->index_len, &row) < 0) ||
+        h5i_write_rows(w->index, w->index_mtype, w->index_len, 1, &row) < 0) {
         w->failed = 1;
         return H5FAIL(err, CDEM_ERR_IO,
-                      "%s: cannot write the index row of increment %d (disk full?); the file "
+                      "%s: cannot write the commit record of increment %d (disk full?); the file "
                       "keeps the %llu increments before",
                       w->path, (int)info->number, (unsigned long long)w->index_len);
     }
@@ -337,6 +350,10 @@ cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sa
     }
     w->buf[w->nbuf++] = *sample;
     return CDEM_OK;
+}
+
+const char *cdem_h5_writer_kept_aside(const cdem_h5_writer *w) {
+    return w ? w->kept_aside : NULL;
 }
 
 cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason,
@@ -394,7 +411,7 @@ cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report 
             w->series[c] = -1;
         for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
             w->data[k] = -1;
-        w->index = w->stop_reason = w->stop_detail = w->ckpt_index = -1;
+        w->index = w->commit = w->stop_reason = w->stop_detail = w->ckpt_index = -1;
         w->ckpt_data[0] = w->ckpt_data[1] = -1;
         if (st == CDEM_OK)
             st = CDEM_FAIL(err, CDEM_ERR_IO,
@@ -418,7 +435,18 @@ cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report 
         /* a completed run's checkpoints are dropped below, when there are any */
         const int has_checkpoints = (w->ckpt_data[0] >= 0 && h5i_extent_of(w->ckpt_data[0]) > 0) ||
                                     (w->ckpt_data[1] >= 0 && h5i_extent_of(w->ckpt_data[1]) > 0);
-        hid_t *rest[] = {&w->index,        &w->stop_reason,  &w->stop_detail,
+        /* and a paged file (h5_create.c) is rewritten without the pages' slack */
+        int paged = 0;
+        hid_t fcpl = H5Fget_create_plist(file);
+        H5F_fspace_strategy_t strategy;
+        hbool_t persist;
+        hsize_t threshold;
+        if (fcpl >= 0 && H5Pget_file_space_strategy(fcpl, &strategy, &persist, &threshold) >= 0)
+            paged = strategy == H5F_FSPACE_STRATEGY_PAGE;
+        if (fcpl >= 0)
+            H5Pclose(fcpl);
+        H5Eclear2(H5E_DEFAULT);
+        hid_t *rest[] = {&w->index,        &w->commit,       &w->stop_reason, &w->stop_detail,
                          &w->ckpt_data[0], &w->ckpt_data[1], &w->ckpt_index};
         for (size_t i = 0; i < sizeof rest / sizeof rest[0]; i++) {
             if (*rest[i] >= 0)
@@ -429,8 +457,11 @@ cdem_status cdem_h5_writer_close_report(cdem_h5_writer *w, cdem_h5_close_report 
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot close the file (disk full?)", w->path);
         es = h5i_keep_errors(st != CDEM_OK);
         /* closed cleanly: compact under the lock, which h5i_writer_release gives up */
-        if (st == CDEM_OK && w->completed && has_checkpoints && w->placed)
-            h5i_compact_completed(w->path, w->sync, rep);
+        if (st == CDEM_OK && w->completed && (has_checkpoints || paged) && w->placed)
+            h5i_compact_completed(w->path, w->sync, has_checkpoints, rep);
+        /* the run it replaced (--force) is no longer needed once this one completed */
+        if (st == CDEM_OK && w->completed && w->placed)
+            rep->dropped_replaced = h5i_drop_replaced(w->path);
     }
     h5i_writer_release(w);
     h5i_restore_errors(es);

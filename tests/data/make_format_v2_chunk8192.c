@@ -22,7 +22,7 @@ int main(int argc, char **argv) {
     cdem_error err;
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, NULL, "chunk8192 fixture", "d5eb302", "cdem-run"};
+    cdem_run_meta meta = {&p, NULL, "chunk8192 fixture", "d5eb302", "cdem-run", 0};
     cdem_h5_writer *w = NULL;
     if (cdem_h5_writer_create(argv[1], &meta, &w, &err) != CDEM_OK)
         return fprintf(stderr, "%s\n", err.msg), 1;

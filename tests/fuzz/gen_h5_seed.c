@@ -19,7 +19,7 @@ int main(int argc, char **argv) {
     cdem_error_clear(&err);
     cdem_params p;
     cdem_params_defaults(&p);
-    cdem_run_meta meta = {&p, "[time]\nruntime = 300\n", "summary", "0.1.0", "gen_h5_seed"};
+    cdem_run_meta meta = {&p, "[time]\nruntime = 300\n", "summary", "0.1.0", "gen_h5_seed", 0};
     cdem_h5_writer *w = NULL;
     cdem_state s = {0};
     cdem_status st = cdem_h5_writer_create(argv[1], &meta, &w, &err);

@@ -15,7 +15,9 @@
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
-#  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c).
+#  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c), and the crash
+#     states of every write of a short run, every tenth of them resumed to the uninterrupted
+#     run's file (tests/test_crash.c; CDEM_CRASH_RESUME=all resumes every one, about 30 min).
 #  8b. ParaView (Debian's, headless under xvfb-run) opens the XDMF sidecars of the default
 #     run, of the stress run, of a compute --format h5 file and an --xdmf2 sidecar, reads
 #     every time step and array, compares them with the HDF5 files and renders a picture
@@ -157,6 +159,8 @@ fi
 #    left behind opens and every increment it lists loads (docs/reliability.md).
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
+check crash-states env CDEM_CRASH_RESUME=${CDEM_CRASH_RESUME:-10} CDEM_TEST_TMP="$TMP" \
+    "$BUILD/tests/test_crash"
 check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
 check examples-features $PY tests/validate/check_examples.py "$STRAIN" "$TMP/examples"
 
