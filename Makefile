@@ -14,8 +14,9 @@
 #                   FUZZ_SECONDS (default 600); FUZZ_HARNESSES picks a subset
 #   make install    programs, man pages and bash completion into $(DESTDIR)$(PREFIX)
 #                   (PREFIX default /usr/local); make uninstall removes them
-#   make man, make completion, make measured   regenerate man/, completion/cdem-c.bash
-#                   and docs/measured.md (tests fail when the committed ones are stale)
+#   make man, make completion, make measured, make errors   regenerate man/,
+#                   completion/cdem-c.bash, docs/measured.md and docs/errors.md (tests fail
+#                   when the committed ones are stale)
 
 BUILD   ?= build
 CC      ?= gcc
@@ -164,6 +165,13 @@ man: all
 measured: all
 	/usr/bin/python3 scripts/measure_docs.py $(BUILD) > docs/measured.md.tmp
 	mv docs/measured.md.tmp docs/measured.md
+
+# docs/errors.md: every message of the sources (test_man fails when the page is stale,
+# test_error_catalogue when a message of the sources is missing from it).
+.PHONY: errors
+errors:
+	/usr/bin/python3 scripts/error_catalogue.py > docs/errors.md.tmp
+	mv docs/errors.md.tmp docs/errors.md
 
 # Bash completion from the programs' --help (tests/test_man.c fails when it is stale).
 .PHONY: completion
