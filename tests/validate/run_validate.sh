@@ -78,6 +78,13 @@ check inversion-kinematics $CHECK "$TMP/inversion.h5" --equil ${EQ% *} --total $
 
 STRAIN="$BUILD/cdem-strain"
 PY=/usr/bin/python3
+# The graben of the default model (README.md): `cdem-strain faults` at its default threshold
+# (the field's outlier bound) picks its two faults, the synthetic one dipping right and the
+# antithetic one dipping left (issue 35: the old fixed threshold 1 found only the first).
+check default-faults sh -c "'$STRAIN' faults '$TMP/default.h5' -o '$TMP/default-faults.csv' &&
+    $PY -c \"import csv; z = list(csv.DictReader(open('$TMP/default-faults.csv')));
+print(len(z), 'zones:', ', '.join(r['dip'] + ' ' + r['dips'] for r in z));
+assert [r['dips'] for r in z] == ['right', 'left']\""
 
 check repose-run "$RUN" -q -o "$TMP/repose.h5" -s boundary.mode=repose \
     -s time.display_interval=20 -s time.runtime=3000
