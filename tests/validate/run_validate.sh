@@ -25,7 +25,7 @@
 #     (tests/validate/check_slurm.sh, also make check-slurm); skipped, saying why, where
 #     Slurm cannot be installed or started (not root, no Debian mirror, daemons fail).
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
-#     analyses and pictures; a few minutes on 2 cores), and the paper's measurable features
+#     analyses and pictures; docs/times.md has its time), and the paper's measurable features
 #     on those runs (tests/validate/check_examples.py: the 7A graben, no void, the 7C
 #     faults, more than one thrust and an undeformed foreland in 12A).
 # 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
