@@ -63,8 +63,8 @@ typedef struct {
 void cdem_faults_default_options(cdem_faults_options *o);
 
 /* Picks the fault zones of state s from values v (one per element, NaN where undefined).
- * Fails with CDEM_ERR_INVALID when the options are out of range (threshold < 0) or s has no free element
- * with a value, CDEM_ERR_NOMEM when memory runs out. On success res owns its zones. */
+ * Fails with CDEM_ERR_INVALID when the options are out of range (threshold < 0) or s has no free
+ * element with a value, CDEM_ERR_NOMEM when memory runs out. On success res owns its zones. */
 cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_faults_options *o,
                              cdem_faults_result *res, cdem_error *err);
 
