@@ -203,6 +203,10 @@ char *cdem_xdmf_path_for(const char *h5_path) {
     return p;
 }
 
+const char *cdem_xdmf_open_prefix(const char *xmf_path) {
+    return strchr(xmf_path, '/') ? "" : "./";
+}
+
 hid_t cdem_xdmf_create_xy_view(hid_t loc, const char *x_name, const char *y_name,
                                const char *xy_name, int unlimited) {
     hsize_t rows = 0;

@@ -74,6 +74,13 @@ cdem_status cdem_xdmf_reference(const char *h5_path, const char *xmf_path, char 
  * malloc'd; NULL when out of memory. */
 char *cdem_xdmf_path_for(const char *h5_path);
 
+/* What to put before a sidecar's path when showing it to a user who will open it in
+ * ParaView: "./" for a bare name ("run.xmf"), "" for a path with a folder part. ParaView
+ * 5.11's Xdmf3 reader resolves the heavy-data reference of a bare name as "run.xmfrun.h5"
+ * and aborts (pvpython's OpenDataFile("run.xmf")); "./run.xmf" and absolute paths work
+ * (tests/validate/check_paraview.py checks both forms). */
+const char *cdem_xdmf_open_prefix(const char *xmf_path);
+
 /* Creates the virtual dataset loc/xy_name of rows x 2 doubles whose columns are the 1-D
  * datasets x_name and y_name (absolute paths) of the same file (HDF5 VDS, no storage). unlimited:
  * the view follows the sources as they grow (the run file's extendible x and y); otherwise it has

@@ -6,7 +6,8 @@ usage: measure.py CDEM_STRAIN RUN.h5 [--wedge] [--threshold V] > NAME-measures.m
 Writes a short Markdown section with what `cdem-strain` measures in the last increment:
 element counts, boundary displacement, the steepest 1 km of surface, voids and open
 fissures (`cdem-strain voids`), the fault zones of total maximum shear strain >= V
-(`cdem-strain faults`, default V = 1) and, with --wedge, the wedge's height, length and
+(`cdem-strain faults --threshold V`, default V = 1: the tables compare runs at one strain,
+not at cdem-strain faults' own default, the outlier bound of each field) and, with --wedge, the wedge's height, length and
 taper (`cdem-strain wedge`). Every number a README quotes about a run comes from this file.
 """
 import csv

@@ -6,8 +6,10 @@ usage: montage.py OUT.png COLUMNS [--width PX] [--max-kb KB] [--title T1] IN1.pn
 COLUMNS is the number of pictures per row, or a comma list per row ("1,2": one picture in
 the first row, two in the next and every later row). Each input is scaled to its column
 width (total width PX, default 1000) and may carry a title line above it. The result is
-saved as a palette PNG of at most --max-kb KB (default 300: fewer colours first, then a
-smaller size). Needs Pillow (python3-pil)."""
+saved as an RGB PNG of at most --max-kb KB (default 600), scaled down when larger. (It was
+a palette PNG of 256 to 32 colours, which posterised the colour bars and the strain
+fields' gradients: calibration.png, fig14.png, fig7.png; issue 35.) Needs Pillow
+(python3-pil)."""
 import os
 import sys
 from PIL import Image, ImageDraw, ImageFont
@@ -16,7 +18,7 @@ def main(argv):
     if len(argv) < 4:
         sys.exit(__doc__)
     out, cols = argv[1], [int(c) for c in argv[2].split(",")]
-    width, title, items, max_kb = 1000, None, [], 300
+    width, title, items, max_kb = 1000, None, [], 600
     args = argv[3:]
     i = 0
     while i < len(args):
@@ -58,11 +60,11 @@ def main(argv):
         for c, t in enumerate(ts):
             sheet.paste(t, (c * colw, y))
         y += max(t.height for t in ts)
-    # Keep README pictures small (<= max_kb): fewer colours first, then a smaller size.
-    for colors, scale in ((256, 1.0), (128, 1.0), (64, 1.0), (64, 0.85), (64, 0.7), (32, 0.6)):
+    # Keep README pictures small (<= max_kb) by a smaller size only: every colour stays.
+    for scale in (1.0, 0.85, 0.7, 0.6):
         im = sheet if scale == 1.0 else sheet.resize(
             (round(sheet.width * scale), round(sheet.height * scale)), Image.LANCZOS)
-        im.quantize(colors=colors, method=Image.Quantize.MEDIANCUT).save(out, optimize=True)
+        im.save(out, optimize=True)
         if os.path.getsize(out) <= max_kb * 1024:
             break
 

@@ -1,10 +1,12 @@
 #!/usr/bin/python3
-"""Lists every error message cdem-run and cdem-strain can print, from the sources: each
-CDEM_FAIL(err, CODE, "format", ...) in common/, solver/ and analysis/, and the usage
-messages printed by the two main programs. Writes markdown to stdout (docs/errors.md is
-made with it: /usr/bin/python3 scripts/error_catalogue.py > docs/errors.md).
+"""Lists every message cdem-run and cdem-strain can print, from the sources: each call of
+MESSAGE_CALLS below (CDEM_FAIL, H5FAIL, the parameter rules, the context put before a
+message, both programs' usage errors, fprintf(stderr, ...)) in common/, solver/ and
+analysis/, read by a C tokenizer (comments and character literals skipped). Writes
+markdown to stdout (`make errors` writes docs/errors.md with it).
 
-printf conversions are shown as <...> (a file name, a value, a line number...)."""
+printf conversions are shown as <…> (a file name, a value, a line number...); a message
+put together in a buffer by snprintf is shown with that snprintf's format."""
 import glob
 import os
 import re
@@ -75,66 +77,186 @@ GROUPS = [  # (title, source files, what to do)
 ]
 
 
-def c_strings(args):
-    """Concatenates the C string literals at the start of an argument."""
-    return "".join(re.findall(r'"((?:[^"\\]|\\.)*)"', args))
+# The calls that make a message, with the 1-based position of their format (or message)
+# argument; tests/test_error_catalogue.c has the same table and fails when the sources hold
+# a message source that is in neither (a printf-like function, a macro passing its
+# arguments on to one of these, a function passing its parameter on as a message).
+MESSAGE_CALLS = {
+    "CDEM_FAIL": 3,          # common/cdem_error.h: the error record of every library call
+    "cdem_error_set": 5,     # what CDEM_FAIL calls
+    "H5FAIL": 3,             # common/h5/h5_internal.h: the run file's errors
+    "h5i_fail_at": 5,        # what H5FAIL calls
+    "cdem_error_prefix": 2,  # context put before a message on its way up
+    "rule_add": 2,           # common/params.c: rules between keys, reported together
+    "usage_error": 1,        # solver/main.c: cdem-run's usage errors
+    "cdem_cmd_usage": 2,     # analysis/cli/cmd_support.c: cdem-strain's usage errors
+    "usage": 1,              # analysis/cli/cmd_render.c: cdem_cmd_usage with render's help
+    "fprintf": 2,            # only fprintf(stderr, ...)
+}
+KIND = {"rule_add": "rule", "cdem_error_prefix": "context", "usage_error": "usage",
+        "cdem_cmd_usage": "usage", "usage": "usage", "fprintf": "stderr"}
+
+TOKEN = re.compile(r"""
+    (?P<nl>\n) | (?P<ws>[ \t\r\f\v]+) | (?P<lc>//[^\n]*) | (?P<bc>/\*.*?\*/)
+  | (?P<pp>(?<![^\n])[ \t]*\#) | (?P<str>"(?:[^"\\\n]|\\.)*") | (?P<chr>'(?:[^'\\\n]|\\.)*')
+  | (?P<id>[A-Za-z_]\w*) | (?P<num>\d[\w.]*) | (?P<punct>.)""", re.S | re.X)
 
 
-def calls(text, token="CDEM_FAIL("):
-    i = 0
-    while True:
-        i = text.find(token, i)
-        if i < 0:
-            return
-        j, depth, in_str = i + len(token), 1, False
-        while j < len(text) and depth:
-            ch = text[j]
-            if in_str:
-                if ch == "\\":
-                    j += 1
-                elif ch == '"':
-                    in_str = False
-            elif ch == '"':
-                in_str = True
-            elif ch == "(":
-                depth += 1
-            elif ch == ")":
-                depth -= 1
-            j += 1
-        yield i, text[i + len(token):j - 1]
-        i = j
-
-
-def split_args(s):
-    out, depth, in_str, cur = [], 0, False, ""
-    k = 0
-    while k < len(s):
-        ch = s[k]
-        if in_str:
-            cur += ch
-            if ch == "\\":
-                cur += s[k + 1]; k += 1
-            elif ch == '"':
-                in_str = False
-        elif ch == '"':
-            in_str = True; cur += ch
-        elif ch in "([{":
-            depth += 1; cur += ch
-        elif ch in ")]}":
-            depth -= 1; cur += ch
-        elif ch == "," and depth == 0:
-            out.append(cur.strip()); cur = ""
-        else:
-            cur += ch
-        k += 1
-    out.append(cur.strip())
+def tokens(text):
+    """The C tokens of text as (kind, text, line, brace depth before it): comments skipped,
+    character literals one token (a '"' is no string), directives tokenized like code."""
+    out, line, depth = [], 1, 0
+    for m in TOKEN.finditer(text):
+        kind, tok = m.lastgroup, m.group()
+        if kind in ("str", "chr", "id", "num", "punct"):
+            out.append((kind, tok[1:-1] if kind == "str" else tok, line, depth))
+            if kind == "punct":
+                depth += (tok == "{") - (tok == "}")
+        line += tok.count("\n")
     return out
 
 
+def split_args(toks, open_):
+    """[(start, end)] token ranges of the arguments of the call whose '(' is toks[open_]."""
+    args, depth, start = [], 0, open_ + 1
+    for i in range(open_ + 1, len(toks)):
+        kind, tok = toks[i][0], toks[i][1]
+        if kind == "punct" and tok in "([{":
+            depth += 1
+        elif kind == "punct" and tok in ")]}":
+            if depth == 0:
+                if i > open_ + 1:
+                    args.append((start, i))
+                return args
+            depth -= 1
+        elif kind == "punct" and tok == "," and depth == 0:
+            args.append((start, i))
+            start = i + 1
+    return args
+
+
+def literals(toks, a, b):
+    """The literal alternatives of the argument toks[a:b]: each run of adjacent string
+    literals (a ternary has two)."""
+    out, i = [], a
+    while i < b:
+        if toks[i][0] != "str":
+            i += 1
+            continue
+        j = i
+        while j < b and toks[j][0] == "str":
+            j += 1
+        out.append("".join(t[1] for t in toks[i:j]))
+        i = j
+    return out
+
+
+def snprintf_format(toks, call, buf):
+    """The literal alternatives of the snprintf(buf, ...) before toks[call] in the same
+    function, or []."""
+    i = call
+    while i > 0 and toks[i][3] > 0:
+        i -= 1
+        if (toks[i][1] == "snprintf" and toks[i + 1][1] == "(" and toks[i + 2][1] == buf
+                and toks[i + 2][0] == "id"):
+            args = split_args(toks, i + 1)
+            if len(args) >= 3:
+                return literals(toks, *args[2])
+    return []
+
+
+def enclosing(toks, i):
+    """(name, parameter names) of the function whose body holds toks[i]."""
+    k = i
+    while k > 0 and toks[k][3] > 0:
+        k -= 1
+    close = k
+    while close > 0 and toks[close][1] != ")":
+        close -= 1
+    depth, open_ = 0, close
+    while open_ > 0:
+        depth += (toks[open_][1] == ")") - (toks[open_][1] == "(")
+        if depth == 0:
+            break
+        open_ -= 1
+    params = {toks[j][1] for j in range(open_ + 1, close)
+              if toks[j][0] == "id" and toks[j + 1][1] in (",", ")")}
+    return toks[open_ - 1][1], params
+
+
+def messages(text):
+    """(line, kind, format) of every message call of a C source."""
+    toks = tokens(text)
+    for i, (kind, tok, line, depth) in enumerate(toks[:-1]):
+        if kind != "id" or tok not in MESSAGE_CALLS or toks[i + 1][1] != "(":
+            continue
+        if i > 0 and ((toks[i - 1][0] == "id" and toks[i - 1][1] != "return")
+                      or toks[i - 1][1] == "*"):
+            continue  # a declaration or definition, or a macro's own name
+        fn, params = enclosing(toks, i) if depth > 0 else ("", set())
+        if fn in MESSAGE_CALLS:
+            continue  # the message function's own implementation
+        args = split_args(toks, i + 1)
+        pos = MESSAGE_CALLS[tok]
+        if len(args) < pos:
+            continue
+        if tok == "fprintf" and [t[1] for t in toks[slice(*args[0])]] != ["stderr"]:
+            continue
+        what = KIND.get(tok)
+        if what is None:
+            code = re.sub(r"([=!<>]) =", r"\1=", " ".join(t[1] for t in toks[slice(*args[1])]))
+            what = code.replace("CDEM_ERR_", "").lower()
+        a, b = args[pos - 1]
+        fmts = literals(toks, a, b)
+        lone = toks[a][1] if b == a + 1 and toks[a][0] == "id" else None
+        if not fmts and lone:
+            if lone == "__VA_ARGS__" or lone in params:
+                continue  # passes its caller's message on: the caller's call is listed
+            fmts = snprintf_format(toks, i, lone)
+        if fmts == ["%s"] and len(args) > pos:
+            # "%s", buf: the message is what filled buf, when an snprintf did it here
+            c, d = args[pos]
+            if d == c + 1 and toks[c][0] == "id":
+                fmts = snprintf_format(toks, i, toks[c][1]) or fmts
+        if not fmts:
+            fmts = ["(message built at run time: " + "".join(t[1] for t in toks[a:b]) + ")"]
+        for fmt in fmts:
+            yield line, what, fmt
+
+
 def show(fmt):
-    fmt = fmt.replace('\\"', '"').replace("\\n", " ").replace("\\t", " ")
-    fmt = re.sub(r"%[-+ #0]*[0-9*]*(?:\.[0-9*]+)?(?:hh|h|ll|l|z|j|t)?[diouxXeEfgGcsp]", "<…>", fmt)
-    return fmt.replace("%%", "%").replace("|", "\\|")
+    """The page's form of a format: escapes undone, each conversion as <…>, '|' escaped
+    (tests/test_error_catalogue.c's page_form does the same)."""
+    out, k = [], 0
+    conv = re.compile(r"%[-+ #0]*[0-9*]*(?:\.[0-9*]*)?[hlzjt]*.?")
+    while k < len(fmt):
+        ch = fmt[k]
+        if ch == "\\" and k + 1 < len(fmt):
+            out.append(" " if fmt[k + 1] in "nt" else fmt[k + 1])
+            k += 2
+        elif fmt.startswith("%%", k):
+            out.append("%")
+            k += 2
+        elif ch == "%":
+            k = conv.match(fmt, k).end()
+            out.append("<…>")
+        elif ch == "|":
+            out.append("\\|")
+            k += 1
+        else:
+            out.append(ch)
+            k += 1
+    return "".join(out).rstrip(" ")
+
+
+USAGE_TITLE = "Command lines (usage errors, exit status 2)"
+USAGE_FIX = ("The program prints the message, its usage line and \"Try '... --help' for more "
+             "information.\"; `cdem-run --help`, `cdem-strain COMMAND --help` and the man pages "
+             "list every option.")
+STDERR_TITLE = "Printed directly on standard error"
+STDERR_FIX = ("cdem-run's refusals of its command line and output (exit status 1 or 2), and the "
+              "notes and summaries cdem-strain's commands print beside their results (exit "
+              "status 0): read the note; nothing failed unless the status says so.")
 
 
 def main():
@@ -143,42 +265,40 @@ def main():
                              "analysis/input", "analysis/measure", "analysis/draw",
                              "analysis/export"))
     files = [f for group in files for f in group]
-    rows = {}
+    rows, special = {}, {"usage": {}, "stderr": {}}
     for path in files:
         rel = os.path.relpath(path, ROOT)
         text = open(path, encoding="utf-8").read()
-        for pos, args in calls(text):
-            a = split_args(args)
-            if len(a) < 3:
-                continue
-            line = text.count("\n", 0, pos) + 1
-            code = a[1].replace("CDEM_ERR_", "").lower()
-            fmt = c_strings(a[2])
-            if not fmt:
-                fmt = "(message built at run time: " + a[2] + ")"
-            rows.setdefault(rel, []).append((line, code, show(fmt)))
-        # parameter rules collected by cdem_params_validate and reported together
-        for pos, args in calls(text, "rule_add(&log,"):
-            fmt = c_strings(split_args(args)[0])
-            if fmt:
-                line = text.count("\n", 0, pos) + 1
-                rows.setdefault(rel, []).append((line, "rule", show(fmt)))
+        for line, kind, fmt in messages(text):
+            table = special[kind] if kind in special else rows
+            table.setdefault(rel, []).append((line, kind, show(fmt)))
+    for table in (rows, *special.values()):
+        for found in table.values():
+            found.sort()
     print("# Error messages of cdem-run and cdem-strain")
     print()
-    print("Generated by `/usr/bin/python3 scripts/error_catalogue.py > docs/errors.md` from the")
-    print("`CDEM_FAIL` calls in common/, solver/ and analysis/ and the parameter rules of")
-    print("`cdem_params_validate` (kind \"rule\": reported together, one per line, after \"the")
-    print("parameters cannot be used as they are:\"); do not edit by hand (`test_man` fails when")
-    print("it is stale). `<…>` stands for a value filled in at run time (a file name, line, key,")
-    print("value). The programs print")
+    print("Generated by `make errors` (`/usr/bin/python3 scripts/error_catalogue.py >")
+    print("docs/errors.md`) from every message call in common/, solver/ and analysis/:")
+    print("`CDEM_FAIL` and `H5FAIL` (the run file's errors; HDF5's own reason may follow in")
+    print("\"(HDF5: …)\"), the context `cdem_error_prefix` puts before a message (kind")
+    print("\"context\"), the parameter rules of `cdem_params_validate` (kind \"rule\": reported")
+    print("together, one per line, after \"the parameters cannot be used as they are:\"), the")
+    print("usage errors of both programs and what they print directly on standard error. Do")
+    print("not edit by hand: `test_man` fails when the page is stale and `test_error_catalogue`")
+    print("when a message of the sources is missing from it. `<…>` stands for a value filled")
+    print("in at run time (a file name, line, key, value). The programs print")
     print("`cdem-run: <message>` or `cdem-strain: <message>` and exit with status 1 (2 for usage")
     print("errors). What to do for each group is in docs/guide.md, section Troubleshooting; the")
     print("group's advice is repeated here.")
     print()
     done = set()
     total = 0
-    for title, srcs, fix in GROUPS + [("Other", sorted(rows), "See the message; it names what is wrong.")]:
-        srcs = [s for s in srcs if s in rows and s not in done]
+    groups = [(t, s, f, rows) for t, s, f in GROUPS]
+    groups.append(("Other", sorted(rows), "See the message; it names what is wrong.", rows))
+    groups.append((USAGE_TITLE, sorted(special["usage"]), USAGE_FIX, special["usage"]))
+    groups.append((STDERR_TITLE, sorted(special["stderr"]), STDERR_FIX, special["stderr"]))
+    for title, srcs, fix, table in groups:
+        srcs = [s for s in srcs if s in table and (id(table), s) not in done]
         if not srcs:
             continue
         print(f"## {title}")
@@ -188,8 +308,8 @@ def main():
         print("| source | kind | message |")
         print("|---|---|---|")
         for s in srcs:
-            done.add(s)
-            for line, code, msg in rows[s]:
+            done.add((id(table), s))
+            for line, code, msg in table[s]:
                 print(f"| {s}:{line} | {code} | {msg} |")
                 total += 1
         print()

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* The dry-run command line make prints for TARGET (with EXTRA make arguments) in OUT. */
 static void dry_run(const char *target, const char *extra, char *out, size_t cap) {
@@ -129,11 +130,65 @@ static void test_build_strain_links_no_solver(void **state) {
         fail_msg("cdem-strain links the solver library: %s", line);
 }
 
+/* Runs CMD (stdout and stderr) into OUT; returns its exit status. */
+static int run_cmd(const char *cmd, char *out, size_t cap) {
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, cap - 1, p);
+    out[n] = '\0';
+    return pclose(p);
+}
+
+/* Every target builds in parallel by default, one job per core (issue 35: `make demo` built
+ * serially and took 1.5 minutes on a fresh clone); a command-line -jN wins. */
+static void test_build_parallel_by_default(void **unused) {
+    (void)unused;
+    static char out[4096];
+    char want[64];
+    const char *show = "printf 'show-makeflags:\\n\\t@echo $(MAKEFLAGS)\\n' | env -u MAKEFLAGS "
+                       "-u MAKELEVEL make -s -f Makefile -f - show-makeflags %s 2>&1";
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, show, "");
+    assert_int_equal(run_cmd(cmd, out, sizeof out), 0);
+    snprintf(want, sizeof want, " -j%ld", sysconf(_SC_NPROCESSORS_ONLN));
+    if (!strstr(out, want))
+        fail_msg("make's flags without -j are '%s': no %s", out, want);
+    snprintf(cmd, sizeof cmd, show, "-j3");
+    assert_int_equal(run_cmd(cmd, out, sizeof out), 0);
+    assert_non_null(strstr(out, " -j3"));
+}
+
+/* `make -C examples help` lists the targets, a line each, and every folder (issue 35: there
+ * was no help target). */
+static void test_build_examples_help(void **unused) {
+    (void)unused;
+    static char out[8192];
+    assert_int_equal(
+        run_cmd("env -u MAKEFLAGS -u MAKELEVEL make -s -C examples help 2>&1", out, sizeof out), 0);
+    const char *targets[] = {"  quick ", "  paper ",     "  clean ", "  tools ",
+                             "  help ",  "quick-FOLDER", "QUICK=1"};
+    for (size_t i = 0; i < sizeof targets / sizeof targets[0]; i++)
+        if (!strstr(out, targets[i]))
+            fail_msg("make -C examples help does not list '%s':\n%s", targets[i], out);
+    FILE *ls = popen("ls examples/*/Makefile", "r");
+    assert_non_null(ls);
+    char line[512];
+    while (fgets(line, sizeof line, ls)) {
+        char folder[512];
+        snprintf(folder, sizeof folder, "  %.*s ", (int)(strrchr(line, '/') - line - 9), line + 9);
+        if (!strstr(out, folder))
+            fail_msg("make -C examples help does not list the folder '%s':\n%s", folder, out);
+    }
+    pclose(ls);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_build_user_cflags_are_appended),
         cmocka_unit_test(test_build_layer_include_paths),
         cmocka_unit_test(test_build_strain_links_no_solver),
+        cmocka_unit_test(test_build_parallel_by_default),
+        cmocka_unit_test(test_build_examples_help),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -66,8 +66,55 @@ static void test_faults_two_bands(void **unused) {
         assert_true(fabs(z->dip_deg - dip[b]) < 4.0);
         assert_true(fabs(z->x_top - x0[b]) < 400.0);
         assert_true(z->rows >= 12);
-        assert_true(z->mean_value > 1.0 && z->max_value <= 2.0 + 1e-12);
+        /* the default threshold takes in the 1-2-1 smoothed edges of the bands too */
+        assert_true(z->mean_value > 0.5 && z->max_value <= 2.0 + 1e-12);
     }
+    cdem_faults_free(&r);
+    free(v);
+    cdem_state_free(&s);
+}
+
+/* The default model's graben (issue 35): a synthetic fault of total shear 2-8 and a weaker
+ * antithetic one of 0.4-0.64 over a background of a few hundredths. The old default
+ * threshold, a fixed 1, found only the synthetic one; the field's outlier bound finds both. */
+static void test_faults_default_finds_a_weak_antithetic_fault(void **unused) {
+    (void)unused;
+    cdem_state s;
+    make_packing(&s, 6000, W, H, 11);
+    const double x0[2] = {3000.0, 10000.0}, dip[2] = {62.0, 51.0};
+    const int right[2] = {1, 0};
+    double *v = malloc(s.n * sizeof *v);
+    assert_non_null(v);
+    unsigned rng = 12345u;
+    for (size_t i = 0; i < s.n; i++) {
+        rng = rng * 1103515245u + 12345u;
+        const double u = (double)(rng >> 8) / (double)(1u << 24);              /* 0..1 */
+        v[i] = (s.flags[i] & CDEM_FLAGS_BOUNDARY) ? NAN : 0.01 + 0.06 * u * u; /* 0.01-0.07 */
+        if (isnan(v[i]))
+            continue;
+        if (band_distance(s.x[i], s.y[i], x0[0], dip[0], right[0]) < 250.0)
+            v[i] = 2.0 + 6.0 * u;
+        else if (band_distance(s.x[i], s.y[i], x0[1], dip[1], right[1]) < 250.0)
+            v[i] = 0.4 + 0.24 * u;
+    }
+    cdem_faults_options o;
+    cdem_faults_default_options(&o);
+    cdem_faults_result r;
+    cdem_error err;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    printf("    default threshold %.3g: %zu zones\n", r.threshold, r.n);
+    assert_int_equal(r.n, 2);
+    assert_true(r.threshold > 0.03 && r.threshold < 0.4); /* above most of the background */
+    for (int b = 0; b < 2; b++) {
+        assert_int_equal(r.zone[b].dips_right, right[b]);
+        assert_true(fabs(r.zone[b].dip_deg - dip[b]) < 5.0);
+        assert_true(fabs(r.zone[b].x_top - x0[b]) < 500.0);
+    }
+    cdem_faults_free(&r);
+    /* the old default: the antithetic fault is lost */
+    o.threshold = 1.0;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 1);
     cdem_faults_free(&r);
     free(v);
     cdem_state_free(&s);
@@ -120,9 +167,15 @@ static void test_faults_errors(void **unused) {
     assert_non_null(strstr(err.msg, "no free element has a value"));
     for (size_t i = 0; i < s.n; i++)
         v[i] = 0.0;
-    o.threshold = 0.0;
+    o.threshold = -1.0;
     assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_ERR_INVALID);
-    assert_non_null(strstr(err.msg, "threshold 0 must be > 0"));
+    assert_non_null(strstr(err.msg, "threshold -1 must be > 0 (or 0: from the field)"));
+    /* the default on a uniform field: its outlier bound lies just above it, no zone */
+    o.threshold = 0.0;
+    assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_OK);
+    assert_int_equal(r.n, 0);
+    assert_true(r.threshold > 0.0 && r.threshold < 1e-8);
+    cdem_faults_free(&r);
     o.threshold = 1.0;
     o.min_rows = 1;
     assert_int_equal(cdem_faults_pick(&s, v, &o, &r, &err), CDEM_ERR_INVALID);
@@ -135,6 +188,7 @@ static void test_faults_errors(void **unused) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_faults_two_bands),
+        cmocka_unit_test(test_faults_default_finds_a_weak_antithetic_fault),
         cmocka_unit_test(test_faults_vertical_and_quiet),
         cmocka_unit_test(test_faults_errors),
     };

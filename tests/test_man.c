@@ -1,7 +1,7 @@
 /* Tests of the generated docs: the man pages man/cdem-run.1 and man/cdem-strain.1 and the
  * bash completion, generated from the programs' --help text (scripts/help2roff.py and
  * help2completion.py: `make man completion`), and docs/errors.md, generated from the
- * sources (scripts/error_catalogue.py); none may go stale.
+ * sources (scripts/error_catalogue.py: `make errors`); none may go stale.
  * Runs from the repository root (tests/run_tests.sh); programs in $CDEM_BUILD (default
  * build/); scratch files in $CDEM_TEST_TMP. */
 #include <setjmp.h>
@@ -247,9 +247,9 @@ static void test_man_completion_fresh_and_working(void **state) {
     }
 }
 
-/* docs/errors.md is generated from the sources' CDEM_FAIL messages (with their file:line)
- * by scripts/error_catalogue.py and must not go stale: a changed message, or code moved
- * above one, makes it differ. */
+/* docs/errors.md is generated from the sources' messages (with their file:line) by
+ * scripts/error_catalogue.py and must not go stale: a changed message, or code moved
+ * above one, makes it differ (test_error_catalogue checks that the script misses none). */
 static void test_man_error_catalogue_fresh(void **state) {
     man_ctx *c = *state;
     char cmd[2400], generated[2100], msg[2400];
@@ -261,8 +261,8 @@ static void test_man_error_catalogue_fresh(void **state) {
     assert_non_null(b);
     if (strcmp(a, b) != 0)
         snprintf(msg, sizeof msg,
-                 "docs/errors.md is stale against the sources: run `/usr/bin/python3 "
-                 "scripts/error_catalogue.py > docs/errors.md` and commit it");
+                 "docs/errors.md is stale against the sources: run `make errors` and "
+                 "commit it");
     else
         msg[0] = '\0';
     free(a);

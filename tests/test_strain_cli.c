@@ -167,6 +167,13 @@ static void test_strain_cli_xdmf(void **state) {
     assert_int_equal(run(cmd, out, sizeof out), 0);
     assert_non_null(strstr(out, "legacy.xdmf2\n"));
     assert_int_equal(atoi(strchr(out, '\n') + 1), NINC);
+    /* in the file's folder: the name as ParaView can open it, ./NAME (issue 35: pvpython's
+     * OpenDataFile("renamed.xmf") aborts looking for "renamed.xmfrenamed.h5") */
+    char exe[4096];
+    assert_non_null(realpath(g_exe, exe)); /* the test may run with a relative CDEM_BUILD */
+    snprintf(cmd, sizeof cmd, "cd %s && %s xdmf renamed.h5", g_scratch.dir, exe);
+    assert_int_equal(run(cmd, out, sizeof out), 0);
+    assert_string_equal(out, "./renamed.xmf\n");
     snprintf(cmd, sizeof cmd, "echo text > %s/not.h5 && %s xdmf %s/not.h5", g_scratch.dir, g_exe,
              g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);

@@ -20,7 +20,9 @@ static const char *const forms[] = {synopsis, NULL};
 static const cdem_cli_option options[] = {
     {"--increment", "K|last|equil|first", "the increment (default last)"},
     {"--quantity", "NAME", "the strain field (default total-max-shear; any quantity)"},
-    {"--threshold", "V", "value at or above which a cell is in a fault zone (default 1)"},
+    {"--threshold", "V",
+     "value at or above which a cell is in a fault zone (default: the field's outlier bound, "
+     "median + 3 x 1.4826 x MAD of the cells)"},
     {"--bin", "M", "cell size in m (default 2 x the largest free radius)"},
     {"--min-rows", "N", "cells of height a zone must span, >= 2 (default 4)"},
     {"-o, --output", "OUT.csv", "output file (default: standard output)"},
@@ -28,13 +30,14 @@ static const cdem_cli_option options[] = {
 static const cdem_cli_help help = {
     .program = "cdem-strain faults",
     .forms = forms,
-    .about = "Fault zones picked from a strain field: the free elements' values are binned on "
-             "a square grid, runs of cells at or above the threshold in each row are linked "
-             "from the top down into zones, and a line through each zone gives its dip and "
-             "dip direction (analysis/measure/faults.h, docs/analysis.md \"Fault zones\"). CSV, one row "
-             "per zone ordered by x at its top: zone, x_top, y_top, x_bottom, y_bottom (m), "
-             "dip (degrees), dips (left or right), rows, mean and max value. A summary line "
-             "goes to standard error.",
+    .about =
+        "Fault zones picked from a strain field: the free elements' values are binned on "
+        "a square grid, runs of cells at or above the threshold in each row are linked "
+        "from the top down into zones, and a line through each zone gives its dip and "
+        "dip direction (analysis/measure/faults.h, docs/analysis.md \"Fault zones\"). CSV, one row "
+        "per zone ordered by x at its top: zone, x_top, y_top, x_bottom, y_bottom (m), "
+        "dip (degrees), dips (left or right), rows, mean and max value. A summary line "
+        "goes to standard error.",
     .options = options,
     .notes = "A thrust verges away from its dip direction: with the right wall pushing, "
              "forward-verging thrusts dip right.",
@@ -120,9 +123,9 @@ static int run(int argc, char **argv) {
             left += !res.zone[k].dips_right;
         fprintf(stderr,
                 "cdem-strain faults: increment %d: %zu zones (%zu dip left, %zu dip right) of %s "
-                ">= %g on cells of %.4g m\n",
+                ">= %.4g%s on cells of %.4g m\n",
                 (int)cdem_analysis_info(a, index)->number, res.n, left, res.n - left, q->name,
-                res.threshold, res.bin);
+                res.threshold, o.threshold > 0.0 ? "" : " (median + 3 robust sd)", res.bin);
     }
     cdem_faults_free(&res);
     free(v);

@@ -36,7 +36,8 @@ static int cmd_xdmf(const cdem_cmd_options *o) {
                          ? cdem_qexport_write_xdmf(o->file, out, want, &written, &err)
                          : cdem_h5_write_xdmf(o->file, out, want, &written, &err);
     if (st == CDEM_OK) {
-        printf("%s\n", out);
+        /* ./run.xmf, not run.xmf: the name as ParaView can open it (cdem_xdmf_open_prefix) */
+        printf("%s%s\n", cdem_xdmf_open_prefix(out), out);
         if (written != want)
             fprintf(stderr,
                     "cdem-strain xdmf: note: %s has no xy view (written by an older version) "
@@ -61,7 +62,8 @@ static const cdem_cli_help help = {
     .about = "Writes the XDMF sidecar that lets ParaView (and VisIt, with --xdmf2) open a run "
              "file or a compute --format h5 file: after renaming or moving the file, or for "
              "the other flavour. cdem-run and compute write one themselves (docs/format.md, "
-             "\"XDMF sidecar\"). Prints the sidecar's name.",
+             "\"XDMF sidecar\"). Prints the sidecar's name as ParaView opens it: ./run.xmf, "
+             "not run.xmf (ParaView 5.11's Xdmf3 reader aborts on a bare name).",
     .options = xdmf_options,
 };
 

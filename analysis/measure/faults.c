@@ -30,7 +30,7 @@ typedef struct {
 } link_candidate;
 
 void cdem_faults_default_options(cdem_faults_options *o) {
-    o->threshold = 1.0;
+    o->threshold = 0.0; /* from the field: outlier_threshold */
     o->bin = 0.0;
     o->min_rows = 4;
     o->max_shift = 3.0;
@@ -90,6 +90,39 @@ static void bin_values(const cdem_state *s, const double *v, double x0, double y
             }
             out[j * nx + i] = acc / w;
         }
+}
+
+static int cmp_double(const void *a, const void *b) {
+    const double p = *(const double *)a, q = *(const double *)b;
+    return (p > q) - (p < q);
+}
+
+/* The median of the n values of v (sorted in place). */
+static double median_of(double *v, long n) {
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The default threshold: the outlier bound of the cells' values, median + 3 robust standard
+ * deviations (1.4826 x the median absolute deviation: the standard deviation for normal
+ * values, unmoved by the fault zones themselves, which are the outliers; 3 is the usual
+ * cut-off, Leys et al. 2013). A fixed strain (the old default 1) missed the weaker
+ * antithetic fault of the default model's graben (its cells reach 0.64) and says nothing
+ * early in a run; the bound follows each field. A field without spread gives a bound just
+ * above its median (by 1e-9 of it, or of 1), so a uniform field has no zone. tmp holds nx * ny
+ * doubles. */
+static double outlier_threshold(const double *g, long ncells, double *tmp) {
+    long n = 0;
+    for (long c = 0; c < ncells; c++)
+        if (isfinite(g[c]))
+            tmp[n++] = g[c];
+    if (n == 0)
+        return INFINITY;
+    const double med = median_of(tmp, n);
+    for (long k = 0; k < n; k++)
+        tmp[k] = fabs(tmp[k] - med);
+    const double bound = med + 3.0 * 1.4826 * median_of(tmp, n);
+    return bound > med ? bound : med + 1e-9 * fmax(fabs(med), 1.0);
 }
 
 /* Appends the runs of row j at or above the threshold as picks; returns the new count or -1
@@ -233,8 +266,9 @@ static void fit_zone(const pick *p, long np, int z, const chain *ch, double y0, 
 cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_faults_options *o,
                              cdem_faults_result *res, cdem_error *err) {
     memset(res, 0, sizeof *res);
-    if (!(o->threshold > 0.0) || !isfinite(o->threshold))
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "faults: threshold %g must be > 0", o->threshold);
+    if (!(o->threshold >= 0.0) || !isfinite(o->threshold))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "faults: threshold %g must be > 0 (or 0: from the field)", o->threshold);
     if (o->min_rows < 2 || !(o->max_shift > 0.0) || !isfinite(o->max_shift) || !(o->bin >= 0.0) ||
         !isfinite(o->bin))
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
@@ -270,8 +304,10 @@ cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_fa
         goto done;
     }
     bin_values(s, v, xmin, ymin, h, nx, ny, sum, cnt, g);
+    /* sum is free after binning: the scratch of the threshold's medians */
+    const double thr = o->threshold > 0.0 ? o->threshold : outlier_threshold(g, nx * ny, sum);
     for (long j = ny - 1; j >= 0 && np >= 0; j--)
-        np = row_picks(g, nx, j, xmin, h, o->threshold, &p, np, &cap);
+        np = row_picks(g, nx, j, xmin, h, thr, &p, np, &cap);
     if (np < 0 || !link_picks(p, np, o->max_shift * h, &ch, &nch)) {
         st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "faults: out of memory linking picks");
         goto done;
@@ -287,7 +323,7 @@ cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_fa
     if (res->n > 1)
         qsort(res->zone, res->n, sizeof *res->zone, cmp_zone);
     res->bin = h;
-    res->threshold = o->threshold;
+    res->threshold = thr;
 done:
     free(sum);
     free(cnt);

@@ -6,7 +6,11 @@
  *   1. Bin the values on a grid of square cells of side `bin` (default 2 x the largest free
  *      radius: about one element across) and smooth each row along x with weights 1-2-1.
  *   2. In every row, each maximal run of cells at or above `threshold` is one pick, placed at
- *      the value-weighted centre of the run.
+ *      the value-weighted centre of the run. The default threshold is the field's own outlier
+ *      bound, median + 3 x 1.4826 x MAD of the cells' values (a robust 3 sigma): a fault zone
+ *      is where the strain stands out from the rest, whatever the displacement, and a weak
+ *      antithetic fault (0.64 in the default model's graben) counts as well as a strong
+ *      synthetic one (8). A fixed value (the default until 2026-11, 1) missed the former.
  *   3. Picks are linked from the top row down into zones: a pick continues the zone whose
  *      last pick is in one of the two rows above and nearest in x, within `max_shift` x the
  *      row spacing (nearest pairs first, one pick per zone per row). A shift of up to 3 cells
@@ -30,7 +34,8 @@
 #include <stddef.h>
 
 typedef struct {
-    double threshold; /* value at or above which a cell belongs to a zone, > 0 */
+    double threshold; /* value at or above which a cell belongs to a zone, > 0; 0: the
+                         field's outlier bound (median + 3 robust standard deviations) */
     double bin;       /* m, cell size; <= 0: 2 x the largest free radius */
     int min_rows;     /* rows a zone must span to count, >= 2 (default 4) */
     double max_shift; /* largest x shift between linked picks, in cells per row (default 3) */
@@ -48,18 +53,18 @@ typedef struct {
 
 typedef struct {
     double bin;            /* m, the cell size used */
-    double threshold;      /* the threshold used */
+    double threshold;      /* the threshold used (the bound found, for threshold 0) */
     size_t n;              /* zones found */
     cdem_fault_zone *zone; /* n zones, ordered by x_top */
 } cdem_faults_result;
 
-/* Default options: threshold 1 (total maximum shear strain of a fault zone), bin 0 (2 x the
- * largest free radius), min_rows 4, max_shift 3. */
+/* Default options: threshold 0 (the field's outlier bound), bin 0 (2 x the largest free
+ * radius), min_rows 4, max_shift 3. */
 void cdem_faults_default_options(cdem_faults_options *o);
 
 /* Picks the fault zones of state s from values v (one per element, NaN where undefined).
- * Fails with CDEM_ERR_INVALID when the options are out of range or s has no free element
- * with a value, CDEM_ERR_NOMEM when memory runs out. On success res owns its zones. */
+ * Fails with CDEM_ERR_INVALID when the options are out of range (threshold < 0) or s has no free
+ * element with a value, CDEM_ERR_NOMEM when memory runs out. On success res owns its zones. */
 cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_faults_options *o,
                              cdem_faults_result *res, cdem_error *err);
 

@@ -27,7 +27,7 @@
 #     (tests/validate/check_slurm.sh, also make check-slurm); skipped, saying why, where
 #     Slurm cannot be installed or started (not root, no Debian mirror, daemons fail).
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
-#     analyses and pictures; a few minutes on 2 cores), and the paper's measurable features
+#     analyses and pictures; docs/times.md has its time), and the paper's measurable features
 #     on those runs (tests/validate/check_examples.py: the 7A graben, no void, the 7C
 #     faults, more than one thrust and an undeformed foreland in 12A).
 # 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
@@ -80,6 +80,13 @@ check inversion-kinematics $CHECK "$TMP/inversion.h5" --equil ${EQ% *} --total $
 
 STRAIN="$BUILD/cdem-strain"
 PY=/usr/bin/python3
+# The graben of the default model (README.md): `cdem-strain faults` at its default threshold
+# (the field's outlier bound) picks its two faults, the synthetic one dipping right and the
+# antithetic one dipping left (issue 35: the old fixed threshold 1 found only the first).
+check default-faults sh -c "'$STRAIN' faults '$TMP/default.h5' -o '$TMP/default-faults.csv' &&
+    $PY -c \"import csv; z = list(csv.DictReader(open('$TMP/default-faults.csv')));
+print(len(z), 'zones:', ', '.join(r['dip'] + ' ' + r['dips'] for r in z));
+assert [r['dips'] for r in z] == ['right', 'left']\""
 
 check repose-run "$RUN" -q -o "$TMP/repose.h5" -s boundary.mode=repose \
     -s time.display_interval=20 -s time.runtime=3000
