@@ -2677,6 +2677,21 @@ static void test_format_index_and_series_checksummed(void **state) {
     assert_non_null(strstr(err.msg, "damaged"));
     assert_non_null(strstr(err.msg, "checksum"));
 
+    /* a row in the middle: named, not the valid rows after it */
+    write_small(path, 6, 1);
+    {
+        FILE *fp = fopen(path, "rb");
+        assert_non_null(fp);
+        assert_int_equal(fseek(fp, commit_record_at(path) + 2 * COMMIT_ROW + 12, SEEK_SET), 0);
+        byte = (unsigned char)fgetc(fp);
+        fclose(fp);
+    }
+    byte ^= 0x01;
+    patch_commit_row(path, 2, 12, &byte, 1, 0); /* time of increment 2 */
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_ERR_FORMAT);
+    assert_non_null(strstr(err.msg, "/increments/commit row 2: its checksum does not match"));
+    assert_non_null(strstr(err.msg, "rows 0..1 are valid"));
+
     write_small(path, 4, 1);
     flip_in_chunk(path, "increments/index", 3 * 84 + 24 + 7, 0x10);
     assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);

@@ -147,11 +147,14 @@ const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, int unclos
     while (later < capacity && h5i_commit_row_blank(&rows[later]))
         later++;
     if (later < capacity) {
+        if (!h5i_commit_row_blank(&rows[k])) {
+            *bad_row = k;
+            return "its checksum does not match its contents, and rows after it are written (a "
+                   "kill tears only the last row)";
+        }
         *bad_row = later;
-        return h5i_commit_row_valid(&rows[later], later)
-                   ? "it is a valid row after an invalid or unwritten one (only the rows of a "
-                     "prefix can be committed)"
-                   : "it is neither a valid row nor unwritten";
+        return "it is written after an unwritten row (only the rows of a prefix can be "
+               "committed)";
     }
     if (!h5i_commit_row_blank(&rows[k])) {
         if (!unclosed) {
