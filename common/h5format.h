@@ -28,6 +28,23 @@
 #define CDEM_FORMAT_NAME    "cdem-c"
 #define CDEM_FORMAT_VERSION 2
 
+/* Physical bounds of what a run file holds (docs/format.md, "Physical bounds"). A checksum
+ * only says the bytes are those written; these say the values are a model's. The reader
+ * refuses a value outside them as damage, naming the file, dataset, row and value; the writer
+ * refuses to write one (CDEM_ERR_NUMERIC: a run that produced it has blown up), so a file
+ * cdem-c writes is always one it reads. They lie far beyond any model (the parameters allow
+ * at most 100 km wide assemblies and 2e6 s of model time) and keep every square and sum over
+ * all elements finite. */
+#define CDEM_FILE_MAX_LENGTH 1e7   /* m: |x|, |y|, |net displacement|, |sea level| */
+#define CDEM_FILE_MAX_RADIUS 1e5   /* m: radius in (0, this] */
+#define CDEM_FILE_MAX_TIME   1e9   /* s: model time in [0, this] */
+#define CDEM_FILE_MAX_STRESS 1e20  /* N/m: |sxx|, |syy|, |sxy|, |differential stress| */
+#define CDEM_FILE_MAX_STRAIN 1e6   /* |axial strain|: the length bound over a 10 m sample */
+
+/* The stop reasons a file may record (/stop_reason; "" = none recorded): the reader refuses
+ * any other text. NULL-terminated. */
+extern const char *const cdem_stop_reasons[];
+
 typedef enum {
     CDEM_PHASE_EQUILIBRATION = 0, /* walls still, assembly settling */
     CDEM_PHASE_DEFORMATION = 1,   /* boundaries moving */
@@ -224,6 +241,11 @@ const char *cdem_h5_reader_stop_detail(const cdem_h5_reader *r);
 const char *cdem_h5_reader_source(const cdem_h5_reader *r);
 const char *cdem_h5_reader_created(const cdem_h5_reader *r);
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r);
+/* Added with issue 35: whether a writer held the file's lock (runlock.h) when it was opened:
+ * 1 yes (the run is being written), 0 no, -1 cannot tell (a filesystem without locks). A
+ * file its writer did not close (_unclosed) and that no writer holds was left by a killed or
+ * crashed writer: its stop reason still says "running", but the run was interrupted. */
+int cdem_h5_reader_writer_alive(const cdem_h5_reader *r);
 
 /* Added with format version 2: re-reads the increment list and the stop reason of a file
  * that is being written (SWMR-read mode); *changed (may be NULL) becomes 1 when the list or
