@@ -35,11 +35,11 @@
  * cdem-c writes is always one it reads. They lie far beyond any model (the parameters allow
  * at most 100 km wide assemblies and 2e6 s of model time) and keep every square and sum over
  * all elements finite. */
-#define CDEM_FILE_MAX_LENGTH 1e7   /* m: |x|, |y|, |net displacement|, |sea level| */
-#define CDEM_FILE_MAX_RADIUS 1e5   /* m: radius in (0, this] */
-#define CDEM_FILE_MAX_TIME   1e9   /* s: model time in [0, this] */
-#define CDEM_FILE_MAX_STRESS 1e20  /* N/m: |sxx|, |syy|, |sxy|, |differential stress| */
-#define CDEM_FILE_MAX_STRAIN 1e6   /* |axial strain|: the length bound over a 10 m sample */
+#define CDEM_FILE_MAX_LENGTH 1e7  /* m: |x|, |y|, |net displacement|, |sea level| */
+#define CDEM_FILE_MAX_RADIUS 1e5  /* m: radius in (0, this] */
+#define CDEM_FILE_MAX_TIME   1e9  /* s: model time in [0, this] */
+#define CDEM_FILE_MAX_STRESS 1e20 /* N/m: |sxx|, |syy|, |sxy|, |differential stress| */
+#define CDEM_FILE_MAX_STRAIN 1e6  /* |axial strain|: the length bound over a 10 m sample */
 
 /* The stop reasons a file may record (/stop_reason; "" = none recorded): the reader refuses
  * any other text. NULL-terminated. */
@@ -214,10 +214,17 @@ size_t cdem_h5_reader_increment_count(const cdem_h5_reader *r);
 cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
                                           cdem_increment_info *info, cdem_error *err);
 
-/* Resolves "K" (an increment number), "last", "first" or "equil" (the last increment of the
- * equilibration phase) to an index. */
+/* Resolves "K" (an increment number), "last", "first" or "equil" (the end of equilibration,
+ * cdem_h5_reader_equil_end) to an index. */
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err);
+
+/* Added with issue 35: the end of equilibration, the last increment of the equilibration
+ * phase, into *index; known only when an increment of a later phase follows it, or the run
+ * completed. CDEM_ERR_NOTFOUND, saying why, when the file has no increment of that phase or
+ * the run has not left it (stopped, killed or still running in equilibration: its last
+ * increment is then not the end, which lies later; it is never guessed). */
+cdem_status cdem_h5_reader_equil_end(const cdem_h5_reader *r, size_t *index, cdem_error *err);
 
 /* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
  * s must be zeroed ({0}) or initialised; on failure it is left empty. */

@@ -312,6 +312,11 @@ cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, 
                          "wedge: the run is a '%s' run (boundary.mode); the wedge measurement "
                          "needs boundary.mode = detachment",
                          cdem_mode_name(prm->mode));
+    if (!cdem_analysis_equil_known(a))
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "wedge: the wedge is measured from the end of equilibration, which is not "
+                         "reached: %s (its last increment, %d, is of the equilibration phase)",
+                         cdem_analysis_equil_why(a), (int)cdem_analysis_info(a, count - 1)->number);
     if (first < e)
         first = e;
     if (last < e)

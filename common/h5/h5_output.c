@@ -92,8 +92,12 @@ static void describe_existing(const char *path, int *is_cdem, int *resumable, in
     *completed = strcmp(stop, "completed") == 0;
     *resumable = strcmp(cdem_h5_reader_source(r), "cdem-run") == 0 && !*completed &&
                  cdem_h5_reader_format_version(r) >= 2;
-    snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\", %zu increments",
-             cdem_h5_reader_source(r), stop, cdem_h5_reader_increment_count(r));
+    /* a file still saying "running" that no writer holds was interrupted (killed) */
+    const int killed = !strcmp(stop, "running") && cdem_h5_reader_writer_alive(r) == 0;
+    snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\"%s, %zu increments",
+             cdem_h5_reader_source(r), stop,
+             killed ? " but no writer holds it (interrupted: killed or crashed)" : "",
+             cdem_h5_reader_increment_count(r));
     cdem_h5_reader_close(r);
 }
 

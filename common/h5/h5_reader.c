@@ -639,6 +639,42 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
     return CDEM_OK;
 }
 
+/* The rule of docs/format.md ("Counting"): the last increment of the equilibration phase is
+ * its end only once an increment of a later phase follows it, or the run completed. A run
+ * stopped, killed or still running in equilibration has not written its end yet (its last
+ * increment was 42 where the end was 56): never guessed. */
+static cdem_status equil_end(const cdem_h5_reader *r, size_t *index, const char *what,
+                             cdem_error *err) {
+    size_t last = SIZE_MAX;
+    for (size_t i = r->n_incr; i-- > 0 && last == SIZE_MAX;)
+        if (r->incr[i].info.phase == CDEM_PHASE_EQUILIBRATION)
+            last = i;
+    if (last == SIZE_MAX)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "%s: %sno increment is in the equilibration phase, so the file has no "
+                         "end of equilibration",
+                         r->path, what);
+    if (last + 1 < r->n_incr || !strcmp(r->stop_reason, "completed")) {
+        *index = last;
+        return CDEM_OK;
+    }
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                     "%s: %sthe end of equilibration is not reached: %s (its last increment, %d, "
+                     "is of the equilibration phase; the end is known once an increment of the "
+                     "deformation phase follows)",
+                     r->path, what,
+                     r->writer == 1 && !strcmp(r->stop_reason, "running")
+                         ? "the run is still in equilibration"
+                         : "the run stopped during equilibration",
+                     (int)r->incr[last].info.number);
+}
+
+cdem_status cdem_h5_reader_equil_end(const cdem_h5_reader *r, size_t *index, cdem_error *err) {
+    if (!r || !index)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_equil_end: bad arguments");
+    return equil_end(r, index, "", err);
+}
+
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err) {
     if (!r || !spec || !index)
@@ -656,14 +692,7 @@ cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *s
         return CDEM_OK;
     }
     if (!strcmp(spec, "equil")) {
-        for (size_t i = r->n_incr; i-- > 0;)
-            if (r->incr[i].info.phase == CDEM_PHASE_EQUILIBRATION) {
-                *index = i;
-                return CDEM_OK;
-            }
-        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
-                         "%s: increment 'equil': no increment is in the equilibration phase",
-                         r->path);
+        return equil_end(r, index, "increment 'equil': ", err);
     }
     const char *p = spec;
     while (isspace((unsigned char)*p))
