@@ -286,8 +286,9 @@ double cdem_h5_estimate_run_space(double n_elements, double n_increments, int wi
 
 /* Checks, before a run starts, that the directory of path has at least bytes_needed bytes
  * free for an unprivileged user (statvfs). Fails with CDEM_ERR_IO naming the directory, the
- * estimate and the free space when it has not; with CDEM_ERR_NOTFOUND when the directory
- * cannot be reached (missing, not a folder, no permission), naming it. */
+ * estimate and the free space when it has not (and only then: callers advise freeing space);
+ * with CDEM_ERR_NOTFOUND, naming it, when the directory cannot be reached (missing, not a
+ * folder, no permission) or written (a read-only file system, no write permission). */
 cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */

@@ -134,8 +134,9 @@ cdem_status cdem_analysis_open_source(const cdem_analysis_source *src, void *ctx
     }
     cdem_h5_reader *r = src->reader ? src->reader(ctx) : NULL;
     if (a->n == 0) {
+        const cdem_status st = no_increments(r, err); /* before the close closes r */
         cdem_analysis_close(a);
-        return no_increments(r, err);
+        return st;
     }
     /* The end of equilibration is the last increment of that phase once a later phase has
      * begun (or the run completed); a run that stopped, was killed or still runs in
@@ -211,6 +212,22 @@ const char *cdem_analysis_equil_why(const cdem_analysis *a) {
 int cdem_analysis_from_equil(const cdem_quantity *q) {
     return q->family == CDEM_QF_TOTAL_DISP || q->family == CDEM_QF_TOTAL_STRAIN ||
            q->family == CDEM_QF_CUM_STRAIN;
+}
+
+/* A computation on increment index against increment ref failed (ref == index: on index
+ * alone): its message, from code that sees only states ("duplicate element id 7 at slots 0
+ * and 1"), is prefixed with the run and the increments, so it names where (issue 35, item
+ * 10). The loads before it name their file and increment themselves. */
+static cdem_status in_increments(const cdem_analysis *a, cdem_status st, size_t index, size_t ref,
+                                 cdem_error *err) {
+    if (st == CDEM_OK || st == CDEM_ERR_NOMEM)
+        return st;
+    char against[64] = "";
+    if (ref != index)
+        snprintf(against, sizeof against, " against increment %d", (int)a->infos[ref].number);
+    cdem_error_prefix(err, "%s%sincrement %d%s", a->name ? a->name : "", a->name ? ": " : "",
+                      (int)a->infos[index].number, against);
+    return st;
 }
 
 /* CDEM_ERR_NOTFOUND: what (a quantity at an increment, ...) is measured from the end of
@@ -371,7 +388,7 @@ static cdem_status for_total_groups(cdem_analysis *a, size_t index, pair_fn fn, 
             break;
         for (size_t i = 0; i < n; i++)
             sel[i] = group[i] == g;
-        st = fn(ref, cur, sel, user, err);
+        st = in_increments(a, fn(ref, cur, sel, user, err), index, g, err);
         if (st != CDEM_OK)
             break;
         done_below = g + 1;
@@ -439,9 +456,9 @@ static cdem_status cum_advance(cdem_analysis *a, size_t index, cdem_error *err) 
                 break;
             }
         }
-        st = cdem_strain_compute(prev, cur, NULL, 0.0, m, err);
+        st = in_increments(a, cdem_strain_compute(prev, cur, NULL, 0.0, m, err), k, k - 1, err);
         if (st == CDEM_OK)
-            st = cdem_strain_cum_add(&a->cum, cur, m, err);
+            st = in_increments(a, cdem_strain_cum_add(&a->cum, cur, m, err), k, k - 1, err);
         if (st != CDEM_OK) {
             cdem_strain_cum_reset(&a->cum);
             a->cum_at = SIZE_MAX;
@@ -484,7 +501,8 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         if (st == CDEM_OK)
             st = cdem_analysis_state(a, index, &cur, err);
         if (st == CDEM_OK)
-            st = cdem_displacement_compute(ref, cur, NULL, ux, uy, err);
+            st = in_increments(a, cdem_displacement_compute(ref, cur, NULL, ux, uy, err), index,
+                               incr_ref(index), err);
         if (st == CDEM_OK)
             pick_disp(ux, uy, n, q->component, v);
         break;
@@ -502,7 +520,8 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         if (st == CDEM_OK)
             st = cdem_analysis_state(a, index, &cur, err);
         if (st == CDEM_OK)
-            st = cdem_strain_compute(ref, cur, NULL, 0.0, m, err);
+            st = in_increments(a, cdem_strain_compute(ref, cur, NULL, 0.0, m, err), index,
+                               incr_ref(index), err);
         if (st == CDEM_OK)
             for (size_t i = 0; i < n; i++)
                 v[i] = pick_strain(&m[i], q->component);
@@ -685,7 +704,7 @@ cdem_status cdem_analysis_axes(cdem_analysis *a, size_t index, cdem_axes_kind ki
     const cdem_state *cur, *ref;
     if (kind == CDEM_AXES_STRESS) {
         CDEM_TRY(cdem_analysis_state(a, index, &cur, err));
-        return cdem_axes_stress(cur, 0.0, out, err);
+        return in_increments(a, cdem_axes_stress(cur, 0.0, out, err), index, index, err);
     }
     if (kind == CDEM_AXES_TOTAL_STRAIN && !a->equil_known)
         return equil_not_known(a, "the total strain axes", err);
@@ -694,5 +713,5 @@ cdem_status cdem_analysis_axes(cdem_analysis *a, size_t index, cdem_axes_kind ki
         return CDEM_OK; /* no total strain during equilibration: no axes (n = 0) */
     CDEM_TRY(cdem_analysis_state(a, r, &ref, err));
     CDEM_TRY(cdem_analysis_state(a, index, &cur, err));
-    return cdem_axes_strain(ref, cur, 0.0, out, err);
+    return in_increments(a, cdem_axes_strain(ref, cur, 0.0, out, err), index, r, err);
 }
