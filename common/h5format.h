@@ -28,6 +28,23 @@
 #define CDEM_FORMAT_NAME    "cdem-c"
 #define CDEM_FORMAT_VERSION 2
 
+/* Physical bounds of what a run file holds (docs/format.md, "Physical bounds"). A checksum
+ * only says the bytes are those written; these say the values are a model's. The reader
+ * refuses a value outside them as damage, naming the file, dataset, row and value; the writer
+ * refuses to write one (CDEM_ERR_NUMERIC: a run that produced it has blown up), so a file
+ * cdem-c writes is always one it reads. They lie far beyond any model (the parameters allow
+ * at most 100 km wide assemblies and 2e6 s of model time) and keep every square and sum over
+ * all elements finite. */
+#define CDEM_FILE_MAX_LENGTH 1e7  /* m: |x|, |y|, |net displacement|, |sea level| */
+#define CDEM_FILE_MAX_RADIUS 1e5  /* m: radius in (0, this] */
+#define CDEM_FILE_MAX_TIME   1e9  /* s: model time in [0, this] */
+#define CDEM_FILE_MAX_STRESS 1e20 /* N/m: |sxx|, |syy|, |sxy|, |differential stress| */
+#define CDEM_FILE_MAX_STRAIN 1e6  /* |axial strain|: the length bound over a 10 m sample */
+
+/* The stop reasons a file may record (/stop_reason; "" = none recorded): the reader refuses
+ * any other text. NULL-terminated. */
+extern const char *const cdem_stop_reasons[];
+
 typedef enum {
     CDEM_PHASE_EQUILIBRATION = 0, /* walls still, assembly settling */
     CDEM_PHASE_DEFORMATION = 1,   /* boundaries moving */
@@ -197,10 +214,17 @@ size_t cdem_h5_reader_increment_count(const cdem_h5_reader *r);
 cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
                                           cdem_increment_info *info, cdem_error *err);
 
-/* Resolves "K" (an increment number), "last", "first" or "equil" (the last increment of the
- * equilibration phase) to an index. */
+/* Resolves "K" (an increment number), "last", "first" or "equil" (the end of equilibration,
+ * cdem_h5_reader_equil_end) to an index. */
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err);
+
+/* Added with issue 35: the end of equilibration, the last increment of the equilibration
+ * phase, into *index; known only when an increment of a later phase follows it, or the run
+ * completed. CDEM_ERR_NOTFOUND, saying why, when the file has no increment of that phase or
+ * the run has not left it (stopped, killed or still running in equilibration: its last
+ * increment is then not the end, which lies later; it is never guessed). */
+cdem_status cdem_h5_reader_equil_end(const cdem_h5_reader *r, size_t *index, cdem_error *err);
 
 /* Loads increment `index` into s (re-initialised; velocities and forces zero, masses zero).
  * s must be zeroed ({0}) or initialised; on failure it is left empty. */
@@ -224,6 +248,11 @@ const char *cdem_h5_reader_stop_detail(const cdem_h5_reader *r);
 const char *cdem_h5_reader_source(const cdem_h5_reader *r);
 const char *cdem_h5_reader_created(const cdem_h5_reader *r);
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r);
+/* Added with issue 35: whether a writer held the file's lock (runlock.h) when it was opened:
+ * 1 yes (the run is being written), 0 no, -1 cannot tell (a filesystem without locks). A
+ * file its writer did not close (_unclosed) and that no writer holds was left by a killed or
+ * crashed writer: its stop reason still says "running", but the run was interrupted. */
+int cdem_h5_reader_writer_alive(const cdem_h5_reader *r);
 
 /* Added with format version 2: re-reads the increment list and the stop reason of a file
  * that is being written (SWMR-read mode); *changed (may be NULL) becomes 1 when the list or
@@ -257,8 +286,9 @@ double cdem_h5_estimate_run_space(double n_elements, double n_increments, int wi
 
 /* Checks, before a run starts, that the directory of path has at least bytes_needed bytes
  * free for an unprivileged user (statvfs). Fails with CDEM_ERR_IO naming the directory, the
- * estimate and the free space when it has not; with CDEM_ERR_NOTFOUND when the directory
- * cannot be reached (missing, not a folder, no permission), naming it. */
+ * estimate and the free space when it has not (and only then: callers advise freeing space);
+ * with CDEM_ERR_NOTFOUND, naming it, when the directory cannot be reached (missing, not a
+ * folder, no permission) or written (a read-only file system, no write permission). */
 cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem_error *err);
 
 /* The parameter record rebuilt into a cdem_params (defaults for keys the file lacks). */

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Lists every message cdem-run and cdem-strain can print, from the sources: each call of
 MESSAGE_CALLS below (CDEM_FAIL, H5FAIL, the parameter rules, the context put before a
-message, both programs' usage errors, fprintf(stderr, ...)) in common/, solver/ and
+message, the reasons a run file's value is refused, both programs' usage errors,
+fprintf(stderr, ...)) in common/, solver/ and
 analysis/, read by a C tokenizer (comments and character literals skipped). Writes
 markdown to stdout (`make errors` writes docs/errors.md with it).
 
@@ -92,9 +93,10 @@ MESSAGE_CALLS = {
     "cdem_cmd_usage": 2,     # analysis/cli/cmd_support.c: cdem-strain's usage errors
     "usage": 1,              # analysis/cli/cmd_render.c: cdem_cmd_usage with render's help
     "fprintf": 2,            # only fprintf(stderr, ...)
+    "say_why": 3,            # common/h5/h5_layout.c: why a value of a run file is refused
 }
 KIND = {"rule_add": "rule", "cdem_error_prefix": "context", "usage_error": "usage",
-        "cdem_cmd_usage": "usage", "usage": "usage", "fprintf": "stderr"}
+        "cdem_cmd_usage": "usage", "usage": "usage", "fprintf": "stderr", "say_why": "reason"}
 
 TOKEN = re.compile(r"""
     (?P<nl>\n) | (?P<ws>[ \t\r\f\v]+) | (?P<lc>//[^\n]*) | (?P<bc>/\*.*?\*/)
@@ -282,7 +284,9 @@ def main():
     print("`CDEM_FAIL` and `H5FAIL` (the run file's errors; HDF5's own reason may follow in")
     print("\"(HDF5: …)\"), the context `cdem_error_prefix` puts before a message (kind")
     print("\"context\"), the parameter rules of `cdem_params_validate` (kind \"rule\": reported")
-    print("together, one per line, after \"the parameters cannot be used as they are:\"), the")
+    print("together, one per line, after \"the parameters cannot be used as they are:\"), why a")
+    print("value of a run file is refused (kind \"reason\": put into the reader's or the writer's")
+    print("message, docs/format.md \"Physical bounds\"), the")
     print("usage errors of both programs and what they print directly on standard error. Do")
     print("not edit by hand: `test_man` fails when the page is stale and `test_error_catalogue`")
     print("when a message of the sources is missing from it. `<…>` stands for a value filled")

@@ -45,6 +45,7 @@ static const message_call MESSAGE_CALLS[] = {
     {"cdem_cmd_usage", 2},    /* analysis/cli/cmd_support.c: cdem-strain's usage errors */
     {"usage", 1},             /* analysis/cli/cmd_render.c: cdem_cmd_usage with render's help */
     {"fprintf", 2},           /* only fprintf(stderr, ...) */
+    {"say_why", 3},           /* common/h5/h5_layout.c: why a value of a run file is refused */
 };
 #define N_CALLS (sizeof MESSAGE_CALLS / sizeof MESSAGE_CALLS[0])
 

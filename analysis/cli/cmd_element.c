@@ -52,6 +52,12 @@ static int cmd_element(const cdem_cmd_options *o) {
     for (size_t j = 0; j < nq; j++) {
         if (t[j].needs_stress && !has_stress)
             continue;
+        if (cdem_analysis_from_equil(&t[j]) && !cdem_analysis_equil_known(a)) {
+            printf("  %-18s not defined yet (measured from the end of equilibration, not "
+                   "reached)\n",
+                   t[j].name);
+            continue;
+        }
         double *v;
         if (cdem_analysis_values(a, k, &t[j], &s, &v, &err) != CDEM_OK) {
             cdem_analysis_close(a);

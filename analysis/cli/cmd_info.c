@@ -14,6 +14,59 @@ static const char *phase_name(int phase) {
                                              : "unknown";
 }
 
+/* How the run stands. The stop reason recorded, except that a file still saying "running"
+ * that no writer holds (runlock.h: its lock is free) was interrupted: its writer was killed
+ * or crashed before it could record how the run ended (issue 35, item 9: info said
+ * "running", as for a live run); the detail then says what can be done with it. */
+typedef struct {
+    const char *reason; /* the stop reason to show */
+    char detail[2200];  /* the detail to show */
+    int interrupted;    /* 1: "running" recorded and no writer holds the file */
+} run_state;
+
+static void run_state_of(cdem_h5_reader *r, const char *path, run_state *rs) {
+    const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
+    const int alive = cdem_h5_reader_writer_alive(r);
+    rs->interrupted = !strcmp(reason, "running") && alive == 0;
+    rs->reason = rs->interrupted ? "interrupted" : reason[0] ? reason : "(none recorded)";
+    if (!rs->interrupted) {
+        snprintf(rs->detail, sizeof rs->detail, "%s",
+                 !strcmp(reason, "running") && alive < 0
+                     ? "whether a writer still holds it cannot be told here (the filesystem has "
+                       "no locks): interrupted if none does"
+                     : detail);
+        return;
+    }
+    /* what --resume needs: a cdem-run file of version 2 with a checkpoint */
+    const int cdem_run =
+        !strcmp(cdem_h5_reader_source(r), "cdem-run") && cdem_h5_reader_format_version(r) >= 2;
+    int32_t at = -1;
+    cdem_error err;
+    cdem_snapshot *snap = NULL;
+    const int resumable = cdem_run && cdem_snapshot_alloc(&snap, &err) == CDEM_OK &&
+                          cdem_h5_reader_read_checkpoint(r, snap, &at, &err) == CDEM_OK;
+    cdem_snapshot_free(snap);
+    if (resumable)
+        snprintf(rs->detail, sizeof rs->detail, "continue with cdem-run --resume %s", path);
+    else if (cdem_run)
+        snprintf(rs->detail, sizeof rs->detail,
+                 "it cannot be resumed: its writer was killed before the first checkpoint; run "
+                 "it again");
+    else
+        snprintf(rs->detail, sizeof rs->detail,
+                 "it cannot be resumed (written by %s, not cdem-run): write it again",
+                 cdem_h5_reader_source(r)[0] ? cdem_h5_reader_source(r) : "an unknown program");
+}
+
+/* The "stop reason: ..." line: "interrupted (no writer holds it): continue with cdem-run
+ * --resume RUN.h5" for a killed run. */
+static void print_stop(cdem_h5_reader *r, const char *path) {
+    run_state rs;
+    run_state_of(r, path, &rs);
+    printf("\nstop reason: %s%s%s%s\n", rs.reason, rs.interrupted ? " (no writer holds it)" : "",
+           rs.detail[0] ? ": " : "", rs.detail);
+}
+
 /* info on a file without increments yet (a run that has just started, or was killed
  * before its first increment): the stored texts and "increments: 0". -1 when it has some. */
 static int info_without_increments(const char *path) {
@@ -27,10 +80,9 @@ static int info_without_increments(const char *path) {
     }
     const char *sum = cdem_h5_reader_summary(r);
     printf("%s%s", sum, sum[0] && sum[strlen(sum) - 1] != '\n' ? "\n" : "");
-    const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
-    printf("\nstop reason: %s%s%s\n", reason[0] ? reason : "(none recorded)", detail[0] ? ": " : "",
-           detail);
-    printf("increments: 0 (none written yet)\n");
+    print_stop(r, path);
+    printf("increments: 0 (%s)\n",
+           cdem_h5_reader_writer_alive(r) == 1 ? "none written yet" : "none was written");
     cdem_h5_reader_close(r);
     return CDEM_EXIT_OK;
 }
@@ -71,8 +123,9 @@ static int info_json(const cdem_cmd_options *o) {
         return cdem_cmd_fail(NULL, NULL, &err);
     const size_t n = cdem_h5_reader_increment_count(r);
     size_t equil = 0;
-    const int has_equil =
-        n > 0 && cdem_h5_reader_find_increment(r, "equil", &equil, &err) == CDEM_OK;
+    cdem_error equil_err;
+    cdem_error_clear(&equil_err);
+    const int has_equil = n > 0 && cdem_h5_reader_equil_end(r, &equil, &equil_err) == CDEM_OK;
     FILE *f = stdout;
     fputs("{\n  \"file\": ", f);
     json_string(f, o->file);
@@ -83,12 +136,27 @@ static int info_json(const cdem_cmd_options *o) {
     json_string(f, cdem_h5_reader_source(r));
     fputs(",\n  \"created\": ", f);
     json_string(f, cdem_h5_reader_created(r));
+    run_state rs;
+    run_state_of(r, o->file, &rs);
+    const int alive = cdem_h5_reader_writer_alive(r);
     fprintf(f,
-            ",\n  \"seed\": %ld,\n  \"unclosed\": %s,\n  \"stop_reason\": ", cdem_h5_reader_seed(r),
-            cdem_h5_reader_unclosed(r) ? "true" : "false");
-    json_string(f, cdem_h5_reader_stop_reason(r));
+            ",\n  \"seed\": %ld,\n  \"unclosed\": %s,\n  \"writer_alive\": %s,\n  "
+            "\"stop_reason\": ",
+            cdem_h5_reader_seed(r), cdem_h5_reader_unclosed(r) ? "true" : "false",
+            alive > 0    ? "true"
+            : alive == 0 ? "false"
+                         : "null");
+    json_string(f, rs.reason[0] == '(' ? "" : rs.reason);
     fputs(",\n  \"stop_detail\": ", f);
-    json_string(f, cdem_h5_reader_stop_detail(r));
+    if (rs.interrupted) { /* "no writer holds it: continue with cdem-run --resume RUN.h5" */
+        char d[2300];
+        snprintf(d, sizeof d, "no writer holds it: %s", rs.detail);
+        json_string(f, d);
+    } else {
+        json_string(f, rs.detail);
+    }
+    fputs(",\n  \"recorded_stop_reason\": ", f);
+    json_string(f, cdem_h5_reader_stop_reason(r));
     fputs(",\n  \"summary\": ", f);
     json_string(f, cdem_h5_reader_summary(r));
     fprintf(f, ",\n  \"increment_count\": %zu", n);
@@ -104,8 +172,15 @@ static int info_json(const cdem_cmd_options *o) {
     if (n > 0)
         fprintf(f, ",\n  \"first_increment\": %d,\n  \"last_increment\": %d", (int)first.number,
                 (int)last.number);
-    if (has_equil)
+    if (has_equil) {
         fprintf(f, ",\n  \"end_of_equilibration\": %d", (int)eq.number);
+    } else if (n > 0) { /* not reached, or no equilibration increment: null, and why */
+        fputs(",\n  \"end_of_equilibration\": null,\n  \"end_of_equilibration_note\": ", f);
+        const size_t at = strlen(o->file); /* the message without "RUN.h5: " */
+        json_string(f, !strncmp(equil_err.msg, o->file, at) && equil_err.msg[at] == ':'
+                           ? equil_err.msg + at + 2
+                           : equil_err.msg);
+    }
     fputs(",\n  \"increments\": [", f);
     for (size_t k = 0; k < n && st == CDEM_OK; k++) {
         cdem_increment_info in;
@@ -146,14 +221,19 @@ static int cmd_info(const cdem_cmd_options *o) {
     if (cdem_h5_reader_summary(r)[0] &&
         cdem_h5_reader_summary(r)[strlen(cdem_h5_reader_summary(r)) - 1] != '\n')
         printf("\n");
-    const char *reason = cdem_h5_reader_stop_reason(r), *detail = cdem_h5_reader_stop_detail(r);
-    printf("\nstop reason: %s%s%s\n", reason[0] ? reason : "(none recorded)", detail[0] ? ": " : "",
-           detail);
-    /* the counts of the summary and the progress line (docs/format.md, "Counting") */
+    print_stop(r, o->file);
+    /* the counts of the summary and the progress line (docs/format.md, "Counting"); the end
+     * of equilibration only once known (never the last increment of a run still in it) */
     const size_t n_inc = cdem_analysis_count(a);
-    printf("increments: %zu, numbered %d..%d (end of equilibration: increment %d)\n", n_inc,
+    char equil[160];
+    if (cdem_analysis_equil_known(a))
+        snprintf(equil, sizeof equil, "increment %d",
+                 (int)cdem_analysis_info(a, cdem_analysis_equil_index(a))->number);
+    else
+        snprintf(equil, sizeof equil, "not reached: %s", cdem_analysis_equil_why(a));
+    printf("increments: %zu, numbered %d..%d (end of equilibration: %s)\n", n_inc,
            (int)cdem_analysis_info(a, 0)->number, (int)cdem_analysis_info(a, n_inc - 1)->number,
-           (int)cdem_analysis_info(a, cdem_analysis_equil_index(a))->number);
+           equil);
     printf("%9s %12s %12s %-13s %14s %9s\n", "increment", "step", "time_s", "phase", "net_displ_m",
            "elements");
     /* an imported cdem2D folder has no step, time or displacement: "-" rather than zeros */

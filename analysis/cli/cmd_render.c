@@ -478,6 +478,20 @@ static cdem_status follow_render(const render_args *a, const cdem_quantity *q, i
         cdem_analysis_close(an);
         return CDEM_OK;
     }
+    /* a live run still in equilibration has no total quantities yet (they are measured from
+     * its end): wait for them (*number = -2, err says why) rather than fail */
+    const int from_equil =
+        (q && cdem_analysis_from_equil(q)) || a->vectors == 2 || a->axes == CDEM_AXES_TOTAL_STRAIN;
+    if (from_equil && !cdem_analysis_equil_known(an) &&
+        cdem_h5_reader_writer_alive(cdem_analysis_reader(an)) == 1) {
+        CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                  "%s: %s is measured from the end of equilibration, which the run has not "
+                  "reached yet: waiting for it",
+                  a->path, q && cdem_analysis_from_equil(q) ? q->name : "the total picture");
+        *number = -2;
+        cdem_analysis_close(an);
+        return CDEM_OK;
+    }
     cdem_render_options o = a->ro;
     o.growth1_layers = cdem_analysis_params(an)->growth_sequence1_layers;
     if (a->zoom_given)
@@ -536,6 +550,7 @@ static int run_follow(const render_args *a) {
             return 0;
     }
     int32_t shown = -1;
+    int waiting = 0;     /* 1: the note that the picture waits for the end of equilibration */
     int writer_gone = 0; /* 1: no live writer holds the file's lock (checked last time) */
     for (;;) {
         int stopped = strcmp(cdem_h5_reader_stop_reason(r), "running") != 0;
@@ -552,6 +567,9 @@ static int run_follow(const render_args *a) {
                 shown = number;
                 printf("%s: increment %d\n", a->output, (int)number);
                 fflush(stdout);
+            } else if (number == -2 && !waiting) {
+                waiting = 1; /* said once */
+                fprintf(stderr, "cdem-strain render: note: %s\n", err.msg);
             }
         }
         if (stopped) {

@@ -4,6 +4,7 @@
 #include "cdem2d.h"
 
 #include "grid.h"
+#include "h5format.h"
 #include "params.h"
 
 #include <ctype.h>
@@ -245,9 +246,10 @@ typedef struct {
 
 /* Bounds of an imported row (m): far beyond any model, yet small enough that sums, squares
  * and the cell grid of the id matching stay finite (x = 1e308 or a radius of 1e300 were
- * imported once, and turned into infinities downstream). */
-#define IMPORT_MAX_COORD  1e7
-#define IMPORT_MAX_RADIUS 1e5
+ * imported once, and turned into infinities downstream). They are the run file's own
+ * (h5format.h, docs/format.md "Physical bounds"): its writer refuses anything beyond. */
+#define IMPORT_MAX_COORD  CDEM_FILE_MAX_LENGTH
+#define IMPORT_MAX_RADIUS CDEM_FILE_MAX_RADIUS
 
 static cdem_status result_row(void *user, const double *v, const char *path, long line,
                               cdem_error *err) {
@@ -281,6 +283,16 @@ static cdem_status force_row(void *user, const double *v, const char *path, long
         return CDEM_FAIL(err, CDEM_ERR_PARSE,
                          "%s:%ld: more stress rows than the %zu elements of the results file", path,
                          line, c->s->n);
+    for (int k = 0; k < 3; k++)
+        if (!(fabs(v[k]) <= CDEM_FILE_MAX_STRESS))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                             "%s:%ld: %s = %g N/m is outside the range -%g..%g N/m allowed for a "
+                             "stress",
+                             path, line,
+                             k == 0   ? "sxx"
+                             : k == 1 ? "syy"
+                                      : "sxy",
+                             v[k], CDEM_FILE_MAX_STRESS, CDEM_FILE_MAX_STRESS);
     c->s->sxx[c->stress_row] = v[0];
     c->s->syy[c->stress_row] = v[1];
     c->s->sxy[c->stress_row] = v[2];

@@ -3,7 +3,8 @@
  * reference, birth reference), so with four slots a state fetched inside a request is never
  * evicted before the request re-fetches the current state it returns. Cumulative strain is a
  * running sum advanced pair by pair (each pair computed once while k increases; going back
- * restarts from the end of equilibration). Limits spanning many increments (stress over all
+ * restarts from the end of equilibration; none of them while the end is not known, which a run
+ * still in equilibration has not reached). Limits spanning many increments (stress over all
  * increments, total displacement at the last increment) are computed once and cached. */
 #include "analysis.h"
 
@@ -32,7 +33,9 @@ struct cdem_analysis {
     cdem_params params;            /* the run's parameters */
     size_t n;                      /* increments */
     cdem_increment_info *infos;    /* n infos */
-    size_t equil;                  /* end-of-equilibration index */
+    size_t equil;                  /* end-of-equilibration index (when equil_known) */
+    int equil_known;               /* 0: the run has not left equilibration (see open) */
+    char equil_why[80];            /* when not known: why ("the run stopped during ...") */
     cache_slot slot[CACHE_SLOTS];  /* LRU cache */
     unsigned long clock;           /* use counter for LRU */
     cdem_strain_cum cum;           /* running cumulative sums */
@@ -75,6 +78,27 @@ static const cdem_analysis_source mem_ops = {
 };
 
 /* ---------------------------------------------------------------- lifecycle */
+
+/* Why a run has no increment to analyse, or what is wrong with it (the reader refuses a
+ * closed file whose stop reason says increments were written and that lists none). */
+static cdem_status no_increments(cdem_h5_reader *r, cdem_error *err) {
+    if (!r)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "analysis: no increments to analyse");
+    const char *stop = cdem_h5_reader_stop_reason(r);
+    if (!strcmp(stop, "running") && cdem_h5_reader_writer_alive(r) == 1)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "the run is being written and has no increment yet (increment 0 is "
+                         "written when its assembly is done): try again in a moment");
+    if (!strcmp(stop, "running") || !stop[0])
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "the file holds no increment: its writer stopped before writing "
+                         "increment 0 (killed or crashed; no writer holds the file)");
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                     "the file holds no increment: the run stopped (stop reason \"%s\"%s%.300s) "
+                     "before writing increment 0",
+                     stop, cdem_h5_reader_stop_detail(r)[0] ? ": " : "",
+                     cdem_h5_reader_stop_detail(r));
+}
 cdem_status cdem_analysis_open_source(const cdem_analysis_source *src, void *ctx,
                                       const cdem_params *params, cdem_analysis **out,
                                       cdem_error *err) {
@@ -108,14 +132,32 @@ cdem_status cdem_analysis_open_source(const cdem_analysis_source *src, void *ctx
             return st;
         }
     }
+    cdem_h5_reader *r = src->reader ? src->reader(ctx) : NULL;
     if (a->n == 0) {
+        const cdem_status st = no_increments(r, err); /* before the close closes r */
         cdem_analysis_close(a);
-        return CDEM_FAIL(err, CDEM_ERR_FORMAT, "analysis: the run has no increments");
+        return st;
     }
-    a->equil = 0;
+    /* The end of equilibration is the last increment of that phase once a later phase has
+     * begun (or the run completed); a run that stopped, was killed or still runs in
+     * equilibration has not written it yet (its last increment was 42 where the end was 56),
+     * and totals are then not defined: never guessed (docs/analysis.md). A run without
+     * equilibration increments measures from its first. */
+    size_t last_eq = SIZE_MAX;
     for (size_t i = 0; i < a->n; i++)
         if (a->infos[i].phase == CDEM_PHASE_EQUILIBRATION)
-            a->equil = i;
+            last_eq = i;
+    a->equil = last_eq == SIZE_MAX ? 0 : last_eq;
+    a->equil_known = 1;
+    if (last_eq == a->n - 1 && (!r || strcmp(cdem_h5_reader_stop_reason(r), "completed") != 0)) {
+        a->equil_known = 0;
+        snprintf(a->equil_why, sizeof a->equil_why, "%s",
+                 !r ? "the increments end in equilibration"
+                 : cdem_h5_reader_writer_alive(r) == 1 &&
+                         !strcmp(cdem_h5_reader_stop_reason(r), "running")
+                     ? "the run is still in equilibration"
+                     : "the run stopped during equilibration");
+    }
     *out = a;
     return CDEM_OK;
 }
@@ -161,6 +203,43 @@ const cdem_increment_info *cdem_analysis_info(const cdem_analysis *a, size_t ind
 size_t cdem_analysis_equil_index(const cdem_analysis *a) {
     return a->equil;
 }
+int cdem_analysis_equil_known(const cdem_analysis *a) {
+    return a->equil_known;
+}
+const char *cdem_analysis_equil_why(const cdem_analysis *a) {
+    return a->equil_known ? "" : a->equil_why;
+}
+int cdem_analysis_from_equil(const cdem_quantity *q) {
+    return q->family == CDEM_QF_TOTAL_DISP || q->family == CDEM_QF_TOTAL_STRAIN ||
+           q->family == CDEM_QF_CUM_STRAIN;
+}
+
+/* A computation on increment index against increment ref failed (ref == index: on index
+ * alone): its message, from code that sees only states ("duplicate element id 7 at slots 0
+ * and 1"), is prefixed with the run and the increments, so it names where (issue 35, item
+ * 10). The loads before it name their file and increment themselves. */
+static cdem_status in_increments(const cdem_analysis *a, cdem_status st, size_t index, size_t ref,
+                                 cdem_error *err) {
+    if (st == CDEM_OK || st == CDEM_ERR_NOMEM)
+        return st;
+    char against[64] = "";
+    if (ref != index)
+        snprintf(against, sizeof against, " against increment %d", (int)a->infos[ref].number);
+    cdem_error_prefix(err, "%s%sincrement %d%s", a->name ? a->name : "", a->name ? ": " : "",
+                      (int)a->infos[index].number, against);
+    return st;
+}
+
+/* CDEM_ERR_NOTFOUND: what (a quantity at an increment, ...) is measured from the end of
+ * equilibration, which the run has not reached. */
+static cdem_status equil_not_known(const cdem_analysis *a, const char *what, cdem_error *err) {
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                     "%s%s%s is not defined yet: it is measured from the end of equilibration, "
+                     "which is not reached: %s (its last increment, %d, is of the equilibration "
+                     "phase)",
+                     a->name ? a->name : "", a->name ? ": " : "", what, a->equil_why,
+                     (int)a->infos[a->n - 1].number);
+}
 const cdem_params *cdem_analysis_params(const cdem_analysis *a) {
     return &a->params;
 }
@@ -183,6 +262,13 @@ cdem_status cdem_analysis_find(const cdem_analysis *a, const char *spec, size_t 
         return CDEM_OK;
     }
     if (strcmp(spec, "equil") == 0) {
+        if (!a->equil_known)
+            return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                             "%s%sincrement 'equil': the end of equilibration is not reached: %s "
+                             "(its last increment, %d, is of the equilibration phase; the end is "
+                             "known once an increment of the deformation phase follows)",
+                             a->name ? a->name : "", a->name ? ": " : "", a->equil_why,
+                             (int)a->infos[a->n - 1].number);
         *index = a->equil;
         return CDEM_OK;
     }
@@ -302,7 +388,7 @@ static cdem_status for_total_groups(cdem_analysis *a, size_t index, pair_fn fn, 
             break;
         for (size_t i = 0; i < n; i++)
             sel[i] = group[i] == g;
-        st = fn(ref, cur, sel, user, err);
+        st = in_increments(a, fn(ref, cur, sel, user, err), index, g, err);
         if (st != CDEM_OK)
             break;
         done_below = g + 1;
@@ -370,9 +456,9 @@ static cdem_status cum_advance(cdem_analysis *a, size_t index, cdem_error *err) 
                 break;
             }
         }
-        st = cdem_strain_compute(prev, cur, NULL, 0.0, m, err);
+        st = in_increments(a, cdem_strain_compute(prev, cur, NULL, 0.0, m, err), k, k - 1, err);
         if (st == CDEM_OK)
-            st = cdem_strain_cum_add(&a->cum, cur, m, err);
+            st = in_increments(a, cdem_strain_cum_add(&a->cum, cur, m, err), k, k - 1, err);
         if (st != CDEM_OK) {
             cdem_strain_cum_reset(&a->cum);
             a->cum_at = SIZE_MAX;
@@ -401,6 +487,12 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
     for (size_t i = 0; i < n; i++)
         v[i] = ux[i] = uy[i] = NAN;
     fill_nan_measures(m, n);
+    if (cdem_analysis_from_equil(q) && !a->equil_known) {
+        char what[160];
+        snprintf(what, sizeof what, "%s at increment %d", q->name, (int)a->infos[index].number);
+        st = equil_not_known(a, what, err);
+        goto done;
+    }
     pair_out o = {ux, uy, m};
     switch (q->family) {
     case CDEM_QF_INCR_DISP: {
@@ -409,7 +501,8 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         if (st == CDEM_OK)
             st = cdem_analysis_state(a, index, &cur, err);
         if (st == CDEM_OK)
-            st = cdem_displacement_compute(ref, cur, NULL, ux, uy, err);
+            st = in_increments(a, cdem_displacement_compute(ref, cur, NULL, ux, uy, err), index,
+                               incr_ref(index), err);
         if (st == CDEM_OK)
             pick_disp(ux, uy, n, q->component, v);
         break;
@@ -427,7 +520,8 @@ cdem_status cdem_analysis_values(cdem_analysis *a, size_t index, const cdem_quan
         if (st == CDEM_OK)
             st = cdem_analysis_state(a, index, &cur, err);
         if (st == CDEM_OK)
-            st = cdem_strain_compute(ref, cur, NULL, 0.0, m, err);
+            st = in_increments(a, cdem_strain_compute(ref, cur, NULL, 0.0, m, err), index,
+                               incr_ref(index), err);
         if (st == CDEM_OK)
             for (size_t i = 0; i < n; i++)
                 v[i] = pick_strain(&m[i], q->component);
@@ -507,6 +601,8 @@ cdem_status cdem_analysis_limits(cdem_analysis *a, size_t index, const cdem_quan
     if (index >= a->n)
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "increment index %zu out of range (0..%zu)", index,
                          a->n - 1);
+    if (cdem_analysis_from_equil(q) && !a->equil_known)
+        return equil_not_known(a, q->name, err); /* no scale for values that do not exist */
     const int sym = q->scale == CDEM_SCALE_SIGNED;
     const double tsm = a->params.total_strain_max;
     if (strcmp(q->unit, "deg") == 0) { /* directions: the whole half circle */
@@ -608,12 +704,14 @@ cdem_status cdem_analysis_axes(cdem_analysis *a, size_t index, cdem_axes_kind ki
     const cdem_state *cur, *ref;
     if (kind == CDEM_AXES_STRESS) {
         CDEM_TRY(cdem_analysis_state(a, index, &cur, err));
-        return cdem_axes_stress(cur, 0.0, out, err);
+        return in_increments(a, cdem_axes_stress(cur, 0.0, out, err), index, index, err);
     }
+    if (kind == CDEM_AXES_TOTAL_STRAIN && !a->equil_known)
+        return equil_not_known(a, "the total strain axes", err);
     size_t r = kind == CDEM_AXES_INCR_STRAIN ? incr_ref(index) : a->equil;
     if (kind == CDEM_AXES_TOTAL_STRAIN && index < a->equil)
         return CDEM_OK; /* no total strain during equilibration: no axes (n = 0) */
     CDEM_TRY(cdem_analysis_state(a, r, &ref, err));
     CDEM_TRY(cdem_analysis_state(a, index, &cur, err));
-    return cdem_axes_strain(ref, cur, 0.0, out, err);
+    return in_increments(a, cdem_axes_strain(ref, cur, 0.0, out, err), index, r, err);
 }

@@ -7,6 +7,10 @@
  *     equilibration; the first increment when none is), growth elements (born after it)
  *     against the first increment numbered >= their birth; NaN before the end of
  *     equilibration; cumulative: sum over successive pairs from the end of equilibration.
+ *   The end of equilibration is known once an increment of a later phase follows it (or the
+ *     run completed): a run stopped, killed or still running in equilibration has not written
+ *     it, and total and cumulative quantities then fail (CDEM_ERR_NOTFOUND, "not defined
+ *     yet") rather than measure from its last increment.
  * Ownership: the context owns its cache; states returned through `const cdem_state **` are
  * borrowed and stay valid until the next call on the same context; value arrays are
  * malloc'd and owned by the caller. Thread safety: one context per thread (the cache
@@ -58,13 +62,22 @@ void cdem_analysis_set_name(cdem_analysis *a, const char *name);
 
 size_t cdem_analysis_count(const cdem_analysis *a);
 const cdem_increment_info *cdem_analysis_info(const cdem_analysis *a, size_t index);
-/* Index of the end-of-equilibration increment. */
+/* Index of the end-of-equilibration increment (meaningful when cdem_analysis_equil_known). */
 size_t cdem_analysis_equil_index(const cdem_analysis *a);
+/* 1 when the end of equilibration is known, 0 while the run has not left equilibration (its
+ * increments all are of that phase and it did not complete: stopped, killed or running). */
+int cdem_analysis_equil_known(const cdem_analysis *a);
+/* Why it is not known ("the run stopped during equilibration", "the run is still in
+ * equilibration"), "" when it is. */
+const char *cdem_analysis_equil_why(const cdem_analysis *a);
+/* 1 for a quantity measured from the end of equilibration (total and cumulative ones). */
+int cdem_analysis_from_equil(const cdem_quantity *q);
 const cdem_params *cdem_analysis_params(const cdem_analysis *a);
 /* The reader of a file-backed context (NULL otherwise). */
 cdem_h5_reader *cdem_analysis_reader(const cdem_analysis *a);
 
-/* Resolves "K" (increment number), "last", "first" or "equil" to an index. */
+/* Resolves "K" (increment number), "last", "first" or "equil" to an index ("equil" fails
+ * while the end of equilibration is not known). */
 cdem_status cdem_analysis_find(const cdem_analysis *a, const char *spec, size_t *index,
                                cdem_error *err);
 

@@ -312,6 +312,11 @@ cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, 
                          "wedge: the run is a '%s' run (boundary.mode); the wedge measurement "
                          "needs boundary.mode = detachment",
                          cdem_mode_name(prm->mode));
+    if (!cdem_analysis_equil_known(a))
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "wedge: the wedge is measured from the end of equilibration, which is not "
+                         "reached: %s (its last increment, %d, is of the equilibration phase)",
+                         cdem_analysis_equil_why(a), (int)cdem_analysis_info(a, count - 1)->number);
     if (first < e)
         first = e;
     if (last < e)
@@ -339,8 +344,9 @@ cdem_status cdem_wedge_analyse(cdem_analysis *a, const cdem_wedge_options *opt, 
         st = cdem_analysis_state(a, k, &s, err);
         if (st == CDEM_OK)
             st = cdem_wedge_measure(ref, &r0, s, row, err);
-        if (st != CDEM_OK) {
-            cdem_error_prefix(err, "increment %d", (int)in->number);
+        if (st != CDEM_OK) { /* where: the messages of the state code name no increment */
+            cdem_error_prefix(err, "increment %d against increment %d (the end of equilibration)",
+                              (int)in->number, (int)cdem_analysis_info(a, e)->number);
             break;
         }
         row->number = (int)in->number;

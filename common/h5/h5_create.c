@@ -287,6 +287,7 @@ cdem_status h5i_writer_alloc(const char *path, cdem_h5_writer **out, cdem_error 
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
         w->data[k] = -1;
     w->last_number = -1;
+    w->last_sample_step = -1;
     w->chunk_rows = CHUNK_ELEMS;
     w->sync = 1;
     w->path = h5i_dup_str(path);

@@ -202,8 +202,32 @@ extern const index_member h5i_ckpt_members[N_CKPT_MEMBERS];
 /* Builds the memory (native, padded) or file (little-endian, packed) compound type. */
 hid_t h5i_make_compound(const index_member *m, size_t nm, size_t mem_size, int file);
 
+/* The checks of the values a run file holds against the physical bounds (CDEM_FILE_MAX_*,
+ * h5format.h; docs/format.md, "Physical bounds"), shared by the writer (it refuses to write
+ * what fails) and the reader (it refuses to read it). Each returns NULL when the value is
+ * sensible, else what is wrong with the value in it (written into buf). */
+/* An index row's own values and their order after prev (NULL for the first row). */
+const char *h5i_bad_index_values(const index_row *row, const index_row *prev, char *buf,
+                                 size_t cap);
+/* The same, and its rows within the extents of the element and stress datasets. */
 const char *h5i_bad_index_row(const index_row *row, const index_row *prev, hsize_t data_ext,
-                              hsize_t stress_ext);
+                              hsize_t stress_ext, char *buf, size_t cap);
+/* Element i of s (*field: the dataset of the value refused). */
+const char *h5i_bad_element(const cdem_state *s, size_t i, const char **field, char *buf,
+                            size_t cap);
+/* A series sample, except its step and time (their order is the reader's check). Bit c of
+ * absent: column c is not in the file (read as NaN). blown_up: the file's stop reason is
+ * "numerical-failure", whose last samples may hold Inf or NaN. *column: the column refused. */
+const char *h5i_bad_sample(const cdem_series_sample *q, int blown_up, unsigned absent,
+                           const char **column, char *buf, size_t cap);
+/* 1 when two of the n ids are equal (*first < *second: their positions), 0 when none is, -1
+ * when out of memory. Linear for ascending ids (every file written since 2026-11-27). */
+int h5i_find_duplicate_id(const int32_t *id, size_t n, size_t *first, size_t *second);
+/* 1 when reason is one of cdem_stop_reasons or "" (none recorded). */
+int h5i_known_stop_reason(const char *reason);
+/* text with every byte that is not part of printable UTF-8 (nor a newline or tab) written as
+ * \xNN: a stop detail or summary is printed to a terminal. malloc'd, NULL when out of memory. */
+char *h5i_printable(const char *text);
 hsize_t h5i_chunk_end(hsize_t rows, hsize_t chunk_rows);
 hsize_t h5i_chunk_rows_of(hid_t ds);
 
@@ -273,6 +297,9 @@ struct cdem_h5_writer {
     hsize_t index_len;              /* rows in /increments/index */
     int32_t last_number;            /* number of the last increment written (-1: none) */
     int64_t last_step;              /* its step */
+    index_row last_row;             /* its row (the next one is checked against it) */
+    int64_t last_sample_step;       /* step of the last series sample (-1: none) */
+    double last_sample_time;        /* its time, s (0: none) */
     ckpt_row ckpt[2];               /* the checkpoint index as on disk */
     unsigned char *ckpt_buf;        /* serialised snapshot, grown as needed */
     size_t ckpt_cap;                /* bytes allocated in ckpt_buf */
@@ -349,7 +376,9 @@ struct cdem_h5_reader {
     long seed;                    /* root attribute seed */
     int unclosed;                 /* 1: the writer did not close the file (status flag set) */
     int version;                  /* format_version of the file: 1 or 2 */
-    int swmr;                     /* 1: opened in SWMR-read mode (writer running or killed) */
+    int swmr;                     /* 1: opened in SWMR-read mode (a writer holds the lock) */
+    int writer;                   /* a writer held the lock at open: 1 yes, 0 no, -1 cannot
+                                     tell (cdem_runlock_probe; 0 for a closed file) */
     hid_t data[N_ELEMENT_FIELDS]; /* version 2: /increments/<field>, -1 when not open */
     hid_t index;                  /* version 2: /increments/index, -1 when not open */
     size_t n_skipped;             /* unclosed file: increments left out as incompletely flushed */

@@ -62,6 +62,23 @@ cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "cannot write %s: cannot reach folder %s: %s",
                          path, dir, strerror(e));
     }
+    /* A folder a run cannot write to is named as such, not as short of space: a read-only
+     * file system reports little or no free space, and the caller's advice for too little
+     * space ("free some space ... or --ignore-free-space") would not help (issue 35, item
+     * 10). So neither is CDEM_ERR_IO, which the caller keeps for too little space. A folder
+     * of mode 0555 is writable for root, and access() says so. */
+    if (sv.f_flag & ST_RDONLY)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "cannot write %s: folder %s is on a read-only file system; write the "
+                         "run elsewhere (-o)",
+                         path, dir);
+    if (access(dir, W_OK | X_OK) != 0) {
+        const int e = errno;
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "cannot write %s: folder %s is not writable (%s); write the run "
+                         "elsewhere (-o) or make the folder writable",
+                         path, dir, strerror(e));
+    }
     double avail = (double)sv.f_bavail * (double)sv.f_frsize;
     if (avail < bytes_needed)
         return CDEM_FAIL(err, CDEM_ERR_IO,
@@ -92,8 +109,12 @@ static void describe_existing(const char *path, int *is_cdem, int *resumable, in
     *completed = strcmp(stop, "completed") == 0;
     *resumable = strcmp(cdem_h5_reader_source(r), "cdem-run") == 0 && !*completed &&
                  cdem_h5_reader_format_version(r) >= 2;
-    snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\", %zu increments",
-             cdem_h5_reader_source(r), stop, cdem_h5_reader_increment_count(r));
+    /* a file still saying "running" that no writer holds was interrupted (killed) */
+    const int killed = !strcmp(stop, "running") && cdem_h5_reader_writer_alive(r) == 0;
+    snprintf(desc, cap, "a cdem run file written by %.60s: stop reason \"%.40s\"%s, %zu increments",
+             cdem_h5_reader_source(r), stop,
+             killed ? " but no writer holds it (interrupted: killed or crashed)" : "",
+             cdem_h5_reader_increment_count(r));
     cdem_h5_reader_close(r);
 }
 

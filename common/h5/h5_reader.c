@@ -41,7 +41,21 @@ void cdem_h5_reader_close(cdem_h5_reader *r) {
     free(r);
 }
 
-static cdem_status read_root_text(cdem_h5_reader *r, const char *name, char **out,
+/* *text replaced by its printable form (h5i_printable): the texts of a file are printed to
+ * terminals and into JSON, and a damaged or forged one may hold any bytes (a stop reason of
+ * 0xFF 0xFE was printed raw). */
+static int make_printable(char **text) {
+    char *p = h5i_printable(*text);
+    if (!p)
+        return -1;
+    free(*text);
+    *text = p;
+    return 0;
+}
+
+/* A root text attribute into *out (malloc'd, "" when absent); printable when shown (every
+ * text but the parameter file, which is parsed, never printed by the reader). */
+static cdem_status read_root_text(cdem_h5_reader *r, const char *name, char **out, int shown,
                                   cdem_error *err) {
     int rc = h5i_get_str_attr(r->file, name, out);
     if (rc < 0)
@@ -49,7 +63,37 @@ static cdem_status read_root_text(cdem_h5_reader *r, const char *name, char **ou
                       r->path, name);
     if (rc > 0 && !(*out = h5i_dup_str("")))
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+    if (shown && make_printable(out) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
     return CDEM_OK;
+}
+
+/* The stop reason must be one the writer records (h5format.h, cdem_stop_reasons); the detail
+ * is made printable. Called once the texts are read (either version). */
+static cdem_status check_stop_texts(cdem_h5_reader *r, const char *where, cdem_error *err) {
+    if (!h5i_known_stop_reason(r->stop_reason)) {
+        char *shown = h5i_printable(r->stop_reason);
+        cdem_status st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                                   "%s: %s is \"%.80s\", not a stop reason (running, completed, "
+                                   "interrupted, stopped-early, numerical-failure, "
+                                   "write-failure, error): damaged file",
+                                   r->path, where, shown ? shown : "?");
+        free(shown);
+        return st;
+    }
+    if (make_printable(&r->stop_detail) != 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+    return CDEM_OK;
+}
+
+/* "integer", "float", ... for messages. */
+static const char *class_name(H5T_class_t c) {
+    return c == H5T_INTEGER    ? "integer"
+           : c == H5T_FLOAT    ? "float"
+           : c == H5T_STRING   ? "string"
+           : c == H5T_COMPOUND ? "compound"
+           : c == H5T_ARRAY    ? "array"
+                               : "other";
 }
 
 /* Version 2: reads a scalar fixed-length string dataset (/stop_reason, /stop_detail) into a
@@ -105,6 +149,33 @@ static int read_rows_retrying(const cdem_h5_reader *r, hid_t ds, hid_t mt, hsize
     }
 }
 
+/* A closed file with the commit record: its writer wrote every row to both the record and
+ * /increments/index, so their lengths agree; a record whose rows were blanked (all zero
+ * passes as "never written") would otherwise read as a run of fewer increments, or none. The
+ * index's chunks are not read (damage there costs no increment), only its extent; an index
+ * that cannot be opened is left to HDF5 tools. */
+static cdem_status check_index_agrees(cdem_h5_reader *r, hsize_t committed, cdem_error *err) {
+    if (r->index < 0 && (r->index = H5Dopen2(r->file, "increments/index", H5P_DEFAULT)) < 0) {
+        H5Eclear2(H5E_DEFAULT);
+        return CDEM_OK;
+    }
+    hid_t sp = H5Dget_space(r->index);
+    hsize_t rows = 0;
+    const int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+    if (rank == 1)
+        H5Sget_simple_extent_dims(sp, &rows, NULL);
+    if (sp >= 0)
+        H5Sclose(sp);
+    H5Eclear2(H5E_DEFAULT);
+    if (rank != 1 || rows == committed)
+        return CDEM_OK;
+    return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                     "%s: the commit record /increments/commit holds %llu committed rows but "
+                     "/increments/index %llu, in a file its writer closed (it writes every row to "
+                     "both): damaged file",
+                     r->path, (unsigned long long)committed, (unsigned long long)rows);
+}
+
 /* Version 2, a file with the commit record (h5_commit.c): its committed rows into *out
  * (malloc'd, *rows of them). The dataset is opened for this read alone, so a reader that
  * follows a running writer reads the rows from the file every time, never from a buffer. */
@@ -143,6 +214,8 @@ static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_
         st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
                        "%s: /increments/commit row %llu: %s; rows 0..%lld are valid: damaged file",
                        r->path, (unsigned long long)bad, why, (long long)committed - 1);
+    if (st == CDEM_OK && !r->unclosed)
+        st = check_index_agrees(r, committed, err);
     if (st == CDEM_OK) {
         for (hsize_t i = 0; i < committed; i++)
             ix[i] = c[i].row;
@@ -163,6 +236,42 @@ static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_
     return st;
 }
 
+/* Version 2, a file without the commit record: /increments/index must be a 1-D compound
+ * dataset with every member of an index row, of its type class (an index replaced by a 5 x 5
+ * float dataset read as a file of no increments beside a stop detail of 284). */
+static cdem_status check_index_type(cdem_h5_reader *r, cdem_error *err) {
+    hid_t t = H5Dget_type(r->index), sp = H5Dget_space(r->index);
+    const H5T_class_t cls = t >= 0 ? H5Tget_class(t) : H5T_NO_CLASS;
+    const int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+    const char *missing = NULL;
+    for (size_t k = 0; k < N_INDEX_MEMBERS && cls == H5T_COMPOUND && !missing; k++) {
+        const index_member *m = &h5i_index_members[k];
+        const int at = H5Tget_member_index(t, m->name);
+        const H5T_class_t mc = at >= 0 ? H5Tget_member_class(t, (unsigned)at) : H5T_NO_CLASS;
+        if (mc != (m->kind == IX_F64 ? H5T_FLOAT : H5T_INTEGER))
+            missing = m->name;
+    }
+    hid_t es = h5i_keep_errors(cls != H5T_COMPOUND || rank != 1 || missing);
+    if (t >= 0)
+        H5Tclose(t);
+    if (sp >= 0)
+        H5Sclose(sp);
+    h5i_restore_errors(es);
+    H5Eclear2(H5E_DEFAULT);
+    if (cls == H5T_COMPOUND && rank == 1 && !missing)
+        return CDEM_OK;
+    if (missing)
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: dataset /increments/index (the list of increments) lacks the "
+                         "member '%s' of its documented type (docs/format.md): damaged file",
+                         r->path, missing);
+    return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                     "%s: dataset /increments/index (the list of increments) is a %d-D %s "
+                     "dataset, not the 1-D compound dataset of index rows (number, step, time, "
+                     "...; docs/format.md): damaged file",
+                     r->path, rank, class_name(cls));
+}
+
 /* Version 2, a file without the commit record (written before it existed): the rows of
  * /increments/index into *out (malloc'd, *rows of them). In a file whose writer did not
  * close it, a last chunk whose checksum fails because a kill tore its rewrite gives back the
@@ -176,6 +285,7 @@ static cdem_status read_old_index(cdem_h5_reader *r, index_row **out, hsize_t *r
                       r->path);
     if (r->swmr && H5Drefresh(r->index) < 0)
         return H5FAIL(err, CDEM_ERR_IO, "%s: cannot refresh /increments/index", r->path);
+    CDEM_TRY(check_index_type(r, err));
     hsize_t n = h5i_extent_of(r->index);
     if (n > MAX_ELEMENTS)
         return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/index claims %llu rows", r->path,
@@ -233,6 +343,25 @@ static int all_zero(const void *p, size_t n) {
     return 1;
 }
 
+/* A run that completed, or was stopped and wrote its final increment, holds increments:
+ * such a stop reason in a closed file of none is damage, not "increments: 0" (the audit of
+ * issue 35 saw that beside "completed ... 284 increments"). */
+static cdem_status check_not_empty(cdem_h5_reader *r, cdem_error *err) {
+    const char *why = r->stop_reason;
+    if (r->n_incr > 0 || r->unclosed ||
+        (strcmp(why, "completed") && strcmp(why, "interrupted") && strcmp(why, "stopped-early")))
+        return CDEM_OK;
+    return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                     "%s: the run's stop reason is \"%s\" (\"%.200s\"), which it records after "
+                     "writing increments, but the file lists none (%s holds no valid row): "
+                     "damaged file",
+                     r->path, why, r->stop_detail,
+                     r->version < 2 ? "/increments has no group"
+                     : H5Lexists(r->file, "increments/commit", H5P_DEFAULT) > 0
+                         ? "the commit record /increments/commit"
+                         : "/increments/index");
+}
+
 /* Version 2: (re)reads the list of increments and the stop reason. The list comes from the
  * commit record (/increments/commit) when the file has one, else from /increments/index;
  * in SWMR-read mode the element datasets are refreshed after it, so that they are at least
@@ -244,6 +373,7 @@ static int all_zero(const void *p, size_t n) {
 static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
     CDEM_TRY(read_text_dataset(r, "stop_reason", &r->stop_reason, err));
     CDEM_TRY(read_text_dataset(r, "stop_detail", &r->stop_detail, err));
+    CDEM_TRY(check_stop_texts(r, "dataset /stop_reason", err));
     r->n_skipped = 0;
     const htri_t has_commit = H5Lexists(r->file, "increments/commit", H5P_DEFAULT);
     if (has_commit < 0)
@@ -307,7 +437,9 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
     }
     r->n_incr = 0;
     for (hsize_t i = 0; st == CDEM_OK && i < rows; i++) {
-        const char *why = h5i_bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext);
+        char buf[300];
+        const char *why =
+            h5i_bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext, buf, sizeof buf);
         /* A follower can see a commit row before HDF5 shows it the extents the writer flushed
          * before that row (seen under load: a row "beyond the element datasets" that a later
          * refresh covers): it looks again for about 0.6 s, and lists no row it cannot see. */
@@ -315,7 +447,8 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
             struct timespec ts = {0, (long)(10 * 1000 * 1000) << attempt}; /* 10 .. 320 ms */
             nanosleep(&ts, NULL);
             refresh_extents(r, &data_ext, &stress_ext);
-            why = h5i_bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext);
+            why = h5i_bad_index_row(&ix[i], i ? &ix[i - 1] : NULL, data_ext, stress_ext, buf,
+                                    sizeof buf);
         }
         if (why && has_commit && r->swmr) {
             r->n_skipped = (size_t)(rows - i);
@@ -332,12 +465,9 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
                 r->n_skipped = (size_t)(rows - i);
                 break;
             }
-            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                           "%s: %s row %llu (increment %d): %s (step %lld, time %.17g s, net "
-                           "displacement %.17g m): damaged file",
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: %s row %llu (increment %d): %s: damaged file",
                            r->path, has_commit ? "/increments/commit" : "/increments/index",
-                           (unsigned long long)i, (int)ix[i].number, why, (long long)ix[i].step,
-                           ix[i].time, ix[i].net_displacement);
+                           (unsigned long long)i, (int)ix[i].number, why);
             break;
         }
         incr_entry *e = &r->incr[r->n_incr++];
@@ -357,7 +487,7 @@ static cdem_status scan_v2(cdem_h5_reader *r, cdem_error *err) {
         snprintf(e->name, sizeof e->name, "%06d", (int)ix[i].number);
     }
     free(ix);
-    return st;
+    return st == CDEM_OK ? check_not_empty(r, err) : st;
 }
 
 cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *err) {
@@ -414,12 +544,13 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
      * second open whose locking setting differs). */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_file_locking(fapl, 0, 1);
-    int live = 0;
-    if (status & 0x04) {
+    r->writer = 0;
+    if (r->unclosed) {
         char *real = realpath(path, NULL);
-        live = cdem_runlock_probe(real ? real : path, NULL, 0) != 0;
+        r->writer = cdem_runlock_probe(real ? real : path, NULL, 0);
         free(real);
     }
+    const int live = (status & 0x04) && r->writer != 0;
     if (live) {
         H5Pset_metadata_read_attempts(fapl, SWMR_READ_ATTEMPTS);
         r->file = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
@@ -486,16 +617,18 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     if (h5i_get_num_attr(r->file, "seed", H5T_NATIVE_INT64, &seed) < 0)
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: root attribute 'seed' is unreadable", path);
     r->seed = (long)seed;
-    CDEM_TRY(read_root_text(r, "summary", &r->summary, err));
-    CDEM_TRY(read_root_text(r, "params_text", &r->params_text, err));
-    CDEM_TRY(read_root_text(r, "program_version", &r->program_version, err));
-    CDEM_TRY(read_root_text(r, "source", &r->source, err));
-    CDEM_TRY(read_root_text(r, "created", &r->created, err));
+    CDEM_TRY(read_root_text(r, "summary", &r->summary, 1, err));
+    CDEM_TRY(read_root_text(r, "params_text", &r->params_text, 0, err));
+    CDEM_TRY(read_root_text(r, "program_version", &r->program_version, 1, err));
+    CDEM_TRY(read_root_text(r, "source", &r->source, 1, err));
+    CDEM_TRY(read_root_text(r, "created", &r->created, 1, err));
     if (r->version >= 2)
         return scan_v2(r, err);
-    CDEM_TRY(read_root_text(r, "stop_reason", &r->stop_reason, err));
-    CDEM_TRY(read_root_text(r, "stop_detail", &r->stop_detail, err));
-    return h5i_v1_list_increments(r, err);
+    CDEM_TRY(read_root_text(r, "stop_reason", &r->stop_reason, 0, err));
+    CDEM_TRY(read_root_text(r, "stop_detail", &r->stop_detail, 0, err));
+    CDEM_TRY(check_stop_texts(r, "root attribute stop_reason", err));
+    CDEM_TRY(h5i_v1_list_increments(r, err));
+    return check_not_empty(r, err);
 }
 
 cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_error *err) {
@@ -536,6 +669,42 @@ cdem_status cdem_h5_reader_increment_info(const cdem_h5_reader *r, size_t index,
     return CDEM_OK;
 }
 
+/* The rule of docs/format.md ("Counting"): the last increment of the equilibration phase is
+ * its end only once an increment of a later phase follows it, or the run completed. A run
+ * stopped, killed or still running in equilibration has not written its end yet (its last
+ * increment was 42 where the end was 56): never guessed. */
+static cdem_status equil_end(const cdem_h5_reader *r, size_t *index, const char *what,
+                             cdem_error *err) {
+    size_t last = SIZE_MAX;
+    for (size_t i = r->n_incr; i-- > 0 && last == SIZE_MAX;)
+        if (r->incr[i].info.phase == CDEM_PHASE_EQUILIBRATION)
+            last = i;
+    if (last == SIZE_MAX)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "%s: %sno increment is in the equilibration phase, so the file has no "
+                         "end of equilibration",
+                         r->path, what);
+    if (last + 1 < r->n_incr || !strcmp(r->stop_reason, "completed")) {
+        *index = last;
+        return CDEM_OK;
+    }
+    return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                     "%s: %sthe end of equilibration is not reached: %s (its last increment, %d, "
+                     "is of the equilibration phase; the end is known once an increment of the "
+                     "deformation phase follows)",
+                     r->path, what,
+                     r->writer == 1 && !strcmp(r->stop_reason, "running")
+                         ? "the run is still in equilibration"
+                         : "the run stopped during equilibration",
+                     (int)r->incr[last].info.number);
+}
+
+cdem_status cdem_h5_reader_equil_end(const cdem_h5_reader *r, size_t *index, cdem_error *err) {
+    if (!r || !index)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_equil_end: bad arguments");
+    return equil_end(r, index, "", err);
+}
+
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err) {
     if (!r || !spec || !index)
@@ -553,14 +722,7 @@ cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *s
         return CDEM_OK;
     }
     if (!strcmp(spec, "equil")) {
-        for (size_t i = r->n_incr; i-- > 0;)
-            if (r->incr[i].info.phase == CDEM_PHASE_EQUILIBRATION) {
-                *index = i;
-                return CDEM_OK;
-            }
-        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
-                         "%s: increment 'equil': no increment is in the equilibration phase",
-                         r->path);
+        return equil_end(r, index, "increment 'equil': ", err);
     }
     const char *p = spec;
     while (isspace((unsigned char)*p))
@@ -619,6 +781,52 @@ static cdem_status load_v2(cdem_h5_reader *r, const incr_entry *e, cdem_state *s
     return CDEM_OK;
 }
 
+/* The dataset and row of value i of field (an element dataset's name) of increment e, for
+ * messages: "/increments/x row 8197" (version 2), "/increments/000003/x row 5" (version 1). */
+static void row_name(const cdem_h5_reader *r, const incr_entry *e, const char *field, size_t i,
+                     char *buf, size_t cap) {
+    const int stress = field[0] == 's'; /* sxx, syy, sxy */
+    if (r->version >= 2)
+        snprintf(buf, cap, "/increments/%s row %llu", field,
+                 (unsigned long long)(stress ? e->stress_offset : e->offset) +
+                     (unsigned long long)i);
+    else
+        snprintf(buf, cap, "/increments/%s/%s row %zu", e->name, field, i);
+}
+
+/* A loaded increment's values against the physical bounds (h5i_bad_element) and its ids
+ * unique: a checksum says the bytes are the writer's, not that they are a model's (radii of
+ * 0 made compute print 1288 nan; a duplicated id failed deep inside the strain code, naming
+ * neither file nor increment). */
+static cdem_status check_loaded(const cdem_h5_reader *r, const incr_entry *e, const cdem_state *s,
+                                cdem_error *err) {
+    char why[200], where[160];
+    for (size_t i = 0; i < s->n; i++) {
+        const char *field = NULL;
+        if (!h5i_bad_element(s, i, &field, why, sizeof why))
+            continue;
+        row_name(r, e, field, i, where, sizeof where);
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: increment %d, %s (element id %d): %s (docs/format.md, \"Physical "
+                         "bounds\"): damaged file",
+                         r->path, (int)e->info.number, where, (int)s->id[i], why);
+    }
+    size_t a = 0, b = 0;
+    const int dup = h5i_find_duplicate_id(s->id, s->n, &a, &b);
+    if (dup < 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory checking the ids of increment %d",
+                         r->path, (int)e->info.number);
+    if (dup) {
+        row_name(r, e, "id", a, where, sizeof where);
+        row_name(r, e, "id", b, why, sizeof why);
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: increment %d: element id %d appears twice, at %s and at %s (ids are "
+                         "unique within an increment): damaged file",
+                         r->path, (int)e->info.number, (int)s->id[a], where, strstr(why, "row"));
+    }
+    return CDEM_OK;
+}
+
 cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_state *s,
                                           cdem_increment_info *info, cdem_error *err) {
     if (!r || !s)
@@ -627,17 +835,13 @@ cdem_status cdem_h5_reader_load_increment(cdem_h5_reader *r, size_t index, cdem_
         return CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s: increment index %zu (the file has %zu)",
                          r->path, index, r->n_incr);
     const incr_entry *e = &r->incr[index];
-    if (r->version >= 2) {
-        cdem_status st = load_v2(r, e, s, err);
-        if (st != CDEM_OK) {
-            cdem_state_free(s);
-            return st;
-        }
-        if (info)
-            *info = e->info;
-        return CDEM_OK;
+    cdem_status st = r->version >= 2 ? load_v2(r, e, s, err) : h5i_v1_load(r, e, s, err);
+    if (st == CDEM_OK)
+        st = check_loaded(r, e, s, err);
+    if (st != CDEM_OK) {
+        cdem_state_free(s);
+        return st;
     }
-    CDEM_TRY(h5i_v1_load(r, e, s, err));
     if (info)
         *info = e->info;
     return CDEM_OK;
@@ -680,10 +884,16 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
             H5Tclose(t);
         if (sp >= 0)
             H5Sclose(sp);
-        if (rank != 1 || (cls != H5T_INTEGER && cls != H5T_FLOAT)) {
+        /* each column of its documented class: a float step (or an integer time) is a
+         * forgery, not a file any writer made */
+        const H5T_class_t want =
+            h5i_series_columns[opened].type == COL_I64 ? H5T_INTEGER : H5T_FLOAT;
+        if (rank != 1 || cls != want) {
             st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                           "%s: dataset /%s is not a 1-D numeric dataset (rank %d, class %d)",
-                           r->path, name, rank, (int)cls);
+                           "%s: dataset /%s is a %d-D %s dataset; the column is a 1-D %s dataset "
+                           "(docs/format.md, \"/series\"): damaged file",
+                           r->path, name, rank, class_name(cls),
+                           want == H5T_INTEGER ? "integer (int64)" : "float (float64)");
             opened++;
             break;
         }
@@ -759,7 +969,7 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
      * of order is damage (files written before the series carried a checksum). */
     for (hsize_t i = 0; st == CDEM_OK && i < len; i++) {
         const cdem_series_sample *q = &out[i], *p = i ? &out[i - 1] : NULL;
-        if (q->step >= 0 && isfinite(q->time) && q->time >= 0.0 &&
+        if (q->step >= 0 && q->time >= 0.0 && q->time <= CDEM_FILE_MAX_TIME &&
             (!p || (q->step > p->step && q->time >= p->time)))
             continue;
         if (r->unclosed) {
@@ -769,9 +979,24 @@ cdem_status cdem_h5_reader_read_series(cdem_h5_reader *r, cdem_series_sample **s
         st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
                        "%s: /series sample %llu (step %lld, time %.17g s) is out of order (the "
                        "previous one is step %lld, time %.17g s; steps must increase and times "
-                       "must be finite, >= 0 and not decrease): damaged file",
+                       "must be finite, in 0..1e9 s and not decrease): damaged file",
                        r->path, (unsigned long long)i, (long long)q->step, q->time,
                        p ? (long long)p->step : -1LL, p ? p->time : 0.0);
+    }
+    /* Every other value within the physical bounds (a run that blew up may end on samples of
+     * Inf or NaN: its stop reason says so). */
+    unsigned absent = 0;
+    for (size_t c = 0; st == CDEM_OK && c < N_SERIES; c++)
+        absent |= (unsigned)(ds[c] < 0) << c;
+    const int blown_up = !strcmp(r->stop_reason, "numerical-failure");
+    for (hsize_t i = 0; st == CDEM_OK && i < len; i++) {
+        const char *column = NULL;
+        char why[160];
+        if (h5i_bad_sample(&out[i], blown_up, absent, &column, why, sizeof why))
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: /series/%s sample %llu (step %lld): %s (docs/format.md, "
+                           "\"Physical bounds\"): damaged file",
+                           r->path, column, (unsigned long long)i, (long long)out[i].step, why);
     }
     for (size_t c = 0; c < opened && c < N_SERIES; c++)
         if (ds[c] >= 0)
@@ -820,6 +1045,10 @@ long cdem_h5_reader_seed(const cdem_h5_reader *r) {
 
 int cdem_h5_reader_unclosed(const cdem_h5_reader *r) {
     return r ? r->unclosed : 0;
+}
+
+int cdem_h5_reader_writer_alive(const cdem_h5_reader *r) {
+    return r ? r->writer : 0;
 }
 
 int cdem_h5_reader_format_version(const cdem_h5_reader *r) {

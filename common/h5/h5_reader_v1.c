@@ -222,6 +222,28 @@ cdem_status h5i_v1_list_increments(cdem_h5_reader *r, cdem_error *err) {
     }
     if (r->n_incr > 1)
         qsort(r->incr, r->n_incr, sizeof *r->incr, cmp_incr);
+    /* the values of each group's attributes, as those of an index row (h5_layout.c) */
+    index_row prev = {0};
+    for (size_t i = 0; i < r->n_incr; i++) {
+        const cdem_increment_info *in = &r->incr[i].info;
+        const index_row row = {.number = in->number,
+                               .phase = in->phase,
+                               .step = in->step,
+                               .time = in->time,
+                               .net_displacement = in->net_displacement,
+                               .axial_strain = in->axial_strain,
+                               .differential_stress = in->differential_stress,
+                               .sea_level = in->sea_level,
+                               .n = in->n_elements,
+                               .has_stress = in->has_stress};
+        char buf[300];
+        const char *why = h5i_bad_index_values(&row, i ? &prev : NULL, buf, sizeof buf);
+        if (why)
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                             "%s: /increments/%s (increment %d): %s: damaged file", path,
+                             r->incr[i].name, (int)in->number, why);
+        prev = row;
+    }
     return CDEM_OK;
 }
 

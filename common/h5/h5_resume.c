@@ -286,8 +286,10 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     hsize_t rows = 0;
     CDEM_TRY(read_rows_to_keep(w, flags != 0, &ix, &rows, err));
     hsize_t keep = 0;
+    char why[300];
     while (keep < rows && ix[keep].number <= keep_inc &&
-           !h5i_bad_index_row(&ix[keep], keep ? &ix[keep - 1] : NULL, data_ext, stress_ext))
+           !h5i_bad_index_row(&ix[keep], keep ? &ix[keep - 1] : NULL, data_ext, stress_ext, why,
+                              sizeof why))
         keep++;
     /* Series samples to keep: the leading ones with step <= keep_step. */
     hsize_t slen = h5i_extent_of(w->series[0]);
@@ -306,6 +308,11 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     hsize_t skeep = 0;
     while (st == CDEM_OK && skeep < slen && steps[skeep] <= keep_step)
         skeep++;
+    if (st == CDEM_OK && skeep > 0) { /* the next sample is checked against the last kept */
+        w->last_sample_step = steps[skeep - 1];
+        if (h5i_read_rows(w->series[1], H5T_NATIVE_DOUBLE, skeep - 1, 1, &w->last_sample_time) < 0)
+            st = H5FAIL(err, CDEM_ERR_FORMAT, "%s: cannot read /series/time", w->path);
+    }
     free(steps);
     /* From here on the file is changed. */
     if (st == CDEM_OK && w->commit >= 0) {
@@ -340,6 +347,8 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
     w->index_len = keep;
     w->last_number = keep ? ix[keep - 1].number : -1;
     w->last_step = keep ? ix[keep - 1].step : 0;
+    if (keep)
+        w->last_row = ix[keep - 1];
     free(ix);
     CDEM_TRY(st);
     w->series_len = skeep;

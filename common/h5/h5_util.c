@@ -388,3 +388,46 @@ int h5i_write_fixed_string(hid_t ds, size_t width, const char *text) {
     h5i_restore_errors(es);
     return rc;
 }
+
+/* Length of the valid UTF-8 sequence of one printable character at p (0 when there is
+ * none): no overlong forms, no surrogates, nothing above U+10FFFF, no control characters
+ * (C0, DEL, C1). */
+static size_t printable_utf8(const unsigned char *p) {
+    if (p[0] >= 0x20 && p[0] < 0x7f)
+        return 1;
+    size_t len = p[0] >= 0xc2 && p[0] <= 0xdf   ? 2
+                 : p[0] >= 0xe0 && p[0] <= 0xef ? 3
+                 : p[0] >= 0xf0 && p[0] <= 0xf4 ? 4
+                                                : 0;
+    if (!len)
+        return 0;
+    uint32_t cp = p[0] & (0x7f >> len);
+    for (size_t k = 1; k < len; k++) {
+        if ((p[k] & 0xc0) != 0x80)
+            return 0; /* also stops at the terminating NUL */
+        cp = cp << 6 | (p[k] & 0x3f);
+    }
+    static const uint32_t least[5] = {0, 0, 0x80, 0x800, 0x10000};
+    if (cp < least[len] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff) || cp < 0xa0)
+        return 0;
+    return len;
+}
+
+char *h5i_printable(const char *text) {
+    const unsigned char *p = (const unsigned char *)text;
+    char *out = malloc(4 * strlen(text) + 1), *o = out;
+    if (!out)
+        return NULL;
+    while (*p) {
+        size_t len = *p == '\n' || *p == '\t' ? 1 : printable_utf8(p);
+        if (len) {
+            memcpy(o, p, len);
+            o += len;
+            p += len;
+        } else {
+            o += sprintf(o, "\\x%02X", *p++);
+        }
+    }
+    *o = '\0';
+    return out;
+}

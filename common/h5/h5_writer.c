@@ -214,8 +214,15 @@ static cdem_status order_rows_by_id(cdem_h5_writer *w, const cdem_state *s, int 
         a = b;
         b = t;
     }
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         w->row_order[i] = (size_t)(a[i] & 0xffffffffu);
+        if (i && a[i] >> 32 == a[i - 1] >> 32) /* the reader refuses an id twice */
+            return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                             "%s: an increment is not written: element id %d is in rows %zu and "
+                             "%zu of the state (ids must be unique)",
+                             w->path, (int)s->id[w->row_order[i]], w->row_order[i - 1],
+                             w->row_order[i]);
+    }
     return CDEM_OK;
 }
 
@@ -262,6 +269,36 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
                          "%s: an earlier write failed; increment %d is not written (the file "
                          "keeps the %llu increments before)",
                          w->path, (int)info->number, (unsigned long long)w->index_len);
+    /* what the reader refuses is never written (h5_layout.c): the row's values, then every
+     * element's (a run that has blown up: run.c records "numerical-failure") */
+    const index_row values = {.number = info->number,
+                              .phase = info->phase,
+                              .step = info->step,
+                              .time = info->time,
+                              .net_displacement = info->net_displacement,
+                              .axial_strain = info->axial_strain,
+                              .differential_stress = info->differential_stress,
+                              .sea_level = info->sea_level,
+                              .n = (int64_t)s->n,
+                              .has_stress = s->has_stress && s->n > 0};
+    char why[300];
+    if (h5i_bad_index_values(&values, w->last_number >= 0 ? &w->last_row : NULL, why, sizeof why))
+        return CDEM_FAIL(err,
+                         values.phase < 0 || values.phase > 2 || values.step < w->last_row.step ||
+                                 values.time < w->last_row.time
+                             ? CDEM_ERR_INVALID
+                             : CDEM_ERR_NUMERIC,
+                         "%s: increment %d is not written: %s (a run file holds only values "
+                         "within the physical bounds of docs/format.md)",
+                         w->path, (int)info->number, why);
+    for (size_t i = 0; i < s->n; i++) {
+        const char *field = NULL;
+        if (h5i_bad_element(s, i, &field, why, sizeof why))
+            return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                             "%s: increment %d is not written: element id %d: %s (a run file "
+                             "holds only values within the physical bounds of docs/format.md)",
+                             w->path, (int)info->number, (int)s->id[i], why);
+    }
     if (w->commit >= 0 && w->index_len >= w->commit_capacity)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "%s: increment %d is not written: the file was made for at most %llu "
@@ -327,6 +364,7 @@ cdem_status cdem_h5_writer_write_increment(cdem_h5_writer *w, const cdem_increme
     }
     w->last_number = info->number;
     w->last_step = info->step;
+    w->last_row = row;
     w->entries[w->n_entries++] =
         (xmf_entry){info->number, info->time, (int64_t)n, stress, row.offset, row.stress_offset};
     /* Rewriting the whole sidecar costs O(increments); past XMF_EVERY_LIMIT increments it is
@@ -348,7 +386,32 @@ cdem_status cdem_h5_writer_append_series(cdem_h5_writer *w, const cdem_series_sa
                              w->path);
         CDEM_TRY(flush_series(w, err));
     }
+    /* what the reader refuses is never written (h5_layout.c): a sample out of order, or one
+     * whose values are not finite or beyond the physical bounds (a run that has blown up;
+     * run.c then records "numerical-failure") */
+    if (sample->step < 0 || sample->step <= w->last_sample_step ||
+        !(sample->time >= 0.0 && sample->time <= CDEM_FILE_MAX_TIME) ||
+        sample->time < w->last_sample_time)
+        return CDEM_FAIL(err,
+                         sample->step > w->last_sample_step ? CDEM_ERR_NUMERIC : CDEM_ERR_INVALID,
+                         "%s: the series sample of step %lld, time %.17g s is not written: steps "
+                         "must increase and times be finite, in 0..1e9 s and not decrease (the "
+                         "last sample written is of step %lld, time %.17g s)",
+                         w->path, (long long)sample->step, sample->time,
+                         (long long)w->last_sample_step, w->last_sample_time);
+    unsigned absent = 0;
+    for (size_t c = 0; c < N_SERIES; c++)
+        absent |= (unsigned)(w->series[c] < 0) << c;
+    const char *column = NULL;
+    char why[160];
+    if (h5i_bad_sample(sample, 0, absent, &column, why, sizeof why))
+        return CDEM_FAIL(err, CDEM_ERR_NUMERIC,
+                         "%s: the series sample of step %lld is not written: %s (a run file holds "
+                         "only values within the physical bounds of docs/format.md)",
+                         w->path, (long long)sample->step, why);
     w->buf[w->nbuf++] = *sample;
+    w->last_sample_step = sample->step;
+    w->last_sample_time = sample->time;
     return CDEM_OK;
 }
 
@@ -360,6 +423,12 @@ cdem_status cdem_h5_writer_set_stop_reason(cdem_h5_writer *w, const char *reason
                                            const char *detail, cdem_error *err) {
     if (!w)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_writer_set_stop_reason: no writer");
+    if (reason && !h5i_known_stop_reason(reason))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "%s: stop reason '%.80s' is not one a run file records (running, "
+                         "completed, interrupted, stopped-early, numerical-failure, "
+                         "write-failure, error)",
+                         w->path, reason);
     /* Preallocated datasets: overwriting them needs no new file space (works on a full
      * disk). The detail is cut to STOP_DETAIL_LEN - 1 bytes. */
     if (h5i_write_fixed_string(w->stop_detail, STOP_DETAIL_LEN, detail) < 0 ||
