@@ -16,6 +16,7 @@
 #include "params.h"
 
 #include "model.h"
+#include "suggest.h"
 
 #include <assert.h>
 #include <ctype.h>
@@ -241,38 +242,6 @@ static void copy_trimmed(char *buf, size_t n, const char *text, size_t len) {
         len = n - 1;
     memcpy(buf, text, len);
     buf[len] = '\0';
-}
-
-/* Levenshtein distance of the first 63 characters of a and b (no allocation). */
-static size_t edit_distance(const char *a, const char *b) {
-    enum { CAP = 63 };
-    size_t la = strlen(a), lb = strlen(b);
-    if (la > CAP)
-        la = CAP;
-    if (lb > CAP)
-        lb = CAP;
-    size_t prev[CAP + 1], cur[CAP + 1];
-    for (size_t j = 0; j <= lb; j++)
-        prev[j] = j;
-    for (size_t i = 1; i <= la; i++) {
-        cur[0] = i;
-        for (size_t j = 1; j <= lb; j++) {
-            size_t sub = prev[j - 1] +
-                         (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
-            size_t del = prev[j] + 1, ins = cur[j - 1] + 1;
-            size_t best = sub < del ? sub : del;
-            cur[j] = best < ins ? best : ins;
-        }
-        memcpy(prev, cur, (lb + 1) * sizeof prev[0]);
-    }
-    return prev[lb];
-}
-
-/* A suggestion is offered when the distance is small compared with the word. */
-static int close_enough(size_t dist, const char *word) {
-    size_t len = strlen(word);
-    size_t limit = len / 3 > 2 ? len / 3 : 2;
-    return dist <= limit;
 }
 
 /* Appends "w1, w2, w3" to buf. */
@@ -543,13 +512,13 @@ static cdem_status fail_unknown_key(const char *where, const char *section, cons
             int same = strcmp(param_table[i].section, section) == 0;
             if (same != (pass == 0))
                 continue;
-            size_t dist = edit_distance(key, param_table[i].key);
+            size_t dist = cdem_edit_distance(key, param_table[i].key);
             if (dist < best_d) {
                 best_d = dist;
                 best = &param_table[i];
             }
         }
-    if (best && close_enough(best_d, key)) {
+    if (best && cdem_suggest_close(best_d, key)) {
         if (strcmp(best->section, section) == 0)
             return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [%s] %s: unknown key; did you mean '%s'?",
                              where, section, key, best->key);
@@ -570,16 +539,9 @@ static int known_section(const char *name) {
 }
 
 static cdem_status fail_unknown_section(const char *where, const char *name, cdem_error *err) {
-    const char *best = NULL;
-    size_t best_d = (size_t)-1;
-    for (size_t i = 0; section_names[i]; i++) {
-        size_t dist = edit_distance(name, section_names[i]);
-        if (dist < best_d) {
-            best_d = dist;
-            best = section_names[i];
-        }
-    }
-    if (best && close_enough(best_d, name))
+    const size_t n = sizeof section_names / sizeof section_names[0] - 1;
+    const char *best = cdem_suggest(name, section_names, n);
+    if (best)
         return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: unknown section [%s]; did you mean [%s]?", where,
                          name, best);
     char words[256];

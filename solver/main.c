@@ -126,9 +126,10 @@ static void print_error(const char *msg) {
         fprintf(stderr, "cdem-run: unknown error\n");
 }
 
-static int usage_error(const char *fmt, const char *arg) {
+/* fmt has one or two %s: arg and, for the second, hint. */
+static int usage_error(const char *fmt, const char *arg, const char *hint) {
     fprintf(stderr, "cdem-run: ");
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, arg, hint);
     fprintf(stderr, "\nTry 'cdem-run --help' for more information.\n");
     return EXIT_USAGE;
 }
@@ -191,11 +192,11 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->params_markdown = 1;
         } else if (strcmp(arg, "-o") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a file name", arg);
+                return usage_error("option %s needs a file name", arg, NULL);
             a->output_path = argv[++i];
         } else if (strcmp(arg, "-s") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs section.key=value", arg);
+                return usage_error("option %s needs section.key=value", arg, NULL);
             a->overrides[a->n_overrides++] = argv[++i];
         } else if (strncmp(arg, "-s", 2) == 0 && strchr(arg, '=')) {
             a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
@@ -207,29 +208,34 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->no_fsync = 1;
         } else if (strcmp(arg, "--max-steps") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of time steps", arg);
+                return usage_error("option %s needs a number of time steps", arg, NULL);
             if (parse_count(arg, argv[++i], &a->max_steps) != EXIT_OK)
                 return EXIT_USAGE;
         } else if (strcmp(arg, "--resume") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs the run file to continue", arg);
+                return usage_error("option %s needs the run file to continue", arg, NULL);
             a->resume_path = argv[++i];
         } else if (strcmp(arg, "--threads") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of threads", arg);
+                return usage_error("option %s needs a number of threads", arg, NULL);
             if (cdem_threads_parse(argv[++i], &a->threads) != 0)
-                return usage_error("--threads %s: expected a whole number from 1 to 1024", argv[i]);
+                return usage_error("--threads %s: expected a whole number from 1 to 1024", argv[i],
+                                   NULL);
         } else if (strcmp(arg, "--par-min") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of items", arg);
+                return usage_error("option %s needs a number of items", arg, NULL);
             if (parse_count(arg, argv[++i], &a->par_min) != EXIT_OK)
                 return EXIT_USAGE;
         } else if (arg[0] == '-' && arg[1] != '\0') {
-            return usage_error("unknown option %s", arg);
+            char near[64];
+            return usage_error(cdem_cli_suggest_option(&run_help, arg, near, sizeof near)
+                                   ? "unknown option %s; did you mean %s?"
+                                   : "unknown option %s",
+                               arg, near);
         } else if (!a->model_path) {
             a->model_path = arg;
         } else {
-            return usage_error("more than one model file given (second: %s)", arg);
+            return usage_error("more than one model file given (second: %s)", arg, NULL);
         }
     }
     return EXIT_OK;
