@@ -224,6 +224,19 @@ const char *cdem_mode_name(cdem_mode mode) {
     return mode_words[mode];
 }
 
+int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base) {
+    *base = p->base;
+    const int own =
+        !(isnan(base->friction) && isnan(base->cohesion) && isnan(base->breaking_strain));
+    if (isnan(base->friction))
+        base->friction = p->wall.friction;
+    if (isnan(base->cohesion))
+        base->cohesion = p->wall.cohesion;
+    if (isnan(base->breaking_strain))
+        base->breaking_strain = p->wall.breaking_strain;
+    return own;
+}
+
 /* ---------- small text helpers ---------- */
 
 static int is_blank(char c) {

@@ -210,6 +210,11 @@ void cdem_params_write(const cdem_params *p, FILE *out);
  * range/values, help) for docs/parameters.md. Added for `cdem-run --params-markdown`. */
 void cdem_params_write_markdown(FILE *out);
 
+/* The element-base material in force: material.base_* where set, the wall's value where a
+ * base key is the word "wall" (stored as NaN). Returns 1 when any base key has a value of its
+ * own, 0 when the base is the wall throughout. */
+int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base);
+
 /* Words of enum values (for summaries and messages). */
 const char *cdem_mode_name(cdem_mode mode);
 

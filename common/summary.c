@@ -258,15 +258,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     }
     contact_line(f, "element-element", p, &p->element);
     contact_line(f, "element-wall", p, &p->wall);
-    cdem_contact_material base = p->base;
-    const int own = !(isnan(base.friction) && isnan(base.cohesion) && isnan(base.breaking_strain));
-    if (isnan(base.friction))
-        base.friction = p->wall.friction;
-    if (isnan(base.cohesion))
-        base.cohesion = p->wall.cohesion;
-    if (isnan(base.breaking_strain))
-        base.breaking_strain = p->wall.breaking_strain;
-    if (own)
+    cdem_contact_material base;
+    if (cdem_params_base_material(p, &base))
         contact_line(f, "element-base", p, &base);
     else
         line(f, "element-base", "as element-wall");

@@ -53,14 +53,8 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_contact_law_init: NULL argument");
     CDEM_TRY(check_value(NULL, "kn", kn, 1, err));
     CDEM_TRY(check_value(NULL, "ks", ks, 0, err));
-    /* the base takes the wall's value wherever its own is NaN (parameter word "wall") */
-    cdem_contact_material base = p->base;
-    if (isnan(base.friction))
-        base.friction = p->wall.friction;
-    if (isnan(base.cohesion))
-        base.cohesion = p->wall.cohesion;
-    if (isnan(base.breaking_strain))
-        base.breaking_strain = p->wall.breaking_strain;
+    cdem_contact_material base;
+    cdem_params_base_material(p, &base);
     const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault, &base};
     law->model = p->material;
     law->first_slip = p->first_slip ? 1 : 0;

@@ -492,6 +492,16 @@ static void test_params_base_material_word(void **state) {
                      CDEM_ERR_PARSE);
     assert_msg_has(&err, "base_friction = walls: not a number");
     assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    /* the material in force: the base's own friction, the wall's cohesion and strain */
+    cdem_contact_material base;
+    p.wall.cohesion = 7e8;
+    assert_int_equal(cdem_params_base_material(&p, &base), 1);
+    assert_true(base.friction == 0.0 && base.cohesion == 7e8 &&
+                base.breaking_strain == p.wall.breaking_strain);
+    cdem_params q;
+    cdem_params_defaults(&q);
+    assert_int_equal(cdem_params_base_material(&q, &base), 0);
+    assert_true(base.friction == q.wall.friction && base.cohesion == q.wall.cohesion);
     /* a NaN in a row without the word is still refused */
     p.wall.friction = NAN;
     assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_RANGE);
