@@ -29,6 +29,14 @@ void cdem_force_free(cdem_force *f) {
     memset(f, 0, sizeof *f);
 }
 
+/* The path of f's passes: chosen at the first need (reserve or pass) from the environment's
+ * CDEM_SIMD (force.h), unless a caller set it. */
+static cdem_force_path path_of(cdem_force *f) {
+    if (f->path == CDEM_FORCE_PATH_AUTO)
+        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    return f->path;
+}
+
 cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n, cdem_error *err) {
     if (f->crosscap < nb->pcap) {
         const size_t c = nb->pcap;
@@ -46,10 +54,8 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
         f->elem_work = w;
         f->workcap = c;
     }
-    if (f->path == CDEM_FORCE_PATH_AUTO)
-        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
     /* only the vector path's buffer: the scalar path's memory stays as it was */
-    if (f->path == CDEM_FORCE_PATH_AVX2 && f->acccap < n) {
+    if (path_of(f) == CDEM_FORCE_PATH_AVX2 && f->acccap < n) {
         const size_t c = n + n / 2 + 16;
         double *a = realloc(f->acc, 2 * c * sizeof *a);
         if (!a)
@@ -60,44 +66,53 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
     return CDEM_OK;
 }
 
-/* Finishes element i from its contact-force sum (sx, sy): gravity, the damped second half
- * kick (when kick), and the total force stored in fx, fy. Boundary elements keep the sum. */
-static inline void finish_element(long i, double sx, double sy, const double *restrict mass,
-                                  const double *restrict kick_finish,
-                                  const uint32_t *restrict flags, double *restrict vxw,
-                                  double *restrict vyw, double *restrict fx, double *restrict fy,
-                                  double hdt, double c, double g, double ob, int kick,
-                                  const double *restrict x, double ef, double exmid) {
-    const uint32_t fl = flags[i];
+/* What an element's finish reads besides its contact-force sum: the kick, the loads
+ * (cdem_force_loads) and the element arrays of the pass. */
+typedef struct {
+    int kick;                  /* 1: the damped second half kick */
+    double hdt, c;             /* s, dt / 2; N s/m, the damping of the step */
+    cdem_force_loads loads;    /* gravity, surface and edge loads */
+    const double *mass, *x;    /* kg per metre; m (the edge load's side) */
+    const double *kick_finish; /* 1 / (m + c dt/2) per element (the stepper's), or NULL */
+    const uint32_t *flags;
+} element_finish;
+
+/* Finishes element i from its contact-force sum (sx, sy): gravity and the other loads, the
+ * damped second half kick (when e->kick) of its velocity (vx, vy), and the total force
+ * stored in fx, fy. Boundary elements keep the sum. The written arrays are restrict
+ * parameters rather than members of e: only so does the compiler know that the stores do
+ * not touch what the loop reads next. */
+static inline void finish_element(const element_finish *e, long i, double sx, double sy,
+                                  double *restrict vx, double *restrict vy, double *restrict fx,
+                                  double *restrict fy) {
+    const uint32_t fl = e->flags[i];
     if (fl & CDEM_FLAGS_BOUNDARY) {
         fx[i] = sx;
         fy[i] = sy;
         return;
     }
-    const double m = mass[i];
-    sy -= m * g + ((fl & CDEM_FLAG_SURFACE) ? ob : 0.0);
+    const double m = e->mass[i];
+    sy -= m * e->loads.gravity + ((fl & CDEM_FLAG_SURFACE) ? e->loads.surface_force : 0.0);
     if (fl & CDEM_FLAG_BIAXIAL_EDGE)
-        sx += x[i] < exmid ? ef : -ef;
-    if (kick) {
+        sx += e->x[i] < e->loads.edge_x_mid ? e->loads.edge_force : -e->loads.edge_force;
+    if (e->kick) {
         /* v = (v_half + hdt/m F) / (1 + c hdt/m), with 1 / (m + c hdt) from kick_finish */
-        const double inv = kick_finish ? kick_finish[i] : 1.0 / (m + c * hdt);
-        vxw[i] = (m * vxw[i] + hdt * sx) * inv;
-        vyw[i] = (m * vyw[i] + hdt * sy) * inv;
+        const double inv = e->kick_finish ? e->kick_finish[i] : 1.0 / (m + e->c * e->hdt);
+        vx[i] = (m * vx[i] + e->hdt * sx) * inv;
+        vy[i] = (m * vy[i] + e->hdt * sy) * inv;
     }
-    fx[i] = sx - c * vxw[i];
-    fy[i] = sy - c * vyw[i];
+    fx[i] = sx - e->c * vx[i];
+    fy[i] = sy - e->c * vy[i];
 }
 
 /* Everything the force pass reads or writes, gathered once per step. */
 typedef struct {
     const cdem_contact_law *law;
-    int kick;
-    double dt, hdt, c, g, ob, ef, exmid;
-    const double *x, *y, *mass, *Rp;
-    const double *kick_finish; /* the stepper's kick factors (cdem_force_step) */
+    double dt;
+    element_finish fin; /* the elements' finish */
+    const double *x, *y, *Rp;
     const int32_t *pi, *pj, *istart;
     const uint8_t *cls;
-    const uint32_t *flags;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
     const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
@@ -191,9 +206,7 @@ static long finish_chunk(force_pass *fp, const double *acc, long lo, long hi) {
     const double dt2 = fp->dt * fp->dt;
     long unstable = -1;
     for (long i = lo; i < hi; i++) {
-        finish_element(i, acc[2 * i], acc[2 * i + 1], fp->mass, fp->kick_finish, fp->flags, fp->vx,
-                       fp->vy, fp->fx, fp->fy, fp->hdt, fp->c, fp->g, fp->ob, fp->kick, fp->x,
-                       fp->ef, fp->exmid);
+        finish_element(&fp->fin, i, acc[2 * i], acc[2 * i + 1], fp->vx, fp->vy, fp->fx, fp->fy);
         if (rad && unstable < 0) {
             const double vxi = fp->vx[i], vyi = fp->vy[i];
             const double d2 = (vxi * vxi + vyi * vyi) * dt2;
@@ -256,8 +269,7 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
-        finish_element(i, fx[i], fy[i], fp->mass, fp->kick_finish, fp->flags, vx, vy, fx, fy,
-                       fp->hdt, fp->c, fp->g, fp->ob, fp->kick, x, fp->ef, fp->exmid);
+        finish_element(&fp->fin, i, fx[i], fy[i], vx, vy, fx, fy);
     fp->unstable[chunk] = unstable_in(fp, lo, hi);
 }
 
@@ -540,24 +552,22 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     const long n = (long)s->n;
     force_pass fp = {
         .law = &lawc,
-        .kick = kick,
         .dt = in->dt,
-        .hdt = 0.5 * in->dt,
-        .c = in->damping,
-        .g = in->loads.gravity,
-        .ob = in->loads.surface_force,
-        .ef = in->loads.edge_force,
-        .exmid = in->loads.edge_x_mid,
+        .fin = {.kick = kick,
+                .hdt = 0.5 * in->dt,
+                .c = in->damping,
+                .loads = in->loads,
+                .mass = s->mass,
+                .x = s->x,
+                .kick_finish = in->kick_finish,
+                .flags = s->flags},
         .x = s->x,
         .y = s->y,
-        .mass = s->mass,
-        .kick_finish = in->kick_finish,
         .Rp = nb->R,
         .pi = nb->pi,
         .pj = nb->pj,
         .istart = nb->istart,
         .cls = nb->cls,
-        .flags = s->flags,
         .hist = nb->hist,
         .xs = nb->xs,
         .pfx = nb->pfx,
@@ -567,11 +577,9 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         .vx = s->vx,
         .vy = s->vy,
     };
-    if (f->path == CDEM_FORCE_PATH_AUTO)
-        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
     /* (a pass before the first cdem_force_reserve for this size takes the scalar path: the
      * same bits) */
-    fp.avx2 = f->path == CDEM_FORCE_PATH_AVX2 && f->acc && f->acccap >= (size_t)n;
+    fp.avx2 = path_of(f) == CDEM_FORCE_PATH_AVX2 && f->acc && f->acccap >= (size_t)n;
     fp.acc = f->acc;
     fp.pairs = (cdem_force_pairs){.law = &lawc,
                                   .dt = in->dt,

@@ -173,22 +173,31 @@ static cdem_status check_finite(const cdem_integrator *it, const cdem_state *s, 
     return CDEM_OK;
 }
 
-/* The force pass (force.h) of the current step: pair forces, per-element sums, loads and,
- * when kick, the second half kick. drift: the step's drift first (the drift function's work,
- * in the pass's region). check_moved: the rebuild test first; returns 1 (nothing else
- * computed) when the list is stale, else 0 with unstable_index updated. */
-static int forces_and_kick(cdem_integrator *it, cdem_state *s, int kick, int check_moved, int drift,
-                           cdem_bc_move_fn move, const void *move_ctx) {
+/* What a force pass of forces_and_kick does besides the pair forces and the sums. */
+enum {
+    PASS_KICK = 1 << 0,         /* the damped second half kick of the free elements */
+    PASS_CHECK_MOVED = 1 << 1,  /* the rebuild test first: nothing computed when stale */
+    PASS_DRIFT = 1 << 2,        /* the step's drift first, in the pass's region */
+    PASS_NO_INCREMENT = 1 << 3, /* no tangential increment (dt 0): a configuration's first
+                                   forces, with no previous step (prime, removals) */
+};
+
+/* The force pass (force.h) of the current step, doing what `what` says (PASS_*), and with
+ * PASS_DRIFT the mode's per-element move (may be NULL). Returns 1 (nothing else computed)
+ * when PASS_CHECK_MOVED finds the list stale, else 0 with unstable_index updated. */
+static int forces_and_kick(cdem_integrator *it, cdem_state *s, unsigned what, cdem_bc_move_fn move,
+                           const void *move_ctx) {
+    const int kick = (what & PASS_KICK) != 0, drift = (what & PASS_DRIFT) != 0;
     const cdem_force_step in = {
         .law = &it->law,
         .equilibrating = it->equilibrating,
-        .dt = it->dt,
+        .dt = (what & PASS_NO_INCREMENT) ? 0.0 : it->dt,
         .damping = cdem_integrator_damping(it),
         .kick = kick,
         .kick_finish = (kick && update_kick(it, s)) ? it->kick.finish : NULL,
         .loads = cdem_loads_of_step(&it->loads),
         .par_min = it->par_min,
-        .check_moved = check_moved,
+        .check_moved = (what & PASS_CHECK_MOVED) != 0,
         .unstable_test = it->unstable_guard,
         .drift = drift,
         .drift_factor = (drift && update_kick(it, s)) ? it->kick.drift : NULL,
@@ -210,11 +219,7 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
                              (int)s->id[i], s->mass[i]);
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    /* the first evaluation has no previous step: no tangential increment */
-    const double dt = it->dt;
-    it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0, 0, NULL, NULL);
-    it->dt = dt;
+    forces_and_kick(it, s, PASS_NO_INCREMENT, NULL, NULL);
     return CDEM_OK;
 }
 
@@ -261,11 +266,12 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
     if (list_current &&
-        forces_and_kick(it, s, 1, 1, drift_in_pass, move, move ? bc->ctx : NULL) == 0)
+        forces_and_kick(it, s, PASS_KICK | PASS_CHECK_MOVED | (drift_in_pass ? PASS_DRIFT : 0u),
+                        move, move ? bc->ctx : NULL) == 0)
         return CDEM_OK;
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
-    forces_and_kick(it, s, 1, 0, 0, NULL, NULL);
+    forces_and_kick(it, s, PASS_KICK, NULL, NULL);
     return CDEM_OK;
 }
 
@@ -277,10 +283,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     CDEM_TRY(cdem_removal_collect(&it->removal, s, nrem, err));
     it->removal.n_removed_last = nrem;
     CDEM_TRY(build_list(it, s, it->removal.keep, err));
-    const double dt = it->dt;
-    it->dt = 0.0;
-    forces_and_kick(it, s, 0, 0, 0, NULL, NULL);
-    it->dt = dt;
+    forces_and_kick(it, s, PASS_NO_INCREMENT, NULL, NULL);
     return CDEM_OK;
 }
 
