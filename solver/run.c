@@ -14,10 +14,10 @@
  * increment and at a stop, cdem_run_capture (every module under its own prefix) ->
  * cdem_h5_writer_write_checkpoint; a resume re-runs the set-up, restores, reopens the file.
  * Progress goes to opt->log only (never stdout); the wall clock is read for the progress
- * display and the thread governor, never for results. This file holds the set-up and the loop; the
- * increments and samples are run_output.c, the progress display run_progress.c, the checkpoints and
- * resume run_ckpt.c (run_internal.h). */
-#include "run_internal.h"
+ * display and the thread governor, never for results. This file holds the set-up, the loop and
+ * the two ways in (cdem_run, cdem_run_resume); the increments and samples are run_output.c,
+ * the progress display run_progress.c, the checkpoints run_ckpt.c (run_ctx.h). */
+#include "run_ctx.h"
 
 #include "checkpoint.h"
 #include "grid.h"
@@ -27,18 +27,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-const char *run_phase_name(int phase) {
-    return phase == CDEM_PHASE_EQUILIBRATION ? "equilibration"
-           : phase == CDEM_PHASE_DEFORMATION ? "deformation"
-                                             : "settling";
-}
-
-int run_phase_of(const run_ctx *r, long step) {
-    if (step <= r->m.equil_steps)
-        return CDEM_PHASE_EQUILIBRATION;
-    return cdem_sediment_settling(&r->sed, step) ? CDEM_PHASE_SETTLING : CDEM_PHASE_DEFORMATION;
-}
 
 /* 24 pre-growth layers of equal thickness between the lowest and highest free-element
  * centres at the end of equilibration; layer 1 at the bottom; walls keep layer 0. */
@@ -63,24 +51,6 @@ static void assign_layers(cdem_state *s) {
         }
         s->layer[i] = (int32_t)cdem_grid_row(&layers, s->y[i]) + 1;
     }
-}
-
-/* Erosion before an increment of the deformation phase: every free element whose centre is
- * above erosion_y is removed (integrator removal path), the count logged. */
-cdem_status run_erode(run_ctx *r, cdem_error *err) {
-    if (!r->p->erosion || !isfinite(r->erosion_y) || r->step <= r->m.equil_steps)
-        return CDEM_OK;
-    long count = 0;
-    CDEM_TRY(cdem_integrator_erode(&r->it, &r->s, r->erosion_y, &count, err));
-    r->eroded += count;
-    if (run_logging(r) && count > 0) {
-        run_end_progress_line(r);
-        fprintf(r->opt->log,
-                "cdem-run: erosion removed %ld elements above y = %.6g m before increment %d at "
-                "step %ld (%ld eroded so far)\n",
-                count, r->erosion_y, r->next_inc, r->step, r->eroded);
-    }
-    return CDEM_OK;
 }
 
 /* End of equilibration: the erosion level is erosion_base_level x the height of the
@@ -546,4 +516,64 @@ cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long
     if (n_wall)
         *n_wall = n_boundary;
     return CDEM_OK;
+}
+
+cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_error *err) {
+    if (!path || !opt)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_resume: a file and options are required");
+    cdem_h5_reader *rd = NULL;
+    CDEM_TRY(cdem_h5_reader_open(path, &rd, err));
+    cdem_params p;
+    cdem_snapshot *snap = NULL;
+    int32_t inc = 0;
+    cdem_status st = CDEM_OK;
+    const char *stop = cdem_h5_reader_stop_reason(rd);
+    if (strcmp(stop, "completed") == 0)
+        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                       "%s: the run already completed (stop reason \"completed\"): there is "
+                       "nothing to resume",
+                       path);
+    if (st == CDEM_OK && strcmp(cdem_h5_reader_source(rd), "cdem-run") != 0)
+        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                       "%s: written by \"%s\", not by cdem-run: only cdem-run files can be resumed",
+                       path, cdem_h5_reader_source(rd));
+    if (st == CDEM_OK)
+        st = cdem_h5_reader_params(rd, &p, err);
+    if (st == CDEM_OK)
+        st = cdem_params_validate(&p, err);
+    if (st == CDEM_OK)
+        st = cdem_snapshot_alloc(&snap, err);
+    if (st == CDEM_OK) {
+        st = cdem_h5_reader_read_checkpoint(rd, snap, &inc, err);
+        if (st == CDEM_ERR_NOTFOUND)
+            st = CDEM_FAIL(
+                err, CDEM_ERR_NOTFOUND,
+                "%s has no checkpoint to resume from (its output.checkpoint_interval is %d "
+                "increments, 0 = none): it stopped before its first checkpoint or was "
+                "written without; run the model again from the start",
+                path, p.checkpoint_interval);
+    }
+    cdem_h5_reader_close(rd);
+    if (st == CDEM_OK) {
+        int64_t next_inc = 0;
+        st = cdem_ckpt_get_i64(snap, "run", "next_inc", &next_inc, err);
+        if (st == CDEM_OK && next_inc - 1 != inc)
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: the checkpoint says it follows increment %lld but is stored for "
+                           "increment %d (corrupt checkpoint)",
+                           path, (long long)(next_inc - 1), (int)inc);
+    }
+    if (st != CDEM_OK) {
+        cdem_snapshot_free(snap);
+        return st;
+    }
+    cdem_run_options o = *opt;
+    o.output_path = path;
+    cdem_run_ctx *r = NULL;
+    st = cdem_run_open(&p, &o, snap, &r, err);
+    cdem_snapshot_free(snap);
+    if (st != CDEM_OK)
+        return st;
+    st = cdem_run_advance(r, LONG_MAX, err);
+    return cdem_run_close(r, st, err);
 }

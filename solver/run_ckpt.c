@@ -1,9 +1,9 @@
-/* run_ckpt: the checkpoints of a run (run_internal.h, docs/reliability.md): cdem_run_capture
- * (every module under its own prefix), the restore of a set-up run, the periodic checkpoint
- * after the step of every checkpoint_interval-th increment and the checkpoint of a stop, and
- * cdem_run_resume (read the file's parameters and newest checkpoint, re-run the set-up,
- * restore, reopen the file, run to the end). */
-#include "run_internal.h"
+/* run_ckpt: the checkpoints of a run (run_ctx.h, docs/reliability.md): cdem_run_capture
+ * (every module under its own prefix), the restore of a set-up run, and the periodic
+ * checkpoint after the step of every checkpoint_interval-th increment and the checkpoint of
+ * a stop. cdem_run_resume, which reads a file's newest checkpoint and drives the run from
+ * it, is in run.c beside cdem_run. */
+#include "run_ctx.h"
 
 #include "checkpoint.h"
 
@@ -15,20 +15,6 @@
 /* Layout of the solver's checkpoint arrays (docs/reliability.md); bumped when a module stores
  * something new or changes a meaning, so a checkpoint of another layout is refused. */
 #define CKPT_LAYOUT 1
-
-/* "; continue it with: cdem-run --resume FILE" when the file holds a checkpoint to continue
- * from, else why it cannot be continued; "" without a file. */
-void run_resume_hint(const run_ctx *r, char *buf, size_t cap) {
-    buf[0] = '\0';
-    if (!r->opt->output_path)
-        return;
-    if (!r->ckpt.off && r->p->checkpoint_interval > 0)
-        snprintf(buf, cap, "; continue it with: cdem-run --resume %s", r->opt->output_path);
-    else
-        snprintf(buf, cap,
-                 "; it cannot be continued (no checkpoints: output.checkpoint_interval = %d)",
-                 r->p->checkpoint_interval);
-}
 
 cdem_status cdem_run_capture(const cdem_run_ctx *r, cdem_snapshot *snap, cdem_error *err) {
     if (!r || !snap)
@@ -134,64 +120,4 @@ cdem_status run_write_checkpoint(run_ctx *r, int scheduled, cdem_error *err) {
         return st;
     }
     return CDEM_OK;
-}
-
-cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_error *err) {
-    if (!path || !opt)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_resume: a file and options are required");
-    cdem_h5_reader *rd = NULL;
-    CDEM_TRY(cdem_h5_reader_open(path, &rd, err));
-    cdem_params p;
-    cdem_snapshot *snap = NULL;
-    int32_t inc = 0;
-    cdem_status st = CDEM_OK;
-    const char *stop = cdem_h5_reader_stop_reason(rd);
-    if (strcmp(stop, "completed") == 0)
-        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
-                       "%s: the run already completed (stop reason \"completed\"): there is "
-                       "nothing to resume",
-                       path);
-    if (st == CDEM_OK && strcmp(cdem_h5_reader_source(rd), "cdem-run") != 0)
-        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
-                       "%s: written by \"%s\", not by cdem-run: only cdem-run files can be resumed",
-                       path, cdem_h5_reader_source(rd));
-    if (st == CDEM_OK)
-        st = cdem_h5_reader_params(rd, &p, err);
-    if (st == CDEM_OK)
-        st = cdem_params_validate(&p, err);
-    if (st == CDEM_OK)
-        st = cdem_snapshot_alloc(&snap, err);
-    if (st == CDEM_OK) {
-        st = cdem_h5_reader_read_checkpoint(rd, snap, &inc, err);
-        if (st == CDEM_ERR_NOTFOUND)
-            st = CDEM_FAIL(
-                err, CDEM_ERR_NOTFOUND,
-                "%s has no checkpoint to resume from (its output.checkpoint_interval is %d "
-                "increments, 0 = none): it stopped before its first checkpoint or was "
-                "written without; run the model again from the start",
-                path, p.checkpoint_interval);
-    }
-    cdem_h5_reader_close(rd);
-    if (st == CDEM_OK) {
-        int64_t next_inc = 0;
-        st = cdem_ckpt_get_i64(snap, "run", "next_inc", &next_inc, err);
-        if (st == CDEM_OK && next_inc - 1 != inc)
-            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                           "%s: the checkpoint says it follows increment %lld but is stored for "
-                           "increment %d (corrupt checkpoint)",
-                           path, (long long)(next_inc - 1), (int)inc);
-    }
-    if (st != CDEM_OK) {
-        cdem_snapshot_free(snap);
-        return st;
-    }
-    cdem_run_options o = *opt;
-    o.output_path = path;
-    cdem_run_ctx *r = NULL;
-    st = cdem_run_open(&p, &o, snap, &r, err);
-    cdem_snapshot_free(snap);
-    if (st != CDEM_OK)
-        return st;
-    st = cdem_run_advance(r, LONG_MAX, err);
-    return cdem_run_close(r, st, err);
 }

@@ -1,8 +1,8 @@
-/* run_output: what a run writes into its file besides checkpoints (run_internal.h): the
+/* run_output: what a run writes into its file besides checkpoints (run_ctx.h): the
  * increments (after the erosion due before them, with the stress when asked), the time-series
  * samples (kinetic energy, contacts, bonds, boundary and base forces, the mode's measures) and
  * the summary text. */
-#include "run_internal.h"
+#include "run_ctx.h"
 
 #include "stress.h"
 #include "summary.h"
@@ -11,8 +11,26 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Erosion before an increment of the deformation phase: every free element whose centre is
+ * above erosion_y is removed (integrator removal path), the count logged. */
+static cdem_status erode(run_ctx *r, cdem_error *err) {
+    if (!r->p->erosion || !isfinite(r->erosion_y) || r->step <= r->m.equil_steps)
+        return CDEM_OK;
+    long count = 0;
+    CDEM_TRY(cdem_integrator_erode(&r->it, &r->s, r->erosion_y, &count, err));
+    r->eroded += count;
+    if (run_logging(r) && count > 0) {
+        run_end_progress_line(r);
+        fprintf(r->opt->log,
+                "cdem-run: erosion removed %ld elements above y = %.6g m before increment %d at "
+                "step %ld (%ld eroded so far)\n",
+                count, r->erosion_y, r->next_inc, r->step, r->eroded);
+    }
+    return CDEM_OK;
+}
+
 cdem_status run_write_increment(run_ctx *r, cdem_error *err) {
-    CDEM_TRY(run_erode(r, err));
+    CDEM_TRY(erode(r, err));
     if (r->p->calculate_stress)
         CDEM_TRY(cdem_stress_compute(&r->it.nb, &r->s, err));
     cdem_increment_info inf;

@@ -1,8 +1,8 @@
-/* run_progress: the progress display of a run and the log line that ends it (run_internal.h).
+/* run_progress: the progress display of a run and the log line that ends it (run_ctx.h).
  * Progress goes to opt->log only (never stdout); the wall clock is read here for the display,
  * never for results. On a terminal one line is redrawn (at most 4 times a second), else a log line
  * every tenth of the run or 30 s. */
-#include "run_internal.h"
+#include "run_ctx.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -142,4 +142,18 @@ void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
             r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, steps, wall,
             wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads,
             cdem_force_path_name(r->it.force.path), how, hint);
+}
+
+/* "; continue it with: cdem-run --resume FILE" when the file holds a checkpoint to continue
+ * from, else why it cannot be continued; "" without a file. */
+void run_resume_hint(const run_ctx *r, char *buf, size_t cap) {
+    buf[0] = '\0';
+    if (!r->opt->output_path)
+        return;
+    if (!r->ckpt.off && r->p->checkpoint_interval > 0)
+        snprintf(buf, cap, "; continue it with: cdem-run --resume %s", r->opt->output_path);
+    else
+        snprintf(buf, cap,
+                 "; it cannot be continued (no checkpoints: output.checkpoint_interval = %d)",
+                 r->p->checkpoint_interval);
 }

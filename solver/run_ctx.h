@@ -1,14 +1,14 @@
-/* run_internal: what the files of the run loop share, and nothing outside them includes. The
+/* run_ctx: what the files of the run loop share, and nothing outside them includes. The
  * public interface is run.h. One responsibility per file: run.c (set-up, the loop over the
- * steps and its events, open/advance/close), run_output.c (the increments, the time-series
- * samples and the summary text of the file), run_progress.c (the progress display and the
- * log lines that end a run) and run_ckpt.c (checkpoints: capture, restore, the periodic and
- * the stop checkpoints, and cdem_run_resume).
+ * steps and its events, open/advance/close, cdem_run and cdem_run_resume), run_output.c (the
+ * increments with the erosion due before them, the time-series samples and the summary text
+ * of the file), run_progress.c (the progress display and the log lines that end a run) and
+ * run_ckpt.c (checkpoints: capture, restore, the periodic and the stop checkpoints).
  * The run context holds each file's own state in a group of its own (prog, ckpt); the rest is
  * the run itself. Names are run_*: internal, global only because the run spans several files.
  * Ownership, threads, units: as run.h (one run per process; SI units). */
-#ifndef CDEM_RUN_INTERNAL_H
-#define CDEM_RUN_INTERNAL_H
+#ifndef CDEM_RUN_CTX_H
+#define CDEM_RUN_CTX_H
 
 #include "assembly.h"
 #include "bc.h"
@@ -87,15 +87,28 @@ struct cdem_run_ctx {
 };
 typedef struct cdem_run_ctx run_ctx;
 
-/* run.c */
-const char *run_phase_name(int phase);
-int run_phase_of(const run_ctx *r, long step);
-/* Erosion before an increment of the deformation phase (integrator removal path), logged. */
-cdem_status run_erode(run_ctx *r, cdem_error *err);
+/* The phase of step `step` (CDEM_PHASE_*): equilibration up to its last step, then settling
+ * while a deposit settles, else deformation. */
+static inline int run_phase_of(const run_ctx *r, long step) {
+    if (step <= r->m.equil_steps)
+        return CDEM_PHASE_EQUILIBRATION;
+    return cdem_sediment_settling(&r->sed, step) ? CDEM_PHASE_SETTLING : CDEM_PHASE_DEFORMATION;
+}
+
+static inline const char *run_phase_name(int phase) {
+    return phase == CDEM_PHASE_EQUILIBRATION ? "equilibration"
+           : phase == CDEM_PHASE_DEFORMATION ? "deformation"
+                                             : "settling";
+}
+
+/* The files call downward only: run.c (the set-up, the loop, cdem_run and cdem_run_resume)
+ * calls the other three; run_ckpt.c and run_output.c call run_progress.c; run_progress.c
+ * calls none of them. */
 
 /* run_output.c */
-/* Erodes (run_erode), computes the stress when asked, writes increment next_inc of the
- * current step and advances next_inc. */
+/* Erodes (the erosion due before an increment of the deformation phase, through the
+ * integrator's removal path, logged), computes the stress when asked, writes increment
+ * next_inc of the current step and advances next_inc. */
 cdem_status run_write_increment(run_ctx *r, cdem_error *err);
 /* Appends the time-series sample of the current step (serial, fixed-order sums). */
 cdem_status run_write_sample(run_ctx *r, cdem_error *err);
@@ -118,11 +131,11 @@ void run_progress_line(run_ctx *r, int force, const char *ending);
 void run_progress(run_ctx *r, int force);
 /* The last line of a run's log: the file, its size, the increments and how the run ended. */
 void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer);
-
-/* run_ckpt.c */
 /* "; continue it with: cdem-run --resume FILE" when the file holds a checkpoint to continue
  * from, else why it cannot be continued; "" without a file. */
 void run_resume_hint(const run_ctx *r, char *buf, size_t cap);
+
+/* run_ckpt.c */
 /* Replaces the state of a set-up run by the checkpoint's. */
 cdem_status run_restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *err);
 /* Captures the run and stores it in the file as the checkpoint of the increment written last;
