@@ -15,7 +15,6 @@
  * export the table to every caller instead of keeping "one table, one owner". */
 #include "params.h"
 
-#include "model.h"
 #include "suggest.h"
 
 #include <assert.h>
@@ -269,8 +268,7 @@ static void join_words(const char *const *words, char *buf, size_t n) {
     }
 }
 
-/* Formats a double so that strtod gives back exactly the same value, as short as possible. */
-static void format_double(double v, char *buf, size_t n) {
+void cdem_params_format_number(double v, char *buf, size_t n) {
     if (v == floor(v) && fabs(v) < 1e7) { /* whole numbers up to 7 digits: "2000", not "2e+03" */
         snprintf(buf, n, "%.0f", v);
         return;
@@ -294,8 +292,8 @@ static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
         return;
     }
     char lo[32], hi[32];
-    format_double(d->min, lo, sizeof lo);
-    format_double(d->max, hi, sizeof hi);
+    cdem_params_format_number(d->min, lo, sizeof lo);
+    cdem_params_format_number(d->max, hi, sizeof hi);
     const char *sp = d->unit[0] ? " " : "";
     if (d->max == NOMAX)
         snprintf(buf, n, "%s %s%s%s", d->min_exclusive ? ">" : ">=", lo, sp, d->unit);
@@ -304,18 +302,6 @@ static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
     else
         snprintf(buf, n, "%s %s and %s %s%s%s", d->min_exclusive ? ">" : ">=", lo,
                  d->max_exclusive ? "<" : "<=", hi, sp, d->unit);
-}
-
-/* Rounds v to 4 significant digits towards +inf (up = 1) or -inf (up = 0) and formats it, so
- * that advice such as "at least X" is itself sufficient. */
-static void format_safe(double v, int up, char *buf, size_t n) {
-    if (!(v > 0) || !isfinite(v)) {
-        snprintf(buf, n, "%g", v);
-        return;
-    }
-    double mag = pow(10.0, floor(log10(v)) - 3.0);
-    double r = (up ? ceil(v / mag) : floor(v / mag)) * mag;
-    snprintf(buf, n, "%.4g", r);
 }
 
 /* Short "allowed values" text for comments and the markdown table. */
@@ -340,8 +326,8 @@ static void describe_allowed(const cdem_param_def *d, char *buf, size_t n) {
         break;
     default: {
         char lo[32], hi[32];
-        format_double(d->min, lo, sizeof lo);
-        format_double(d->max, hi, sizeof hi);
+        cdem_params_format_number(d->min, lo, sizeof lo);
+        cdem_params_format_number(d->max, hi, sizeof hi);
         if (d->max == NOMAX)
             snprintf(buf, n, "%s %s", d->min_exclusive ? ">" : ">=", lo);
         else if (!d->min_exclusive && !d->max_exclusive)
@@ -810,7 +796,7 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
         if (isnan(v) && def->choices)
             snprintf(buf, n, "%s", def->choices[0]);
         else
-            format_double(v, buf, n);
+            cdem_params_format_number(v, buf, n);
         break;
     }
     case CDEM_PTYPE_INT: {
@@ -927,16 +913,7 @@ void cdem_params_write_markdown(FILE *out) {
 
 /* ---------- validation of combinations ---------- */
 
-/* Accumulates one message per violated rule, separated by newlines. */
-typedef struct {
-    char *buf;  /* destination (err->msg or a scratch buffer) */
-    size_t cap; /* its size */
-    size_t len; /* characters written */
-    int count;  /* rules violated so far */
-} rule_log;
-
-static void rule_add(rule_log *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void rule_add(rule_log *log, const char *fmt, ...) {
+void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) {
     log->count++;
     if (log->len + 2 >= log->cap)
         return;
@@ -962,11 +939,11 @@ static int is_fault_mode(cdem_mode m) {
            m == CDEM_MODE_IRREGULAR_FAULT;
 }
 
-cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
+cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err) {
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
     char msg[CDEM_ERROR_MSG_MAX];
-    rule_log log = {msg, sizeof msg, 0, 0};
+    cdem_rule_log log = {msg, sizeof msg, 0, 0};
     msg[0] = '\0';
     char v1[64], v2[64];
 
@@ -994,75 +971,78 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
         case CDEM_PTYPE_BOOL:
             memcpy(&iv, field, sizeof iv);
             if (iv != 0 && iv != 1)
-                rule_add(&log, "[%s] %s = %d: must be 0 or 1 (off/on)", d->section, d->key, iv);
+                cdem_rule_add(&log, "[%s] %s = %d: must be 0 or 1 (off/on)", d->section, d->key,
+                              iv);
             continue;
         case CDEM_PTYPE_ENUM:
             memcpy(&iv, field, sizeof iv);
             while (d->choices[count])
                 count++;
             if (iv < 0 || iv >= count)
-                rule_add(&log, "[%s] %s = %d: not a valid choice", d->section, d->key, iv);
+                cdem_rule_add(&log, "[%s] %s = %d: not a valid choice", d->section, d->key, iv);
             continue;
         case CDEM_PTYPE_STRING:
             if (!memchr(field, '\0', d->size))
-                rule_add(&log, "[%s] %s: text not terminated within %zu characters", d->section,
-                         d->key, d->size);
+                cdem_rule_add(&log, "[%s] %s: text not terminated within %zu characters",
+                              d->section, d->key, d->size);
             continue;
         }
         if (!in_range(d, v)) {
             char range[160];
             describe_range(d, range, sizeof range);
-            format_double(v, v1, sizeof v1);
-            rule_add(&log, "[%s] %s = %s: must be %s", d->section, d->key, v1, range);
+            cdem_params_format_number(v, v1, sizeof v1);
+            cdem_rule_add(&log, "[%s] %s = %s: must be %s", d->section, d->key, v1, range);
         }
     }
     if (log.count > 0) /* ranges first: the cross rules below assume sane values */
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
 
     if (!(p->equilibration < p->runtime)) {
-        format_double(p->equilibration, v1, sizeof v1);
-        format_double(p->runtime, v2, sizeof v2);
-        rule_add(&log,
-                 "equilibration = %s s must be shorter than runtime = %s s: increase [time] "
-                 "runtime or reduce [time] equilibration",
-                 v1, v2);
+        cdem_params_format_number(p->equilibration, v1, sizeof v1);
+        cdem_params_format_number(p->runtime, v2, sizeof v2);
+        cdem_rule_add(&log,
+                      "equilibration = %s s must be shorter than runtime = %s s: increase [time] "
+                      "runtime or reduce [time] equilibration",
+                      v1, v2);
     }
     if (p->weak_interval != CDEM_WEAK_OFF && p->layered_friction)
-        rule_add(&log,
-                 "weak_interval = %s excludes layered_friction = on: set [heterogeneity] "
-                 "weak_interval = off or layered_friction = off",
-                 weak_words[p->weak_interval]);
+        cdem_rule_add(&log,
+                      "weak_interval = %s excludes layered_friction = on: set [heterogeneity] "
+                      "weak_interval = off or layered_friction = off",
+                      weak_words[p->weak_interval]);
     if (p->layered_friction && p->material != CDEM_MATERIAL_GRANULAR)
-        rule_add(&log,
-                 "layered_friction = on requires material = granular (got material = %s): set "
-                 "[heterogeneity] layered_friction = off or [material] material = granular",
-                 material_words[p->material]);
+        cdem_rule_add(&log,
+                      "layered_friction = on requires material = granular (got material = %s): set "
+                      "[heterogeneity] layered_friction = off or [material] material = granular",
+                      material_words[p->material]);
     if (p->overburden_pressure > 0) {
-        format_double(p->overburden_pressure, v1, sizeof v1);
+        cdem_params_format_number(p->overburden_pressure, v1, sizeof v1);
         if (p->mode == CDEM_MODE_REPOSE || p->mode == CDEM_MODE_BIAXIAL)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m cannot be used with mode = %s: set [surface] "
-                     "overburden_pressure = 0 or choose another mode",
-                     v1, mode_words[p->mode]);
+            cdem_rule_add(
+                &log,
+                "overburden_pressure = %s N/m cannot be used with mode = %s: set [surface] "
+                "overburden_pressure = 0 or choose another mode",
+                v1, mode_words[p->mode]);
         if (p->erosion)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
-                     "overburden_pressure = 0 or erosion = off",
-                     v1);
+            cdem_rule_add(&log,
+                          "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
+                          "overburden_pressure = 0 or erosion = off",
+                          v1);
         if (p->sedimentation)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m excludes sedimentation = on: set [surface] "
-                     "overburden_pressure = 0 or sedimentation = off",
-                     v1);
+            cdem_rule_add(&log,
+                          "overburden_pressure = %s N/m excludes sedimentation = on: set [surface] "
+                          "overburden_pressure = 0 or sedimentation = off",
+                          v1);
     }
     if (p->mode == CDEM_MODE_BIAXIAL) {
         if (p->width != 10.0 || p->height != 5.0) {
-            format_double(p->width, v1, sizeof v1);
-            format_double(p->height, v2, sizeof v2);
-            rule_add(&log,
-                     "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
-                     "height = %s): set them in [assembly]",
-                     v1, v2);
+            cdem_params_format_number(p->width, v1, sizeof v1);
+            cdem_params_format_number(p->height, v2, sizeof v2);
+            cdem_rule_add(
+                &log,
+                "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
+                "height = %s): set them in [assembly]",
+                v1, v2);
         }
         for (size_t i = 0; i < sizeof biaxial_excludes / sizeof biaxial_excludes[0]; i++) {
             const cdem_param_def *d =
@@ -1071,65 +1051,40 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
             memcpy(&v, (const char *)p + d->offset, sizeof v);
             if (v) {
                 cdem_params_format_value(p, d, v1, sizeof v1);
-                rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key, v1,
-                         d->section, d->key);
+                cdem_rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key,
+                              v1, d->section, d->key);
             }
         }
     }
     if (p->mode == CDEM_MODE_REPOSE) {
         if (p->erosion)
-            rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
+            cdem_rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
         if (p->sedimentation)
-            rule_add(
+            cdem_rule_add(
                 &log,
                 "mode = repose excludes sedimentation = on: set [surface] sedimentation = off");
     }
     if (p->mode == CDEM_MODE_IRREGULAR_FAULT && p->fault_file[0] == '\0')
-        rule_add(&log, "mode = irregular-fault requires fault_file: set [boundary] fault_file to "
-                       "a text file of x y vertices in m");
+        cdem_rule_add(&log,
+                      "mode = irregular-fault requires fault_file: set [boundary] fault_file to "
+                      "a text file of x y vertices in m");
     if (p->mode == CDEM_MODE_VERTICAL_FAULTS &&
         !(p->vertical_fault_location + p->vertical_fault_spacing < 1.0)) {
-        format_double(p->vertical_fault_location, v1, sizeof v1);
-        format_double(p->vertical_fault_spacing, v2, sizeof v2);
-        rule_add(&log,
-                 "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s + "
-                 "%s must be < 1 (the second fault must lie inside the base): reduce one of them",
-                 v1, v2);
+        cdem_params_format_number(p->vertical_fault_location, v1, sizeof v1);
+        cdem_params_format_number(p->vertical_fault_spacing, v2, sizeof v2);
+        cdem_rule_add(
+            &log,
+            "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s + "
+            "%s must be < 1 (the second fault must lie inside the base): reduce one of them",
+            v1, v2);
     }
     if (p->inversion && !is_fault_mode(p->mode))
-        rule_add(&log,
-                 "inversion = on needs mode = planar-fault, listric-fault or irregular-fault "
-                 "(got mode = %s): set [boundary] inversion = off",
-                 mode_words[p->mode]);
-    if (p->sedimentation) {
-        cdem_model m;
-        cdem_error merr;
-        cdem_error_clear(&merr);
-        if (cdem_model_derive(p, &m, &merr) != CDEM_OK) {
-            rule_add(&log, "%s", merr.msg);
-        } else {
-            double settling = 0.2 * p->equilibration;
-            double between = m.sediment_interval / m.boundary_speed;
-            if (settling > between) {
-                char s_set[32], s_bet[32], s_speed[32], s_di[32], s_eq[32];
-                format_double(settling, s_set, sizeof s_set);
-                snprintf(s_bet, sizeof s_bet, "%.4g", between);
-                snprintf(s_speed, sizeof s_speed, "%.4g", m.boundary_speed);
-                /* smallest display interval / largest equilibration that satisfy the rule */
-                format_safe(settling * m.boundary_speed / 30.0, 1, s_di, sizeof s_di);
-                format_safe(between / 0.2, 0, s_eq, sizeof s_eq);
-                format_double(p->display_interval, v1, sizeof v1);
-                format_double(p->equilibration, v2, sizeof v2);
-                rule_add(&log,
-                         "settling > displacement: the settling time 0.2 x equilibration = 0.2 x "
-                         "%s s = %s s is longer than the time between sediment steps 30 x "
-                         "display_interval / boundary speed = 30 x %s m / %s m/s = %s s: increase "
-                         "[time] display_interval to at least %s m or reduce [time] "
-                         "equilibration to at most %s s",
-                         v2, s_set, v1, s_speed, s_bet, s_di, s_eq);
-            }
-        }
-    }
+        cdem_rule_add(&log,
+                      "inversion = on needs mode = planar-fault, listric-fault or irregular-fault "
+                      "(got mode = %s): set [boundary] inversion = off",
+                      mode_words[p->mode]);
+    if (more)
+        more(p, &log);
     if (log.count > 0)
         return CDEM_FAIL(err, CDEM_ERR_CONFLICT, "%s", msg);
     return CDEM_OK;

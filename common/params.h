@@ -196,9 +196,30 @@ cdem_status cdem_params_load(cdem_params *p, const char *path, char **text_out, 
 /* Applies one "section.key=value" override (from -s on the command line). */
 cdem_status cdem_params_override(cdem_params *p, const char *assignment, cdem_error *err);
 
-/* Checks the exclusions and cross-parameter rules (equilibration < runtime, biaxial only on
- * 10 x 5, ...). Every violated rule is reported at once, one per line, in err->msg. */
-cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err);
+/* The violated cross-parameter rules of one validation, one line each of one message. */
+typedef struct {
+    char *buf;  /* destination (err->msg or a scratch buffer) */
+    size_t cap; /* its size */
+    size_t len; /* characters written */
+    int count;  /* rules violated so far */
+} cdem_rule_log;
+
+/* Adds one violated rule (printf format) as a line of the log. */
+void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* A caller's own rules, added after the table's to the same log. */
+typedef void (*cdem_params_rules)(const cdem_params *p, cdem_rule_log *log);
+
+/* Checks every value against its row (CDEM_ERR_RANGE, all such values named at once), then
+ * the rules between parameters (equilibration < runtime, the heterogeneity and surface
+ * exclusions, ...) and, when more is not NULL, the caller's (cdem-run's: the mode's and the
+ * growth strata's, solver/run/validate.c). Every violated rule is reported at once, one per
+ * line, in err->msg (CDEM_ERR_CONFLICT). */
+cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err);
+
+/* Formats a number so that strtod gives back exactly the same value, as short as possible
+ * (whole numbers up to 7 digits without exponent): the values quoted in messages. */
+void cdem_params_format_number(double v, char *buf, size_t n);
 
 /* Formats a parameter's current value as it would be written in a file. */
 void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, char *buf, size_t n);

@@ -469,7 +469,7 @@ int main(int argc, char **argv) {
         rc = EXIT_OK;
         goto done;
     }
-    if (cdem_params_validate(&p, &err) != CDEM_OK) {
+    if (cdem_run_validate(&p, &err) != CDEM_OK) {
         fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
                 !a.model_path               ? ""
                 : strcmp(a.model_path, "-") ? a.model_path

@@ -540,7 +540,7 @@ cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_
     if (st == CDEM_OK)
         st = cdem_h5_reader_params(rd, &p, err);
     if (st == CDEM_OK)
-        st = cdem_params_validate(&p, err);
+        st = cdem_run_validate(&p, err);
     if (st == CDEM_OK)
         st = cdem_snapshot_alloc(&snap, err);
     if (st == CDEM_OK) {

@@ -35,6 +35,10 @@ typedef struct {
     int no_fsync;            /* 1: no fsync at commits (cdem-run --no-fsync, throwaway runs) */
 } cdem_run_options;
 
+/* Checks a run's parameters: every value and rule of the parameter table and the solver's
+ * own rules (the growth strata's), all violations in one message (cdem_params_validate). */
+cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err);
+
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was
  * requested (the file is valid and says where it stopped), other codes on failure. */
 cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_error *err);

@@ -10,11 +10,55 @@
 #include "surface.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* Offset of the deposit RNG seed from the assembly seed (independent streams). */
 #define SEED_XOR 0x5ed1UL
+
+/* Rounds v to 4 significant digits towards +inf (up = 1) or -inf (up = 0) and formats it, so
+ * that advice such as "at least X" is itself sufficient. */
+static void format_safe(double v, int up, char *buf, size_t n) {
+    if (!(v > 0) || !isfinite(v)) {
+        snprintf(buf, n, "%g", v);
+        return;
+    }
+    double mag = pow(10.0, floor(log10(v)) - 3.0);
+    double r = (up ? ceil(v / mag) : floor(v / mag)) * mag;
+    snprintf(buf, n, "%.4g", r);
+}
+
+void cdem_sediment_rules(const cdem_params *p, cdem_rule_log *log) {
+    if (!p->sedimentation)
+        return;
+    cdem_model m;
+    cdem_error merr;
+    cdem_error_clear(&merr);
+    if (cdem_model_derive(p, &m, &merr) != CDEM_OK) {
+        cdem_rule_add(log, "%s", merr.msg);
+        return;
+    }
+    const double settling = 0.2 * p->equilibration;
+    const double between = m.sediment_interval / m.boundary_speed;
+    if (!(settling > between))
+        return;
+    char s_set[32], s_bet[32], s_speed[32], s_di[32], s_eq[32], v1[64], v2[64];
+    cdem_params_format_number(settling, s_set, sizeof s_set);
+    snprintf(s_bet, sizeof s_bet, "%.4g", between);
+    snprintf(s_speed, sizeof s_speed, "%.4g", m.boundary_speed);
+    /* smallest display interval / largest equilibration that satisfy the rule */
+    format_safe(settling * m.boundary_speed / 30.0, 1, s_di, sizeof s_di);
+    format_safe(between / 0.2, 0, s_eq, sizeof s_eq);
+    cdem_params_format_number(p->display_interval, v1, sizeof v1);
+    cdem_params_format_number(p->equilibration, v2, sizeof v2);
+    cdem_rule_add(log,
+                  "settling > displacement: the settling time 0.2 x equilibration = 0.2 x %s s = "
+                  "%s s is longer than the time between sediment steps 30 x display_interval / "
+                  "boundary speed = 30 x %s m / %s m/s = %s s: increase [time] display_interval "
+                  "to at least %s m or reduce [time] equilibration to at most %s s",
+                  v2, s_set, v1, s_speed, s_bet, s_di, s_eq);
+}
 
 cdem_status cdem_sediment_init(cdem_sediment *sd, const cdem_params *p, const cdem_model *m,
                                cdem_error *err) {

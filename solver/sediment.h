@@ -56,6 +56,12 @@ typedef struct {
     size_t newcap;      /* capacity of next_new */
 } cdem_sediment;
 
+/* The growth strata's parameter rule (a cdem_params_rules of cdem_params_validate): with
+ * sedimentation on, a deposit's settling (0.2 x equilibration) must end before the next
+ * deposit is due (30 x display_interval of boundary displacement); the message gives the
+ * display_interval and the equilibration that would do. */
+void cdem_sediment_rules(const cdem_params *p, cdem_rule_log *log);
+
 /* Sets up from the parameters and model; p->sedimentation = 0 gives a disabled context
  * (every query answers "nothing", sea level NaN). Fails with CDEM_ERR_RANGE when the model
  * step counts or radii are unusable, CDEM_ERR_NOMEM when the RNG cannot be allocated. */

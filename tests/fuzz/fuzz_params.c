@@ -5,6 +5,7 @@
  * writes back (cdem_params_write) to a text that parses to the same values. */
 #include "model.h"
 #include "params.h"
+#include "run.h"
 #include "summary.h"
 
 #include "fuzz_util.h"
@@ -75,7 +76,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             FUZZ_CHECK(err.msg[0] != '\0');
     }
     if (st == CDEM_OK) {
-        st = cdem_params_validate(&p, &err);
+        st = cdem_run_validate(&p, &err);
         if (st != CDEM_OK)
             FUZZ_CHECK(err.msg[0] != '\0');
     }
