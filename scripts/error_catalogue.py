@@ -26,21 +26,20 @@ PICTURE_COMMANDS = ["analysis/cli/cmd_render.c", "analysis/cli/cmd_plot.c",
                     "analysis/cli/cmd_plot_series.c", "analysis/cli/cmd_plot_csv.c"]
 
 GROUPS = [  # (title, source files, what to do)
-    ("Parameter files and -s overrides", ["common/params.c", "common/model.c", "common/summary.c"],
+    ("Parameter files and -s overrides", ["common/params.c", "solver/base/model.c",
+                                          "solver/run/summary.c", "solver/run/run_validate.c"],
      "The message names the file, line, key and value and says what is allowed: correct that "
      "line (or the -s argument). `cdem-run --print-defaults` writes a valid file to start "
      "from; docs/parameters.md lists every key, range and rule between keys."),
-    ("Fault vertex files (irregular-fault)", ["solver/fault_file.c"],
+    ("Fault vertex files (irregular-fault)", ["solver/modes/fault_file.c"],
      "Fix the named line of the vertex file: two plain decimal numbers `x y` in metres per "
      "line; first point at (fault_location x width x unit_scaling, 0); every later point at "
      "lower x and higher y, every segment dipping at least 1 degree and at least half the "
      "smallest radius long, no point above twice the model's height. The path is relative to "
      "the directory cdem-run runs in."),
-    ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
-      "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
-      "solver/run.c", "solver/run_output.c", "solver/run_progress.c", "solver/run_ckpt.c", "solver/sediment.c",
-      "solver/integrate.c", "solver/force.c", "solver/loads.c", "solver/removal.c", "solver/contact.c", "solver/neighbour.c",
-      "solver/assembly.c", "solver/stress.c"],
+    ("Boundary modes and the run", [*sources("solver/modes/bc_*.c"), *sources("solver/run/*.c"),
+      *sources("solver/packing/*.c"), *sources("solver/step/*.c"),
+      *sources("solver/contact/*.c"), *sources("solver/base/*.c")],
      "Combinations the mode cannot build are refused before the run (change the named key); "
      "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
      "`keep_constants = off` at small unit scaling or use the default constants; "
@@ -139,7 +138,9 @@ def show(fmt):
 
 def main():
     files = sorted(glob.glob(os.path.join(ROOT, d, "*.c"))
-                   for d in ("common", "common/h5", "solver", "analysis", "analysis/cli",
+                   for d in ("common", "common/h5", "solver", "solver/base", "solver/contact",
+                             "solver/modes", "solver/step", "solver/packing", "solver/run",
+                             "analysis", "analysis/cli",
                              "analysis/input", "analysis/measure", "analysis/draw",
                              "analysis/export"))
     files = [f for group in files for f in group]

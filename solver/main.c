@@ -2,7 +2,7 @@
  *
  * Reads a parameter file (or uses the built-in default model), applies -s overrides in
  * command-line order, validates, prints the model summary and runs the simulation through
- * cdem_run() (solver/run.h). This is the only place that prints messages and chooses exit
+ * cdem_run() (solver/run/run.h). This is the only place that prints messages and chooses exit
  * codes: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM/SIGHUP; the
  * output file is still valid and records where it stopped). An existing output is never
  * replaced without --force, and a file that is not a cdem run file never. Messages go to stderr as

@@ -1,4 +1,4 @@
-/* Tests of the assembly generator (solver/assembly.c): element counts against the original
+/* Tests of the assembly generator (solver/packing/assembly.c): element counts against the original
  * program's figures, geometry (inside the box, no overlap, no large gaps, every disc
  * supported), walls, ordering, size distribution, determinism, the largest assembly and
  * every error path. Params and model are filled by hand (radii 50..125 m at unit scaling

@@ -1,4 +1,4 @@
-/* Tests of the biaxial mode (solver/bc_biaxial.c) and the confining pressure of the
+/* Tests of the biaxial mode (solver/modes/bc_biaxial.c) and the confining pressure of the
  * integrator: the ramp, the edge force on a hand-made pair (analytic), the edge search on a
  * real sample (sum of the lateral forces = p x height within one band), parameter errors, and
  * a short end-to-end 10 x 5 run (equilibration 100 s, runtime 150 s) read back: platen

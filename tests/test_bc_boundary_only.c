@@ -1,6 +1,6 @@
-/* The boundary modes' `boundary_only` promise (solver/bc.h), on which the stepper relies to
+/* The boundary modes' `boundary_only` promise (solver/modes/bc.h), on which the stepper relies to
  * apply a mode before the drift and drift inside the force pass's parallel region
- * (solver/integrate.c): a mode that makes it
+ * (solver/step/integrate.c): a mode that makes it
  *   - writes no free element: every free element's fields are bit-unchanged by its apply;
  *   - reads no free element: its moves of the boundary elements and its net displacement
  *     are bit-identical whatever the free elements' positions, velocities and forces.

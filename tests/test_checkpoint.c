@@ -1,4 +1,4 @@
-/* Tests of checkpoints (solver/checkpoint.h and every module's snapshot_put/_get through
+/* Tests of checkpoints (solver/base/checkpoint.h and every module's snapshot_put/_get through
  * cdem_run_capture / cdem_run_open with a snapshot): a run of N steps straight and a run
  * captured at step k, freed, restored into a fresh run context and continued to N must hold
  * bit-identical state (every array of the capture: elements, pair list with histories,

@@ -28,7 +28,7 @@ static double disc_mass(double r) {
     return RHO * M_PI * r * r;
 }
 
-/* The default model constants (common/model.c) with dt, damping, gravity chosen by the test. */
+/* The default model constants (solver/base/model.c) with dt, damping, gravity chosen by the test. */
 static cdem_model hand_model(double dt, double damping, double g) {
     cdem_model m;
     memset(&m, 0, sizeof m);
@@ -287,7 +287,7 @@ static void test_integrate_simd_paths(void **st) {
     }
 }
 
-/* The thread count changing from step to step (the run loop's governor, solver/governor.h)
+/* The thread count changing from step to step (the run loop's governor, solver/run/governor.h)
  * gives the same bits as one thread throughout, on both force paths and for the bonded
  * model. */
 static void test_integrate_threads_change_mid_run(void **st) {

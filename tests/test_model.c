@@ -1,4 +1,4 @@
-/* Tests of common/model.c: derived constants against hand-computed numbers, the boundary
+/* Tests of solver/base/model.c: derived constants against hand-computed numbers, the boundary
  * speed relation against the paper's worked examples, the increment schedule. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,7 +1,7 @@
 /* The registration tables of cdem-run are complete (issue 20): every boundary mode and every
  * granular contact law that the parameter table offers (the words of boundary.mode and
  * material.granular_law, common/params.c) is
- *   - implemented: the mode has a row in the boundary-mode registry (solver/bc_registry.c,
+ *   - implemented: the mode has a row in the boundary-mode registry (solver/modes/bc_registry.c,
  *     cdem_bc_find succeeds); the law is accepted by the contact kernel
  *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact;
  *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
@@ -150,7 +150,7 @@ static void test_registry_contact_laws(void **state) {
             break;
         default:
             fail_msg("material.granular_law = %s: no case in this test or in the kernel's "
-                     "switch (solver/contact.h)",
+                     "switch (solver/contact/contact.h)",
                      laws[i]);
         }
         assert_true(isfinite(force[i]) && force[i] > 0.0);

@@ -1,4 +1,4 @@
-/* Tests of common/summary.c: the key lines of the model summary for the default model and
+/* Tests of solver/run/summary.c: the key lines of the model summary for the default model and
  * for every boundary mode, with numbers checked against the model (not hard-coded output). */
 #include <setjmp.h>
 #include <stdarg.h>

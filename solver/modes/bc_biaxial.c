@@ -1,4 +1,4 @@
-/* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (common/model.c).
+/* bc_biaxial: the uni/biaxial test of a 10 x 5 unit sample, gravity off (solver/base/model.c).
  * Init: the base row is the bottom platen; a top platen of wall elements (base radius r,
  * spaced r) is added one radius above the highest free element; both platens extend 25% of
  * the base length beyond each end and are CDEM_FLAG_MOVING. Platen contacts are wall-class

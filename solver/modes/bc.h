@@ -1,5 +1,5 @@
 /* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one static
- * const cdem_bc_ops and one exported pointer; solver/bc_registry.c maps cdem_mode -> ops, so
+ * const cdem_bc_ops and one exported pointer; solver/modes/bc_registry.c maps cdem_mode -> ops, so
  * the solver never switches on mode names. Checklist for a mode (bc_planar_fault.c is the
  * template): name (parameter-file word); state_size (bytes of the private context, calloc'd
  * by cdem_bc_init); init (after the assembly is built: add/flag the mode's boundary elements
@@ -20,7 +20,6 @@
 #define CDEM_BC_H
 
 #include "cdem_error.h"
-#include "contact.h"
 #include "model.h"
 #include "params.h"
 #include "snapshot.h"

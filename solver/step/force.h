@@ -103,7 +103,7 @@ typedef struct {
      * the pass's one parallel region: the stepper's drift phase without a region of its own */
     int drift;
     const double *drift_factor;
-    /* with drift: the boundary mode's per-element move of this step (solver/bc.h step_move,
+    /* with drift: the boundary mode's per-element move of this step (solver/modes/bc.h step_move,
      * NULL: none), run by each thread over its chunks before their drift (the two commute:
      * boundary elements and free elements) */
     void (*boundary_move)(const void *ctx, cdem_state *s, long lo, long hi);

@@ -24,7 +24,7 @@
 #include <string.h>
 
 /* Radius classes are drawn from a shuffled "bag" holding each class as many times as its
- * share (CDEM_RADIUS_SHARES, common/model.h): the composition is then exact to within one
+ * share (CDEM_RADIUS_SHARES, solver/base/model.h): the composition is then exact to within one
  * bag instead of carrying binomial noise (about 2 % in the element count of a 10 x 5 unit
  * assembly with independent draws). */
 static const int bag_counts[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;

@@ -5,7 +5,7 @@
  * histories of the remaining pairs are kept. Nothing moves afterwards: the material
  * collapses under gravity; elements that run off the ends of the base are removed by the
  * escape rule. Net displacement is always 0; the display interval is in seconds
- * (common/model.c). */
+ * (solver/base/model.c). */
 #include "bc.h"
 #include "checkpoint.h"
 

@@ -153,7 +153,7 @@ static cdem_status grow_i32(int32_t **a, size_t *cap, size_t need, cdem_error *e
     return CDEM_OK;
 }
 
-/* A radius class drawn with the classes' number shares (CDEM_RADIUS_SHARES, common/model.h):
+/* A radius class drawn with the classes' number shares (CDEM_RADIUS_SHARES, solver/base/model.h):
  * one uniform draw below the shares' sum, placed among their running sums. */
 static int draw_class(gsl_rng *rng) {
     static const int shares[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;

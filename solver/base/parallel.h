@@ -3,7 +3,7 @@
  * A step of the default model (~2500 elements, ~5000 pairs) takes ~0.1 ms, comparable to
  * the cost of waking a sleeping thread (OMP_WAIT_POLICY=passive) on a shared machine, so
  * small models stay serial; from ~8,000 elements (half radii) the force pass (with the
- * boundary modes' moves, solver/bc.h step_move) and the neighbour-list build are threaded.
+ * boundary modes' moves, solver/modes/bc.h step_move) and the neighbour-list build are threaded.
  * The integrator and the neighbour list start from CDEM_PAR_MIN and `cdem-run --par-min N`
  * overrides it. Results never depend on it (docs/reliability.md: bit-identical for any
  * thread count). Compile-time constant; no state. */

@@ -20,7 +20,7 @@
 #define CDEM_PREGROWTH_LAYERS 24
 
 /* The radius classes' number shares, smallest first (4:3:2:1, the original program's): the
- * assembly's composition (solver/assembly.c) and the deposits' draws (solver/sediment.c). An
+ * assembly's composition (solver/packing/assembly.c) and the deposits' draws (solver/packing/sediment.c). An
  * initializer for an int array of CDEM_NUM_RADII, and the shares' sum. */
 #define CDEM_RADIUS_SHARES                                                                         \
     { 4, 3, 2, 1 }
