@@ -34,7 +34,24 @@
 #define NOMAX HUGE_VAL
 
 static const char *const material_words[] = {"granular", "bonded", NULL};
-static const char *const law_words[] = {"normal-cohesion", "coulomb", "spring-cohesion", NULL};
+/* The laws' words, in enum order (the users' laws: a fixture of the tests has no word a
+ * file could use), and every law's row text. */
+static const char *const law_words[] = {
+#define CDEM_LAW(ID, word, description, scalar, lanes) word,
+#include "laws/laws.def"
+#undef CDEM_LAW
+    NULL};
+_Static_assert(sizeof law_words / sizeof law_words[0] == CDEM_LAW_WORDS + 1,
+               "one word per law of parameter files (laws.def)");
+static const struct {
+    const char *word, *description;
+} law_rows[CDEM_LAW_COUNT] = {
+#define CDEM_LAW(ID, word, description, scalar, lanes) [CDEM_LAW_##ID] = {word, description},
+#define CDEM_TEST_LAW                                  CDEM_LAW
+#include "laws/laws.def"
+#undef CDEM_LAW
+#undef CDEM_TEST_LAW
+};
 static const char *const cohesive_words[] = {"equilibrated", "formed", "initial", NULL};
 /* A real parameter whose row has choices accepts its one word instead of a number, stored as
  * NaN: "take the value of another parameter" (the base takes the lateral walls' values). */
@@ -100,7 +117,11 @@ static const cdem_param_def param_table[] = {
     {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
      "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
-     "granular: shear strength mu (Fn + C0) (normal-cohesion), mu Fn + C0 (coulomb), or Fs = Ks Xs + C0 capped at mu Fn (spring-cohesion)"},
+     "granular: how the cohesion C0 enters a contact's shear strength"
+#define CDEM_LAW(ID, word, description, scalar, lanes) "; " word ": " description
+#include "laws/laws.def"
+#undef CDEM_LAW
+    },
     {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "initial", 0, 0, 0, 0, cohesive_words,
      "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)"},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
@@ -217,6 +238,14 @@ const cdem_param_def *cdem_params_find(const char *section, const char *key) {
     return NULL;
 }
 
+const char *cdem_law_name(cdem_granular_law law) {
+    return (int)law >= 0 && law < CDEM_LAW_COUNT ? law_rows[law].word : "?";
+}
+
+const char *cdem_law_description(cdem_granular_law law) {
+    return (int)law >= 0 && law < CDEM_LAW_COUNT ? law_rows[law].description : "?";
+}
+
 const char *cdem_mode_name(cdem_mode mode) {
     if ((int)mode < 0 || (size_t)mode >= sizeof mode_words / sizeof mode_words[0] - 1)
         return "unknown";
@@ -266,6 +295,26 @@ static void join_words(const char *const *words, char *buf, size_t n) {
             break;
         pos += (size_t)w;
     }
+}
+
+void cdem_words_or(const char *const *words, size_t n, char *buf, size_t cap) {
+    size_t pos = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < n && pos < cap; i++) {
+        const char *sep = i == 0 ? "" : i + 1 == n ? " or " : ", ";
+        const int w = snprintf(buf + pos, cap - pos, "%s%s", sep, words[i]);
+        if (w < 0)
+            break;
+        pos += (size_t)w;
+    }
+}
+
+void cdem_params_join_choices(const char *section, const char *key, char *buf, size_t cap) {
+    const cdem_param_def *d = cdem_params_find(section, key);
+    size_t n = 0;
+    while (d && d->choices && d->choices[n])
+        n++;
+    cdem_words_or(d ? d->choices : NULL, n, buf, cap);
 }
 
 void cdem_params_format_number(double v, char *buf, size_t n) {

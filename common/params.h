@@ -21,13 +21,19 @@
 
 typedef enum { CDEM_MATERIAL_GRANULAR = 0, CDEM_MATERIAL_BONDED = 1 } cdem_material_model;
 
-/* Granular contact laws: how the cohesion C0 enters the shear strength of a contact
- * (docs/solver.md section 1; one file each, solver/law_*.h). */
+/* Granular contact laws: how the cohesion C0 enters the shear strength of a contact, one
+ * CDEM_LAW_<ID> per row of common/laws/laws.def (docs/solver.md section 1): the laws of
+ * parameter files first, then the tests' fixtures (CDEM_TEST_LAW). */
 typedef enum {
-    CDEM_LAW_NORMAL_COHESION = 0, /* |Fs| <= mu (Fn + C0): C0 in parallel with the normal force */
-    CDEM_LAW_COULOMB = 1,         /* |Fs| <= mu Fn + C0: a Mohr-Coulomb contact */
-    CDEM_LAW_SPRING_COHESION = 2, /* Fs = Ks Xs + C0, |Fs| <= mu Fn: manual Eq. 2 as printed */
-    CDEM_LAW_COUNT = 3
+#define CDEM_LAW(ID, word, description, scalar, lanes) CDEM_LAW_##ID,
+#include "laws/laws.def"
+#undef CDEM_LAW
+    CDEM_LAW_WORDS, /* the number of laws a parameter file can name */
+    CDEM_LAW_TESTS_BEFORE = CDEM_LAW_WORDS - 1,
+#define CDEM_TEST_LAW(ID, word, description, scalar, lanes) CDEM_LAW_##ID,
+#include "laws/laws.def"
+#undef CDEM_TEST_LAW
+    CDEM_LAW_COUNT /* every registered law, the tests' included */
 } cdem_granular_law;
 
 /* Granular: which contacts carry the cohesion C0. */
@@ -217,6 +223,12 @@ typedef void (*cdem_params_rules)(const cdem_params *p, cdem_rule_log *log);
  * line, in err->msg (CDEM_ERR_CONFLICT). */
 cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err);
 
+/* "a, b or c" from words[0..n) into buf (cut at cap). */
+void cdem_words_or(const char *const *words, size_t n, char *buf, size_t cap);
+
+/* The words of an enum parameter (section.key), as cdem_words_or lists them. */
+void cdem_params_join_choices(const char *section, const char *key, char *buf, size_t cap);
+
 /* Formats a number so that strtod gives back exactly the same value, as short as possible
  * (whole numbers up to 7 digits without exponent): the values quoted in messages. */
 void cdem_params_format_number(double v, char *buf, size_t n);
@@ -238,5 +250,10 @@ int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base)
 
 /* Words of enum values (for summaries and messages). */
 const char *cdem_mode_name(cdem_mode mode);
+
+/* A law's word (a test fixture's too) and its one-line description, from its row; "?" for
+ * a value that is no law. */
+const char *cdem_law_name(cdem_granular_law law);
+const char *cdem_law_description(cdem_granular_law law);
 
 #endif

@@ -3,7 +3,8 @@
  * material.granular_law, common/params.c) is
  *   - implemented: the mode has a row in the boundary-mode registry (solver/modes/bc_registry.c,
  *     cdem_bc_find succeeds); the law is accepted by the contact kernel
- *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact;
+ *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact
+ *     (every registered law: also the tests' fixtures, which no parameter file names);
  *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
  *   - tested: a test source under tests/ (other than this file) names its enum constant
  *     (CDEM_MODE_<NAME> / CDEM_LAW_<NAME>, '-' as '_').
@@ -24,6 +25,7 @@
 #include <ctype.h>
 #include <glob.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -120,45 +122,57 @@ static void test_registry_boundary_modes(void **state) {
     assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }
 
+/* The tangential force a cohesive contact transmits when pushed far past its strength
+ * under law `law` (Kn = Ks = 1e9 N/m, Fn = 1e6 N, mu 0.25, C0 5e8 N): the law's limit. */
+static double sliding_force(cdem_granular_law law, const char *word) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.granular_law = law;
+    p.element.friction = 0.25;
+    p.element.cohesion = 5e8;
+    cdem_contact_law cl;
+    cdem_error err;
+    if (cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err) != CDEM_OK)
+        fail_msg("material.granular_law = %s is refused: %s", word, err.msg);
+    assert_int_equal(cl.granular, (int)law);
+    /* i at the origin, j at (1.999, 0): R - r = 1e-3 m; t = (0, 1); Xs = 1000 m of shear */
+    const double dx = 1.999, R = 2.0;
+    double xs = 1000.0, fx = 0.0, fy = 0.0;
+    uint8_t hist = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
+    cdem_contact_touching(&cl, CDEM_CLASS_ELEMENT, dx * dx, dx, 0.0, R, 0.0, 0.0, 0.01, &xs, &hist,
+                          &fx, &fy);
+    return fy;
+}
+
 static void test_registry_contact_laws(void **state) {
     (void)state;
     size_t n;
     const char *const *laws = choices_of("material", "granular_law", &n);
-    assert_int_equal(n, CDEM_LAW_COUNT);
-    /* each law is accepted and is a law of its own: a cohesive contact pushed past its
-     * strength transmits a different tangential force under each law */
+    assert_int_equal(n, CDEM_LAW_WORDS);
+    /* every registered law, the tests' fixtures too, is accepted by the contact kernel, has
+     * its word and its description, and is a law of its own: a cohesive contact pushed past
+     * its strength transmits a different tangential force under each law */
     double force[CDEM_LAW_COUNT];
-    for (size_t i = 0; i < n; i++) {
-        cdem_params p;
-        cdem_params_defaults(&p);
-        p.granular_law = (cdem_granular_law)i;
-        cdem_contact_law law;
-        cdem_error err;
-        if (cdem_contact_law_init(&law, &p, 1e9, 1e9, &err) != CDEM_OK)
-            fail_msg("material.granular_law = %s is refused: %s", laws[i], err.msg);
-        assert_int_equal(law.granular, (int)i);
-        force[i] = 0.0;
-        switch (law.granular) {
-        case CDEM_LAW_COULOMB:
-            force[i] = cdem_law_coulomb(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        case CDEM_LAW_SPRING_COHESION:
-            force[i] = cdem_law_spring_cohesion(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        case CDEM_LAW_NORMAL_COHESION:
-            force[i] = cdem_law_normal_cohesion(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        default:
-            fail_msg("material.granular_law = %s: no case in this test or in the kernel's "
-                     "switch (solver/contact/contact.h)",
-                     laws[i]);
-        }
+    for (int i = 0; i < CDEM_LAW_COUNT; i++) {
+        const cdem_granular_law law = (cdem_granular_law)i;
+        if ((size_t)i < n)
+            assert_string_equal(cdem_law_name(law), laws[i]);
+        assert_true(strcmp(cdem_law_description(law), "?") != 0);
+        force[i] = sliding_force(law, cdem_law_name(law));
         assert_true(isfinite(force[i]) && force[i] > 0.0);
-        for (size_t j = 0; j < i; j++)
+        for (int j = 0; j < i; j++)
             if (force[j] == force[i])
-                fail_msg("laws %s and %s give the same sliding force %g", laws[j], laws[i],
-                         force[i]);
+                fail_msg("laws %s and %s give the same sliding force %g", cdem_law_name(j),
+                         cdem_law_name(law), force[i]);
     }
+    /* a value that is no law is refused, naming the laws */
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.granular_law = CDEM_LAW_COUNT;
+    cdem_contact_law cl;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb or spring-cohesion"));
     assert_documented_and_tested("material.granular_law", laws, n, "CDEM_LAW_");
 }
 

@@ -1,5 +1,5 @@
-/* contact: see contact.h. Only set-up code lives here; the per-pair law is inline in the
- * header so the force loop in integrate.c can inline it. */
+/* contact: see contact.h. Only set-up code lives here; the per-pair kernel is inline in the
+ * header so the force pass (solver/step/force.c) can inline it. */
 #include "contact.h"
 
 #include "checkpoint.h"
@@ -58,11 +58,12 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
     const cdem_contact_material *mats[CDEM_CLASS_COUNT] = {&p->element, &p->wall, &p->fault, &base};
     law->model = p->material;
     law->first_slip = p->first_slip ? 1 : 0;
-    if ((int)p->granular_law < 0 || p->granular_law >= CDEM_LAW_COUNT)
-        return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "contact law: material.granular_law = %d: must be normal-cohesion, "
-                         "coulomb or spring-cohesion",
-                         (int)p->granular_law);
+    if ((int)p->granular_law < 0 || p->granular_law >= CDEM_LAW_COUNT) {
+        char words[256];
+        cdem_params_join_choices("material", "granular_law", words, sizeof words);
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "contact law: material.granular_law = %d: must be %s",
+                         (int)p->granular_law, words);
+    }
     if (p->cohesive_contacts != CDEM_COHESIVE_EQUILIBRATED &&
         p->cohesive_contacts != CDEM_COHESIVE_FORMED &&
         p->cohesive_contacts != CDEM_COHESIVE_INITIAL)

@@ -1,10 +1,9 @@
 /* contact: the pair force laws of the manual and paper (bonded and frictional-cohesive), evaluated
  * for one pair with its history, in one kernel (cdem_contact_touching / cdem_contact_eval)
  * that the integrator's force loop, the tests and everything else call. The granular laws
- * differ only in how the cohesion C0 enters the shear strength; each is one inline function
- * in its own file (law_normal_cohesion.h, the default; law_coulomb.h; law_spring_cohesion.h;
- * the interface in law.h) selected by material.granular_law. State change rules, the same
- * for every law:
+ * differ only in how the cohesion C0 enters the shear strength; each is a file of
+ * common/laws/ and a line of laws.def (the interface in law.h), selected by
+ * material.granular_law. State change rules, the same for every law:
  *   - cohesion/bond created: at the end of equilibration for every touching pair
  *     (cdem_integrator_make_cohesive); with cohesive_contacts = formed also for every
  *     contact that forms afterwards (cdem_contact_law_phase sets cohesive_new); with
@@ -35,10 +34,10 @@
 #include "snapshot.h"
 #include "state.h"
 
-#include "law.h"
-#include "law_coulomb.h"
-#include "law_normal_cohesion.h"
-#include "law_spring_cohesion.h"
+/* the laws' scalar kernels (common/laws/law.h) */
+#define CDEM_LAW_SCALAR
+#include "laws/law.h"
+#include "laws/laws.def"
 
 #include <math.h>
 #include <stdint.h>
@@ -187,16 +186,17 @@ static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int c
         const double spring = law->ks * sv;
         const double mu = law->friction[cls];
         const double c0 = (h & CDEM_PAIR_COHESIVE) ? law->cohesion[cls] : 0.0;
-        cdem_shear sh;
-        switch (law->granular) {
-        case CDEM_LAW_COULOMB:
-            sh = cdem_law_coulomb(spring, fn, mu, c0);
-            break;
-        case CDEM_LAW_SPRING_COHESION:
-            sh = cdem_law_spring_cohesion(spring, fn, mu, c0);
-            break;
-        default:
-            sh = cdem_law_normal_cohesion(spring, fn, mu, c0);
+        cdem_shear sh = {0.0, 0.0, 0};
+        switch (law->granular) { /* one case per row of laws.def */
+#define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
+    case CDEM_LAW_##ID:                                                                            \
+        sh = scalar(spring, fn, mu, c0);                                                           \
+        break;
+#define CDEM_TEST_LAW CDEM_LAW
+#include "laws/laws.def"
+#undef CDEM_LAW
+#undef CDEM_TEST_LAW
+        default: /* none: cdem_contact_law_init refuses any value without a row */
             break;
         }
         if (sh.slid) {

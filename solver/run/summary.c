@@ -236,12 +236,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
          p->material == CDEM_MATERIAL_GRANULAR ? "granular frictional-cohesive"
                                                : "initially bonded");
     if (p->material == CDEM_MATERIAL_GRANULAR) {
-        static const char *const laws[CDEM_LAW_COUNT] = {
-            "normal-cohesion: shear strength mu (Fn + C0)", "coulomb: shear strength mu Fn + C0",
-            "spring-cohesion: Fs = Ks Xs + C0, shear strength mu Fn"};
-        line(f, "contact law", "%s",
-             (int)p->granular_law >= 0 && p->granular_law < CDEM_LAW_COUNT ? laws[p->granular_law]
-                                                                           : "?");
+        line(f, "contact law", "%s: %s", cdem_law_name(p->granular_law),
+             cdem_law_description(p->granular_law));
         line(f, "cohesive contacts", "%s",
              p->cohesive_contacts == CDEM_COHESIVE_FORMED
                  ? "those of the end of equilibration and every contact formed later"

@@ -1,12 +1,15 @@
 /* force_avx2: the AVX2 evaluation of a block of pairs (force_pairs.h), four pairs per step in
  * the lanes of 256-bit registers: the gathers of the two elements' positions and velocities,
  * the distance, the touch test, the square root and the division, the normal and the trial
- * tangential force, and the granular law with masks (blends) where the scalar kernel
- * branches; the history bytes per lane. A group of four falls back to the scalar kernel when
- * one of its pairs is an intact bond (bonded model) or belongs to another chunk; so does the
- * tail of the block. Compiled for the baseline x86-64 like the rest, with target("avx2") on
- * these functions only, so the scalar path still runs on any x86-64; elsewhere this file
- * provides cdem_force_avx2_usable() = 0 and the scalar path is the only one. */
+ * tangential force, and the granular law's AVX2 kernel (common/laws/law_*.h: masks (blends)
+ * where its scalar kernel branches); the history bytes per lane. Each law has a loop of its
+ * own, its kernel inlined, chosen by one switch generated from laws.def; a law without an
+ * AVX2 kernel is evaluated pair by pair by its scalar kernel, never by another law's. A group
+ * of four falls back to the scalar kernel when one of its pairs is an intact bond (bonded
+ * model) or belongs to another chunk; so does the tail of the block. Compiled for the baseline
+ * x86-64 like the rest, with target("avx2") on these functions only, so the scalar path still runs
+ * on any x86-64; elsewhere this file provides cdem_force_avx2_usable() = 0 and the scalar path is
+ * the only one. */
 #include "force_pairs.h"
 
 #include <string.h>
@@ -16,6 +19,11 @@
 #include <immintrin.h>
 
 #define AVX2 __attribute__((target("avx2")))
+
+/* the laws' AVX2 kernels (common/laws/law.h) */
+#define CDEM_LAW_LANES
+#include "laws/law.h"
+#include "laws/laws.def"
 
 int cdem_force_avx2_usable(void) {
     __builtin_cpu_init();
@@ -65,10 +73,16 @@ static const uint32_t lane_bytes[16] = {0x00000000u, 0x000000ffu, 0x0000ff00u, 0
                                         0xff000000u, 0xff0000ffu, 0xff00ff00u, 0xff00ffffu,
                                         0xffff0000u, 0xffff00ffu, 0xffffff00u, 0xffffffffu};
 
-AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+/* The AVX2 kernel of a law (law.h): four contacts' trial spring force, normal force,
+ * friction and cohesion in, the transmitted force, the spring kept and the slip mask out. */
+typedef cdem_shear4 (*law_lanes)(__m256d spring, __m256d fn, __m256d mu, __m256d c0);
+
+/* cdem_force_pairs_avx2 for the law whose AVX2 kernel is `lanes` (a constant at each call,
+ * so the kernel is inlined and each law has a loop of its own). */
+AVX2 static inline __attribute__((always_inline)) long
+pairs_with_law(const cdem_force_pairs *a, long p0, long p1, int32_t below, law_lanes lanes) {
     const cdem_contact_law *law = a->law;
     const int tangential = law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0;
-    const cdem_granular_law glaw = law->granular;
     /* the history rules on four bytes at once: every byte's TOUCH bit set, COHESIVE added to
      * the bytes that were not touching when forming contacts are cohesive, COHESIVE cleared on
      * a slip with first_slip */
@@ -154,39 +168,15 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
                 _mm256_and_si256(_mm256_cvtepu8_epi64(_mm_cvtsi32_si128((int)hn4)), coh_bit),
                 coh_bit);
             const __m256d c0 = _mm256_and_pd(coh, _mm256_castsi256_pd(cohesive));
-            /* the law (law_*.h): the trial force f and its limit; slid = |f| > limit */
-            __m256d f = spring, limit;
-            switch (glaw) {
-            case CDEM_LAW_COULOMB: {
-                const __m256d l = _mm256_mul_pd(mu, fn);
-                limit =
-                    _mm256_blendv_pd(l, _mm256_add_pd(l, c0), _mm256_cmp_pd(c0, zero, _CMP_GT_OQ));
-                break;
-            }
-            case CDEM_LAW_SPRING_COHESION: {
-                limit = _mm256_mul_pd(mu, fn);
-                const __m256d add = _mm256_and_pd(_mm256_cmp_pd(c0, zero, _CMP_GT_OQ),
-                                                  _mm256_cmp_pd(spring, zero, _CMP_NEQ_UQ));
-                const __m256d sc = _mm256_blendv_pd(_mm256_xor_pd(c0, sign), c0,
-                                                    _mm256_cmp_pd(spring, zero, _CMP_GT_OQ));
-                f = _mm256_blendv_pd(spring, _mm256_add_pd(spring, sc), add);
-                break;
-            }
-            default:
-                limit = _mm256_mul_pd(mu, _mm256_add_pd(fn, c0));
-                break;
-            }
-            const __m256d slid = _mm256_cmp_pd(_mm256_andnot_pd(sign, f), limit, _CMP_GT_OQ);
-            const __m256d capped = _mm256_blendv_pd(_mm256_xor_pd(limit, sign), limit,
-                                                    _mm256_cmp_pd(f, zero, _CMP_GT_OQ));
-            const __m256d force = _mm256_blendv_pd(f, capped, slid);
-            const int slidm = _mm256_movemask_pd(slid);
-            sv = _mm256_blendv_pd(sv, _mm256_div_pd(force, ks), slid);
+            /* the law (common/laws/law_*.h): the force, the spring kept, the slip mask */
+            const cdem_shear4 sh = lanes(spring, fn, mu, c0);
+            const int slidm = _mm256_movemask_pd(sh.slid);
+            sv = _mm256_blendv_pd(sv, _mm256_div_pd(sh.spring, ks), sh.slid);
             /* separated lanes keep their value here (set to 0 below when they have a history) */
             _mm256_storeu_pd(xs + p, _mm256_blendv_pd(sv, xs0, sep));
             hn4 &= ~(lane_bytes[slidm] & slip_clears4);
-            ftx = _mm256_mul_pd(force, tx);
-            fty = _mm256_mul_pd(force, ty);
+            ftx = _mm256_mul_pd(sh.force, tx);
+            fty = _mm256_mul_pd(sh.force, ty);
         }
         const __m256d nfn = _mm256_xor_pd(fn, sign);
         const __m256d fx = _mm256_add_pd(_mm256_mul_pd(nfn, nx), ftx);
@@ -204,6 +194,29 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
         }
     }
     return left + group_scalar(a, p, p1, below);
+}
+
+/* The vector path of a law: its AVX2 kernel when it has one, else every pair by its scalar
+ * kernel (the same bits; only the speed differs). */
+AVX2 static inline __attribute__((always_inline)) long
+pairs_of_law(const cdem_force_pairs *a, long p0, long p1, int32_t below, law_lanes lanes) {
+    if (!lanes)
+        return group_scalar(a, p0, p1, below);
+    return pairs_with_law(a, p0, p1, below, lanes);
+}
+
+AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+    switch (a->law->granular) { /* one case per row of laws.def */
+#define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
+    case CDEM_LAW_##ID:                                                                            \
+        return pairs_of_law(a, p0, p1, below, lanes);
+#define CDEM_TEST_LAW CDEM_LAW
+#include "laws/laws.def"
+#undef CDEM_LAW
+#undef CDEM_TEST_LAW
+    default: /* no law: the scalar kernel says so */
+        return group_scalar(a, p0, p1, below);
+    }
 }
 
 AVX2 void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, double *acc) {
