@@ -56,9 +56,21 @@ static const char *const cohesive_words[] = {"equilibrated", "formed", "initial"
 /* A real parameter whose row has choices accepts its one word instead of a number, stored as
  * NaN: "take the value of another parameter" (the base takes the lateral walls' values). */
 static const char *const as_wall_words[] = {"wall", NULL};
+/* The modes' words, in enum order (the users' modes), and every mode's word. */
 static const char *const mode_words[] = {
-    "planar-fault", "listric-fault", "irregular-fault", "vertical-faults",
-    "detachment",   "repose",        "biaxial",         NULL};
+#define CDEM_MODE(ID, id, word) word,
+#include "modes.def"
+#undef CDEM_MODE
+    NULL};
+_Static_assert(sizeof mode_words / sizeof mode_words[0] == CDEM_MODE_WORDS + 1,
+               "one word per mode of parameter files (modes.def)");
+static const char *const mode_names[CDEM_MODE_COUNT] = {
+#define CDEM_MODE(ID, id, word) [CDEM_MODE_##ID] = word,
+#define CDEM_TEST_MODE          CDEM_MODE
+#include "modes.def"
+#undef CDEM_MODE
+#undef CDEM_TEST_MODE
+};
 static const char *const sense_words[] = {"normal", "reverse", NULL};
 static const char *const kin_words[] = {"ch", "cd", NULL};
 static const char *const vert_words[] = {"caldera", "piston", NULL};
@@ -247,9 +259,7 @@ const char *cdem_law_description(cdem_granular_law law) {
 }
 
 const char *cdem_mode_name(cdem_mode mode) {
-    if ((int)mode < 0 || (size_t)mode >= sizeof mode_words / sizeof mode_words[0] - 1)
-        return "unknown";
-    return mode_words[mode];
+    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_names[mode] : "unknown";
 }
 
 int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base) {
@@ -976,18 +986,6 @@ void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) {
         log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
 }
 
-/* Options the biaxial test excludes ({section, key}; all BOOL or ENUM with 0 = off). */
-static const char *const biaxial_excludes[][2] = {
-    {"heterogeneity", "flexural_slip"},    {"heterogeneity", "weak_interval"},
-    {"heterogeneity", "layered_friction"}, {"surface", "erosion"},
-    {"surface", "sedimentation"},
-};
-
-static int is_fault_mode(cdem_mode m) {
-    return m == CDEM_MODE_PLANAR_FAULT || m == CDEM_MODE_LISTRIC_FAULT ||
-           m == CDEM_MODE_IRREGULAR_FAULT;
-}
-
 cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err) {
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
@@ -1066,12 +1064,6 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
                       material_words[p->material]);
     if (p->overburden_pressure > 0) {
         cdem_params_format_number(p->overburden_pressure, v1, sizeof v1);
-        if (p->mode == CDEM_MODE_REPOSE || p->mode == CDEM_MODE_BIAXIAL)
-            cdem_rule_add(
-                &log,
-                "overburden_pressure = %s N/m cannot be used with mode = %s: set [surface] "
-                "overburden_pressure = 0 or choose another mode",
-                v1, mode_words[p->mode]);
         if (p->erosion)
             cdem_rule_add(&log,
                           "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
@@ -1083,55 +1075,6 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
                           "overburden_pressure = 0 or sedimentation = off",
                           v1);
     }
-    if (p->mode == CDEM_MODE_BIAXIAL) {
-        if (p->width != 10.0 || p->height != 5.0) {
-            cdem_params_format_number(p->width, v1, sizeof v1);
-            cdem_params_format_number(p->height, v2, sizeof v2);
-            cdem_rule_add(
-                &log,
-                "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
-                "height = %s): set them in [assembly]",
-                v1, v2);
-        }
-        for (size_t i = 0; i < sizeof biaxial_excludes / sizeof biaxial_excludes[0]; i++) {
-            const cdem_param_def *d =
-                cdem_params_find(biaxial_excludes[i][0], biaxial_excludes[i][1]);
-            int v;
-            memcpy(&v, (const char *)p + d->offset, sizeof v);
-            if (v) {
-                cdem_params_format_value(p, d, v1, sizeof v1);
-                cdem_rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key,
-                              v1, d->section, d->key);
-            }
-        }
-    }
-    if (p->mode == CDEM_MODE_REPOSE) {
-        if (p->erosion)
-            cdem_rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
-        if (p->sedimentation)
-            cdem_rule_add(
-                &log,
-                "mode = repose excludes sedimentation = on: set [surface] sedimentation = off");
-    }
-    if (p->mode == CDEM_MODE_IRREGULAR_FAULT && p->fault_file[0] == '\0')
-        cdem_rule_add(&log,
-                      "mode = irregular-fault requires fault_file: set [boundary] fault_file to "
-                      "a text file of x y vertices in m");
-    if (p->mode == CDEM_MODE_VERTICAL_FAULTS &&
-        !(p->vertical_fault_location + p->vertical_fault_spacing < 1.0)) {
-        cdem_params_format_number(p->vertical_fault_location, v1, sizeof v1);
-        cdem_params_format_number(p->vertical_fault_spacing, v2, sizeof v2);
-        cdem_rule_add(
-            &log,
-            "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s + "
-            "%s must be < 1 (the second fault must lie inside the base): reduce one of them",
-            v1, v2);
-    }
-    if (p->inversion && !is_fault_mode(p->mode))
-        cdem_rule_add(&log,
-                      "inversion = on needs mode = planar-fault, listric-fault or irregular-fault "
-                      "(got mode = %s): set [boundary] inversion = off",
-                      mode_words[p->mode]);
     if (more)
         more(p, &log);
     if (log.count > 0)

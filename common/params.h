@@ -43,14 +43,18 @@ typedef enum {
     CDEM_COHESIVE_INITIAL = 2,      /* contacts of the built assembly still touching then */
 } cdem_cohesive_contacts;
 
+/* Boundary (faulting) modes, one CDEM_MODE_<ID> per row of common/modes.def (docs/solver.md
+ * section 4): the modes of parameter files first, then the tests' fixtures. */
 typedef enum {
-    CDEM_MODE_PLANAR_FAULT = 0, /* planar normal/reverse fault, optional inversion */
-    CDEM_MODE_LISTRIC_FAULT,    /* left wall sculpted into a listric fault, footwall removed */
-    CDEM_MODE_IRREGULAR_FAULT,  /* as listric, fault shape read from fault_file */
-    CDEM_MODE_VERTICAL_FAULTS,  /* two vertical faults: caldera or piston */
-    CDEM_MODE_DETACHMENT,       /* lateral wall(s) move inward over the base */
-    CDEM_MODE_REPOSE,           /* lateral wall(s) removed after equilibration */
-    CDEM_MODE_BIAXIAL,          /* platens shorten a 10 x 5 unit sample, gravity off */
+#define CDEM_MODE(ID, id, word) CDEM_MODE_##ID,
+#include "modes.def"
+#undef CDEM_MODE
+    CDEM_MODE_WORDS, /* the number of modes a parameter file can name */
+    CDEM_MODE_TESTS_BEFORE = CDEM_MODE_WORDS - 1,
+#define CDEM_TEST_MODE(ID, id, word) CDEM_MODE_##ID,
+#include "modes.def"
+#undef CDEM_TEST_MODE
+    CDEM_MODE_COUNT /* every registered mode, the tests' included */
 } cdem_mode;
 
 typedef enum { CDEM_SENSE_NORMAL = 0, CDEM_SENSE_REVERSE = 1 } cdem_fault_sense;
@@ -248,7 +252,7 @@ void cdem_params_write_markdown(FILE *out);
  * own, 0 when the base is the wall throughout. */
 int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base);
 
-/* Words of enum values (for summaries and messages). */
+/* A mode's word (a test fixture's too), from its row; "unknown" for a value that is none. */
 const char *cdem_mode_name(cdem_mode mode);
 
 /* A law's word (a test fixture's too) and its one-line description, from its row; "?" for

@@ -8,6 +8,7 @@
  * replaced without --force, and a file that is not a cdem run file never. Messages go to stderr as
  * "cdem-run: <message>", one line per problem; the summary and the --print-defaults /
  * --params-markdown texts go to stdout so they can be redirected into files. */
+#include "bc.h"
 #include "h5format.h"
 #include "model.h"
 #include "params.h"
@@ -344,10 +345,9 @@ static int same_file(const char *a, const char *b) {
 /* Refuses an output that is one of the run's inputs, then (before the model is set up, so
  * the refusal is immediate) an output another run is writing or that may not be replaced.
  * The writer repeats the last two checks under its lock. */
-static int check_output(const cli_args *a, const cdem_params *p, const char *out, cdem_error *err) {
-    const char *inputs[2] = {a->model_path,
-                             p->mode == CDEM_MODE_IRREGULAR_FAULT ? p->fault_file : NULL};
-    const char *what[2] = {"the parameter file", "the fault vertex file (boundary.fault_file)"};
+static int check_output(const cli_args *a, const cdem_model *m, const char *out, cdem_error *err) {
+    const char *inputs[2] = {a->model_path, m->mode.input};
+    const char *what[2] = {"the parameter file", m->mode.input_what};
     for (int k = 0; k < 2; k++)
         if (inputs[k] && inputs[k][0] && same_file(out, inputs[k])) {
             fprintf(stderr,
@@ -478,7 +478,7 @@ int main(int argc, char **argv) {
         goto fail;
     }
     cdem_model m;
-    if (cdem_model_derive(&p, &m, &err) != CDEM_OK)
+    if (cdem_bc_derive_model(&p, &m, &err) != CDEM_OK)
         goto fail;
     int running = !a.summary_only && !a.dry_run;
     if (running) {
@@ -487,7 +487,7 @@ int main(int argc, char **argv) {
             fprintf(stderr, "cdem-run: out of memory\n");
             goto done;
         }
-        rc = check_output(&a, &p, out_path, &err);
+        rc = check_output(&a, &m, out_path, &err);
         if (rc != EXIT_OK)
             goto done;
         rc = EXIT_ERROR;

@@ -1,8 +1,9 @@
 /* The registration tables of cdem-run are complete (issue 20): every boundary mode and every
  * granular contact law that the parameter table offers (the words of boundary.mode and
  * material.granular_law, common/params.c) is
- *   - implemented: the mode has a row in the boundary-mode registry (solver/modes/bc_registry.c,
- *     cdem_bc_find succeeds); the law is accepted by the contact kernel
+ *   - implemented: the mode's row of common/modes.def has its ops (cdem_bc_find succeeds, the
+ *     required hooks are there, what it excludes are parameters; every registered mode, the
+ *     tests' fixtures too); the law is accepted by the contact kernel
  *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact
  *     (every registered law: also the tests' fixtures, which no parameter file names);
  *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
@@ -111,13 +112,43 @@ static void test_registry_boundary_modes(void **state) {
     (void)state;
     size_t n;
     const char *const *modes = choices_of("boundary", "mode", &n);
-    for (size_t i = 0; i < n; i++) {
+    assert_int_equal(n, CDEM_MODE_WORDS);
+    /* every registered mode, the tests' fixtures too, has its ops with the required hooks;
+     * what it excludes are parameters of the table; a mode that moves no boundary says what
+     * happens instead (the summary's words) */
+    for (int i = 0; i < CDEM_MODE_COUNT; i++) {
+        const cdem_mode mode = (cdem_mode)i;
+        const char *word = cdem_mode_name(mode);
         const cdem_bc_ops *ops = NULL;
         cdem_error err;
-        if (cdem_bc_find((cdem_mode)i, &ops, &err) != CDEM_OK)
-            fail_msg("boundary.mode = %s has no implementation: %s", modes[i], err.msg);
+        if (cdem_bc_find(mode, &ops, &err) != CDEM_OK)
+            fail_msg("boundary.mode = %s has no implementation: %s", word, err.msg);
         assert_non_null(ops);
-        assert_string_equal(cdem_mode_name((cdem_mode)i), modes[i]);
+        if ((size_t)i < n)
+            assert_string_equal(word, modes[i]);
+        if (!ops->init || !ops->net_displacement || !ops->view || ops->state_size == 0 ||
+            !(ops->apply || (ops->step_begin && ops->step_move)))
+            fail_msg("boundary.mode = %s: a required hook of cdem_bc_ops is missing (bc.h)", word);
+        for (size_t k = 0; ops->excludes && ops->excludes[k]; k++) {
+            char section[32];
+            const char *dot = strchr(ops->excludes[k], '.');
+            assert_non_null(dot);
+            snprintf(section, sizeof section, "%.*s", (int)(dot - ops->excludes[k]),
+                     ops->excludes[k]);
+            if (!cdem_params_find(section, dot + 1))
+                fail_msg("boundary.mode = %s excludes %s, which is no parameter", word,
+                         ops->excludes[k]);
+        }
+        cdem_params p;
+        cdem_params_defaults(&p);
+        p.mode = mode;
+        cdem_model_mode mm = cdem_model_mode_default();
+        if (ops->derive)
+            ops->derive(&p, &mm);
+        if (mm.moving_boundaries == 0 && !mm.still)
+            fail_msg("boundary.mode = %s moves no boundary but does not say what happens", word);
+        if (mm.input && !mm.input_what)
+            fail_msg("boundary.mode = %s names an input file without saying what it is", word);
     }
     assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }

@@ -25,10 +25,12 @@ static const double damping_per_radius = 1091596.58430158;
 /* Sea-level rise factors, in cdem_sea_level_rise order. */
 static const double sea_factor[] = {0.0, 0.25, 0.5, 0.75, 1.0};
 
-cdem_status cdem_model_derive(const cdem_params *p, cdem_model *m, cdem_error *err) {
+cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode, cdem_model *m,
+                              cdem_error *err) {
     if (!p || !m)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_model_derive: NULL argument");
     memset(m, 0, sizeof *m);
+    m->mode = mode ? *mode : cdem_model_mode_default();
     if (!(p->unit_scaling > 0) || !(p->width > 0) || !(p->height > 0) || !(p->density > 0) ||
         !(p->runtime > 0) || !(p->equilibration >= 0) || !(p->display_interval > 0) ||
         !isfinite(p->runtime) || !isfinite(p->unit_scaling) || !isfinite(p->density))
@@ -70,7 +72,7 @@ cdem_status cdem_model_derive(const cdem_params *p, cdem_model *m, cdem_error *e
     m->ks = m->kn;
     m->boundary_speed = CDEM_BOUNDARY_ACCEL * m->dt;
     m->displacement_per_step = m->boundary_speed * m->dt;
-    m->gravity = p->mode == CDEM_MODE_BIAXIAL ? 0.0 : p->gravity;
+    m->gravity = m->mode.gravity_off ? 0.0 : p->gravity;
     m->width_m = p->width * p->unit_scaling;
     m->height_m = p->height * p->unit_scaling;
 
@@ -85,8 +87,8 @@ cdem_status cdem_model_derive(const cdem_params *p, cdem_model *m, cdem_error *e
     if (m->total_steps < m->equil_steps)
         m->total_steps = m->equil_steps;
 
-    /* Repose-collapse: the display interval is in seconds. */
-    if (p->mode == CDEM_MODE_REPOSE)
+    /* the display interval is in m of boundary displacement, in s when no boundary moves */
+    if (m->mode.moving_boundaries == 0)
         m->display_steps = p->display_interval / m->dt;
     else
         m->display_steps = p->display_interval / m->displacement_per_step;
@@ -109,13 +111,10 @@ cdem_status cdem_model_derive(const cdem_params *p, cdem_model *m, cdem_error *e
     m->n_increments_equil = (int)n_equil;
     m->n_increments_total = (int)(n_equil + n_after);
 
-    /* the boundary's displacement; both detachment walls move, so twice the shortening */
-    const double n_moving =
-        p->mode == CDEM_MODE_DETACHMENT && p->detachment_walls == CDEM_WALLS_BOTH ? 2.0 : 1.0;
-    m->total_displacement =
-        p->mode == CDEM_MODE_REPOSE
-            ? 0.0
-            : n_moving * (double)(m->total_steps - m->equil_steps) * m->displacement_per_step;
+    /* the boundaries' displacement: each moving boundary's counts (two walls moving inward,
+     * twice the shortening) */
+    m->total_displacement = (double)m->mode.moving_boundaries *
+                            (double)(m->total_steps - m->equil_steps) * m->displacement_per_step;
     m->sediment_interval = 30.0 * p->display_interval;
     m->sediment_steps = lround(m->sediment_interval / m->displacement_per_step);
     m->settling_steps = lround(0.2 * p->equilibration / m->dt);

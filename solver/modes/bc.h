@@ -1,20 +1,26 @@
-/* bc: boundary (faulting) modes. Each mode is one file solver/bc_<name>.c defining one static
- * const cdem_bc_ops and one exported pointer; solver/modes/bc_registry.c maps cdem_mode -> ops, so
- * the solver never switches on mode names. Checklist for a mode (bc_planar_fault.c is the
- * template): name (parameter-file word); state_size (bytes of the private context, calloc'd
- * by cdem_bc_init); init (after the assembly is built: add/flag the mode's boundary elements
- * CDEM_FLAG_WALL / FAULT / MOVING, record its geometry); apply (deformation step k, 1-based:
- * move the prescribed elements by this step's boundary increment du, sense decided by the
- * mode, and set their velocity to the boundary velocity; walls never move otherwise; a mode
- * with moves_in_equilibration = 1 is also called on every equilibration step, with k = 0;
- * a boundary_only mode gives it as step_begin + step_move instead, so that the stepper can
- * thread the moves: bc_planar_fault.c does);
- * net_displacement (m, of the moving boundary so far); view (one paragraph of the effective
- * settings); free (releases what init allocated in the context; NULL: nothing);
- * begin_deformation (optional, NULL: nothing; once before deformation step 1, may clear keep[i]
- * of elements to remove, e.g. repose drops its walls; the solver removes them through the
- * escape path, histories of the rest kept); confined (a flag: the solver loads the free side
- * edges with boundary.confining_pressure); measure (optional, see below).
+/* bc: boundary (faulting) modes. A mode is one file solver/modes/bc_<name>.c defining one
+ * static const cdem_bc_ops and one exported pointer cdem_bc_<id>, and one row of
+ * common/modes.def (its enum value and word); the registry (bc_registry.c) is made from the
+ * rows, so the solver never switches on mode names and nothing else names a mode. Checklist
+ * for a mode (bc_planar_fault.c is the template):
+ *   required: state_size (bytes of the private context, calloc'd by cdem_bc_init); init
+ *   (after the assembly is built: add/flag the mode's boundary elements CDEM_FLAG_WALL /
+ *   FAULT / MOVING, record its geometry); apply (deformation step k, 1-based: move the
+ *   prescribed elements by this step's boundary increment du, sense decided by the mode, and
+ *   set their velocity to the boundary velocity; walls never move otherwise; a mode with
+ *   moves_in_equilibration = 1 is also called on every equilibration step, with k = 0; a
+ *   boundary_only mode gives it as step_begin + step_move instead, so that the stepper can
+ *   thread the moves: bc_planar_fault.c does); net_displacement (m, of the moving boundary
+ *   so far); view (one paragraph of the effective settings of the set-up mode);
+ *   before the run, from the parameters alone (all optional): validate (its parameter rules),
+ *   excludes (switches it cannot run with), inverts (boundary.inversion allowed), derive (its
+ *   part of the model: gravity off, moving boundaries and display unit, base spacing, an
+ *   input file), describe (its lines of the summary);
+ *   optional during the run: free (NULL: the context owns no memory); begin_deformation (once
+ *   before deformation step 1, may clear keep[i] of elements to remove, e.g. repose drops its
+ *   walls; the solver removes them through the escape path, histories of the rest kept);
+ *   confined (the solver loads the free side edges with boundary.confining_pressure);
+ *   measure; save/restore (checkpoints).
  * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
@@ -28,7 +34,6 @@
 #include <stdio.h>
 
 typedef struct {
-    const char *name;  /* mode name as written in parameter files */
     size_t state_size; /* bytes of the private context, > 0 */
     cdem_status (*init)(void *ctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
                         cdem_error *err);
@@ -73,11 +78,27 @@ typedef struct {
      * init; a stored one that differs fails with CDEM_ERR_CONFLICT) */
     cdem_status (*save)(const void *ctx, cdem_snapshot *snap, cdem_error *err);
     cdem_status (*restore)(void *ctx, const cdem_snapshot *snap, cdem_error *err);
+    /* Before the run, from the parameters alone (cdem_run_validate, cdem_bc_derive_model, the
+     * summary), in this order in the parameter check: */
+    /* may be NULL: the mode's own rules, one cdem_rule_add each (the message names the mode,
+     * the keys and the fix) */
+    void (*validate)(const cdem_params *p, cdem_rule_log *log);
+    /* may be NULL: parameters the mode cannot run with, "section.key" (NULL-terminated); each
+     * must be off (a switch or a choice) or 0 (a number) */
+    const char *const *excludes;
+    /* 1: boundary.inversion reverses the mode's sense; 0: inversion = on is refused */
+    int inverts;
+    /* may be NULL (cdem_model_mode_default): the mode's part of the model (base/model.h) */
+    void (*derive)(const cdem_params *p, cdem_model_mode *out);
+    /* may be NULL (no lines): the summary's lines of the mode after "mode: WORD", written
+     * with cdem_summary_line (base/summary_line.h) */
+    void (*describe)(const cdem_params *p, const cdem_model *m, FILE *out);
 } cdem_bc_ops;
 
 /* A mode instance: its ops and its private context. */
 typedef struct {
     const cdem_bc_ops *ops;  /* NULL before init */
+    const char *name;        /* the mode's word (common/modes.def), for messages */
     void *ctx;               /* calloc'd state_size bytes */
     double lateral_pressure; /* N/m: boundary.confining_pressure when ops->confined, else 0 */
 } cdem_bc;
@@ -86,8 +107,20 @@ typedef struct {
  * has no implementation. */
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err);
 
-/* Comma-separated names of the implemented modes (static text). */
-const char *cdem_bc_implemented(void);
+/* The modes' parameter rules (a cdem_params_rules of cdem_params_validate): p's mode's
+ * validate, its excludes, and inversion = on with a mode that does not invert. */
+void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log);
+
+/* The model of p (cdem_model_derive) with its mode's part (the mode's derive hook). */
+cdem_status cdem_bc_derive_model(const cdem_params *p, cdem_model *m, cdem_error *err);
+
+/* The summary's lines of p's mode (its describe hook; none without one). */
+void cdem_bc_describe(const cdem_params *p, const cdem_model *m, FILE *out);
+
+/* What the fault modes' summaries share: the sense and location of the fault, and the
+ * inversion (its point and the net displacement). */
+void cdem_bc_describe_fault(const cdem_params *p, const cdem_model *m, FILE *out);
+void cdem_bc_describe_inversion(const cdem_params *p, const cdem_model *m, FILE *out);
 
 /* Finds the mode of p->mode, allocates its context and runs its init on s. */
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -155,13 +188,11 @@ static inline int cdem_bc_is_base(const cdem_bc_walls *w, const cdem_state *s, s
     return s->y[i] <= w->y_base + w->tol;
 }
 
-/* The modes implemented so far (one per bc_<name>.c). */
-extern const cdem_bc_ops *const cdem_bc_planar_fault;
-extern const cdem_bc_ops *const cdem_bc_vertical_faults;
-extern const cdem_bc_ops *const cdem_bc_detachment;
-extern const cdem_bc_ops *const cdem_bc_repose;
-extern const cdem_bc_ops *const cdem_bc_biaxial;
-extern const cdem_bc_ops *const cdem_bc_listric_fault;   /* bc_listric.c */
-extern const cdem_bc_ops *const cdem_bc_irregular_fault; /* bc_listric.c */
+/* The modes, one pointer each (bc_<id>.c), by the rows of common/modes.def. */
+#define CDEM_MODE(ID, id, word) extern const cdem_bc_ops *const cdem_bc_##id;
+#define CDEM_TEST_MODE          CDEM_MODE
+#include "modes.def"
+#undef CDEM_MODE
+#undef CDEM_TEST_MODE
 
 #endif

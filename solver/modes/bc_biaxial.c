@@ -15,6 +15,7 @@
  * same as in every other mode. Single-threaded; units m, N, N/m. */
 #include "bc.h"
 #include "checkpoint.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -346,8 +347,49 @@ static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_e
     return CDEM_OK;
 }
 
+/* What the test cannot run with: a load on its top, and everything that makes the sample
+ * other than one uniform material (heterogeneity, erosion, deposits). */
+static const char *const biaxial_excludes[] = {"surface.overburden_pressure",
+                                               "heterogeneity.flexural_slip",
+                                               "heterogeneity.weak_interval",
+                                               "heterogeneity.layered_friction",
+                                               "surface.erosion",
+                                               "surface.sedimentation",
+                                               NULL};
+
+/* The test is defined on a 10 x 5 unit sample. */
+static void biaxial_validate(const cdem_params *p, cdem_rule_log *log) {
+    if (p->width == 10.0 && p->height == 5.0)
+        return;
+    char v1[64], v2[64];
+    cdem_params_format_number(p->width, v1, sizeof v1);
+    cdem_params_format_number(p->height, v2, sizeof v2);
+    cdem_rule_add(log,
+                  "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
+                  "height = %s): set them in [assembly]",
+                  v1, v2);
+}
+
+/* No gravity in the test, and a smooth bottom platen (one radius apart, like the top one), so
+ * the two platens are alike and lubricated platens stay smooth. */
+static void biaxial_derive(const cdem_params *p, cdem_model_mode *out) {
+    (void)p;
+    out->gravity_off = "off in the biaxial test";
+    out->base_spacing = 1.0;
+}
+
+static void biaxial_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    cdem_summary_line(out, "confining pressure",
+                      "%g N/m (%g MPa in 3-D), ramped from zero at %g s to full at %g s",
+                      p->confining_pressure, p->confining_pressure / 1e6, 0.5 * p->equilibration,
+                      p->equilibration);
+    cdem_summary_line(out, "axial strain",
+                      "%.4g at the end (platens shorten the %.6g m high sample)",
+                      m->total_displacement / m->height_m, m->height_m);
+    cdem_summary_line(out, "gravity", "off");
+}
+
 static const cdem_bc_ops biaxial_ops = {
-    .name = "biaxial",                  /* name */
     .state_size = sizeof(biaxial_ctx),  /* state_size */
     .init = biaxial_init,               /* adds the top platen */
     .apply = biaxial_apply,             /* moves both platens (servo in equilibration) */
@@ -361,6 +403,11 @@ static const cdem_bc_ops biaxial_ops = {
     .measure = biaxial_measure,         /* axial strain, differential stress */
     .save = biaxial_save,               /* checkpoint: platens, window, reference */
     .restore = biaxial_restore,         /* resume */
+    .validate = biaxial_validate,       /* the 10 x 5 sample */
+    .excludes = biaxial_excludes,       /* overburden, heterogeneity, erosion, deposits */
+    .inverts = 0,                       /* the platens only close */
+    .derive = biaxial_derive,           /* no gravity, smooth bottom platen */
+    .describe = biaxial_describe,       /* pressure, strain, gravity */
 };
 
 const cdem_bc_ops *const cdem_bc_biaxial = &biaxial_ops;

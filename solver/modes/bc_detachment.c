@@ -12,6 +12,7 @@
  * boundary (each wall's) displacement, as in every other mode. Units: m, s. */
 #include "bc.h"
 #include "checkpoint.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <string.h>
@@ -118,8 +119,18 @@ static cdem_status detach_restore(void *vctx, const cdem_snapshot *snap, cdem_er
     return cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err);
 }
 
+/* Both walls moving inward shorten the model twice as fast. */
+static void detach_derive(const cdem_params *p, cdem_model_mode *out) {
+    out->moving_boundaries = p->detachment_walls == CDEM_WALLS_BOTH ? 2 : 1;
+}
+
+static void detach_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    (void)m;
+    cdem_summary_line(out, "moving walls", "%s, moving inward over the base",
+                      p->detachment_walls == CDEM_WALLS_BOTH ? "both walls" : "right wall");
+}
+
 static const cdem_bc_ops detach_ops = {
-    .name = "detachment",             /* name */
     .state_size = sizeof(detach_ctx), /* state_size */
     .init = detach_init,              /* init */
     .step_begin = detach_step_begin,  /* apply, split: the net displacement */
@@ -131,6 +142,11 @@ static const cdem_bc_ops detach_ops = {
     .begin_deformation = NULL,        /* nothing to remove */
     .save = detach_save,              /* checkpoint: net */
     .restore = detach_restore,        /* resume */
+    .validate = NULL,                 /* no rules of its own */
+    .excludes = NULL,                 /* runs with every option */
+    .inverts = 0,                     /* the walls only move inward */
+    .derive = detach_derive,          /* one or two moving walls */
+    .describe = detach_describe,      /* which walls */
 };
 
 const cdem_bc_ops *const cdem_bc_detachment = &detach_ops;

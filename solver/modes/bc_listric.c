@@ -29,6 +29,7 @@
 #include "bc.h"
 #include "checkpoint.h"
 #include "fault_file.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -406,8 +407,41 @@ static cdem_status listric_restore(void *vctx, const cdem_snapshot *snap, cdem_e
     return cdem_ckpt_get_f64(snap, "bc", "sheet", &c->sheet, err);
 }
 
+/* The summary's lines after the fault's shape: the kinematics, the footwall, the inversion. */
+static void describe_rest(const cdem_params *p, const cdem_model *m, FILE *out) {
+    cdem_summary_line(out, "kinematics", "%s",
+                      p->kinematics == CDEM_KIN_CD ? "constant displacement (CD, mylar sheet)"
+                                                   : "constant heave (CH)");
+    cdem_summary_line(out, "footwall", "removed (hanging-wall deformation only)");
+    cdem_bc_describe_inversion(p, m, out);
+}
+
+static void listric_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    cdem_bc_describe_fault(p, m, out);
+    cdem_summary_line(out, "fault dip", "%g degrees at the base, steepening to 90 degrees",
+                      p->fault_dip);
+    describe_rest(p, m, out);
+}
+
+static void irregular_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    cdem_bc_describe_fault(p, m, out);
+    cdem_summary_line(out, "fault vertices", "%s (x y in m, from the base up-dip)", p->fault_file);
+    describe_rest(p, m, out);
+}
+
+/* irregular-fault: the vertex file is required, and it is an input of the run. */
+static void irregular_validate(const cdem_params *p, cdem_rule_log *log) {
+    if (p->fault_file[0] == '\0')
+        cdem_rule_add(log, "mode = irregular-fault requires fault_file: set [boundary] "
+                           "fault_file to a text file of x y vertices in m");
+}
+
+static void irregular_derive(const cdem_params *p, cdem_model_mode *out) {
+    out->input = p->fault_file;
+    out->input_what = "the fault vertex file (boundary.fault_file)";
+}
+
 static const cdem_bc_ops listric_ops = {
-    .name = "listric-fault",
     .state_size = sizeof(listric_ctx),
     .init = listric_init,
     .step_begin = listric_step_begin, /* apply, split: the sense, the net displacement */
@@ -418,10 +452,14 @@ static const cdem_bc_ops listric_ops = {
     .free = listric_free,
     .save = listric_save,
     .restore = listric_restore,
+    .validate = NULL, /* the built-in curve needs no rule */
+    .excludes = NULL,
+    .inverts = 1,
+    .derive = NULL,
+    .describe = listric_describe,
 };
 
 static const cdem_bc_ops irregular_ops = {
-    .name = "irregular-fault",
     .state_size = sizeof(listric_ctx),
     .init = irregular_init,
     .step_begin = listric_step_begin, /* apply, split: the sense, the net displacement */
@@ -432,6 +470,11 @@ static const cdem_bc_ops irregular_ops = {
     .free = listric_free,
     .save = listric_save,
     .restore = listric_restore,
+    .validate = irregular_validate, /* the vertex file is required */
+    .excludes = NULL,
+    .inverts = 1,
+    .derive = irregular_derive, /* the vertex file is an input of the run */
+    .describe = irregular_describe,
 };
 
 const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;

@@ -14,6 +14,7 @@
  * each other (boundary-boundary pairs are skipped). */
 #include "bc.h"
 #include "checkpoint.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <string.h>
@@ -185,8 +186,14 @@ static cdem_status planar_restore(void *vctx, const cdem_snapshot *snap, cdem_er
     return cdem_ckpt_get_f64(snap, "bc", "gross", &c->gross, err);
 }
 
+/* The summary's lines: the fault, its dip, the inversion. */
+static void planar_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    cdem_bc_describe_fault(p, m, out);
+    cdem_summary_line(out, "fault dip", "%g degrees", p->fault_dip);
+    cdem_bc_describe_inversion(p, m, out);
+}
+
 static const cdem_bc_ops planar_ops = {
-    .name = "planar-fault",           /* name */
     .state_size = sizeof(planar_ctx), /* state_size */
     .init = planar_init,              /* init */
     .step_begin = planar_step_begin,  /* apply, split: the sense, the net displacement */
@@ -197,6 +204,11 @@ static const cdem_bc_ops planar_ops = {
     .free = NULL,                     /* free: the context owns no memory */
     .save = planar_save,              /* checkpoint: net, gross */
     .restore = planar_restore,        /* resume */
+    .validate = NULL,                 /* no rules of its own (the table's ranges suffice) */
+    .excludes = NULL,                 /* runs with every option */
+    .inverts = 1,                     /* boundary.inversion reverses the block's motion */
+    .derive = NULL,                   /* the defaults: gravity, one moving block */
+    .describe = planar_describe,      /* sense, location, dip, inversion */
 };
 
 const cdem_bc_ops *const cdem_bc_planar_fault = &planar_ops;

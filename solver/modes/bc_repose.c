@@ -8,6 +8,7 @@
  * (solver/base/model.c). */
 #include "bc.h"
 #include "checkpoint.h"
+#include "summary_line.h"
 
 #include <string.h>
 
@@ -103,8 +104,25 @@ static cdem_status repose_restore(void *vctx, const cdem_snapshot *snap, cdem_er
     return CDEM_OK;
 }
 
+/* What a collapse cannot run with: a load on its free surface, erosion, deposits. */
+static const char *const repose_excludes[] = {"surface.overburden_pressure", "surface.erosion",
+                                              "surface.sedimentation", NULL};
+
+/* No boundary moves: the walls go and the assembly collapses, so the display interval is in
+ * seconds (cdem_model_mode). */
+static void repose_derive(const cdem_params *p, cdem_model_mode *out) {
+    (void)p;
+    out->moving_boundaries = 0;
+    out->still = "walls removed; the assembly collapses under gravity";
+}
+
+static void repose_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    (void)m;
+    cdem_summary_line(out, "walls removed", "%s, at the end of equilibration",
+                      p->repose_walls == CDEM_WALLS_BOTH ? "both walls" : "right wall");
+}
+
 static const cdem_bc_ops repose_ops = {
-    .name = "repose",                  /* name */
     .state_size = sizeof(repose_ctx),  /* state_size */
     .init = repose_init,               /* init */
     .apply = repose_apply,             /* apply */
@@ -115,6 +133,11 @@ static const cdem_bc_ops repose_ops = {
     .begin_deformation = repose_begin, /* removes the walls */
     .save = repose_save,               /* checkpoint: n_removed */
     .restore = repose_restore,         /* resume */
+    .validate = NULL,                  /* its rules are its excludes */
+    .excludes = repose_excludes,       /* overburden, erosion, sedimentation */
+    .inverts = 0,                      /* nothing to invert */
+    .derive = repose_derive,           /* no moving boundary, interval in s */
+    .describe = repose_describe,       /* which walls go */
 };
 
 const cdem_bc_ops *const cdem_bc_repose = &repose_ops;

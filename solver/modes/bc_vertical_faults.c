@@ -13,6 +13,7 @@
  * faces as it rises). Net displacement = the block's displacement along its sense (>= 0). */
 #include "bc.h"
 #include "checkpoint.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <string.h>
@@ -141,8 +142,34 @@ static cdem_status vert_restore(void *vctx, const cdem_snapshot *snap, cdem_erro
     return cdem_ckpt_get_f64(snap, "bc", "net", &c->net, err);
 }
 
+/* The second fault must lie inside the base. */
+static void vert_validate(const cdem_params *p, cdem_rule_log *log) {
+    if (p->vertical_fault_location + p->vertical_fault_spacing < 1.0)
+        return;
+    char v1[64], v2[64];
+    cdem_params_format_number(p->vertical_fault_location, v1, sizeof v1);
+    cdem_params_format_number(p->vertical_fault_spacing, v2, sizeof v2);
+    cdem_rule_add(log,
+                  "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s "
+                  "+ %s must be < 1 (the second fault must lie inside the base): reduce one of "
+                  "them",
+                  v1, v2);
+}
+
+static void vert_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
+    const double first = p->vertical_fault_location;
+    const double second = p->vertical_fault_location + p->vertical_fault_spacing;
+    cdem_summary_line(out, "sense", "%s",
+                      p->vertical_sense == CDEM_VERT_PISTON ? "piston (block up, compression)"
+                                                            : "caldera (block down, extension)");
+    cdem_summary_line(out, "first fault", "%g of the base = %.6g m from the left end", first,
+                      first * m->width_m);
+    cdem_summary_line(out, "second fault", "%g of the base = %.6g m from the left end", second,
+                      second * m->width_m);
+    cdem_summary_line(out, "block width", "%.6g m", p->vertical_fault_spacing * m->width_m);
+}
+
 static const cdem_bc_ops vert_ops = {
-    .name = "vertical-faults",      /* name */
     .state_size = sizeof(vert_ctx), /* state_size */
     .init = vert_init,              /* init */
     .step_begin = vert_step_begin,  /* apply, split: the net displacement */
@@ -154,6 +181,11 @@ static const cdem_bc_ops vert_ops = {
     .begin_deformation = NULL,      /* nothing to remove */
     .save = vert_save,              /* checkpoint: net */
     .restore = vert_restore,        /* resume */
+    .validate = vert_validate,      /* the second fault inside the base */
+    .excludes = NULL,               /* runs with every option */
+    .inverts = 0,                   /* caldera or piston, never both */
+    .derive = NULL,                 /* the defaults: gravity, one moving block */
+    .describe = vert_describe,      /* sense, faults, block */
 };
 
 const cdem_bc_ops *const cdem_bc_vertical_faults = &vert_ops;

@@ -492,11 +492,10 @@ static void pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails) 
     }
 }
 
-/* The base's centre spacing in wall radii: assembly.base_spacing, except in the biaxial
- * test, whose base row is the bottom platen: it is built like the top platen (one radius
- * apart, smooth), so the two platens are alike and lubricated platens stay smooth. */
-static double base_spacing_of(const cdem_params *p) {
-    return p->mode == CDEM_MODE_BIAXIAL ? 1.0 : p->base_spacing;
+/* The base's centre spacing in wall radii: assembly.base_spacing, unless the mode decides it
+ * (the biaxial test's smooth bottom platen: its derive hook). */
+static double base_spacing_of(const cdem_params *p, const cdem_model *m) {
+    return m->mode.base_spacing > 0.0 ? m->mode.base_spacing : p->base_spacing;
 }
 
 /* Number of base discs: from x = -rw to w + rw with centres at most spacing * rw apart. */
@@ -554,7 +553,7 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
     long n_wall = 0;
     double rw = m->radius[0];
     CDEM_TRY(append_walls(s, pk->w, p->wall_height_multiplier * pk->h, rw, m->mass[0],
-                          base_spacing_of(p), &n_wall, err));
+                          base_spacing_of(p, m), &n_wall, err));
     if (info) {
         memset(info, 0, sizeof *info);
         info->n_internal = pk->n;
@@ -563,7 +562,7 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
         info->wall_radius = rw;
         info->wall_spacing = rw;
         info->base_spacing =
-            (pk->w + 2.0 * rw) / (double)(base_disc_count(pk->w, rw, base_spacing_of(p)) - 1);
+            (pk->w + 2.0 * rw) / (double)(base_disc_count(pk->w, rw, base_spacing_of(p, m)) - 1);
         info->area_fraction = area / (pk->w * pk->h);
         /* top profile: the surface (common/surface.h) in the grid's columns */
         size_t *col_top = malloc(pk->grid.nx * sizeof *col_top);

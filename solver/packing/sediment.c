@@ -35,7 +35,7 @@ void cdem_sediment_rules(const cdem_params *p, cdem_rule_log *log) {
     cdem_model m;
     cdem_error merr;
     cdem_error_clear(&merr);
-    if (cdem_model_derive(p, &m, &merr) != CDEM_OK) {
+    if (cdem_bc_derive_model(p, &m, &merr) != CDEM_OK) {
         cdem_rule_add(log, "%s", merr.msg);
         return;
     }

@@ -110,7 +110,7 @@ static cdem_status check_unstable(const run_ctx *r, cdem_error *err) {
 static cdem_status setup(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
-    CDEM_TRY(cdem_model_derive(p, &r->m, err));
+    CDEM_TRY(cdem_bc_derive_model(p, &r->m, err));
     if (r->opt->dt_factor > 0.0)
         r->m.dt *= r->opt->dt_factor; /* fault injection (tests): a time step too large */
     CDEM_TRY(cdem_sediment_init(&r->sed, p, &r->m, err));
@@ -236,7 +236,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
                 fprintf(opt->log,
                         "cdem-run: start of deformation: %zu boundary elements removed by the %s "
                         "mode, %zu elements left\n",
-                        nrem, r->bc.ops->name, r->s.n);
+                        nrem, r->bc.name, r->s.n);
             }
         }
         /* the forces on boundary elements count as reported on the steps whose sample reports
@@ -490,7 +490,7 @@ cdem_status cdem_run_count_elements(const cdem_params *p, long *n_internal, long
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_run_count_elements: NULL parameters");
     cdem_model m;
-    CDEM_TRY(cdem_model_derive(p, &m, err));
+    CDEM_TRY(cdem_bc_derive_model(p, &m, err));
     /* the assembly as the run builds it, with the mode's elements (fault ramps, ...) */
     cdem_state st = {0};
     cdem_assembly_info info;

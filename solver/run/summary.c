@@ -4,8 +4,13 @@
  * that cdem-run prints and the file writer stores. Every number carries its unit; nothing
  * depends on the clock or the machine, so the text of a model is reproducible and can be
  * diffed (examples keep their expected summary next to them). Lines are "  label: value"
- * with the label padded to a fixed column, under unindented headings. */
+ * with the label padded to a fixed column (summary_line.h), under unindented headings; the
+ * boundary mode writes its own section's lines and says what it changes elsewhere (gravity,
+ * a still boundary and the display interval in seconds: its derive hook, in m->mode). */
 #include "summary.h"
+
+#include "bc.h"
+#include "summary_line.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -13,38 +18,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define LABEL_WIDTH 28
+/* One line of the summary (summary_line.h). */
+#define line cdem_summary_line
 
 static void heading(FILE *f, const char *title) {
     fprintf(f, "\n%s\n", title);
 }
 
-static void line(FILE *f, const char *label, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void line(FILE *f, const char *label, const char *fmt, ...) {
-    fprintf(f, "  %s:%*s", label,
-            (int)(LABEL_WIDTH - strlen(label)) > 1 ? (int)(LABEL_WIDTH - strlen(label)) : 1, "");
-    va_list ap;
-    va_start(ap, fmt);
-    vfprintf(f, fmt, ap);
-    va_end(ap);
-    fputc('\n', f);
-}
-
 static const char *on_off(int v) {
     return v ? "on" : "off";
-}
-
-static const char *sense_word(cdem_fault_sense s) {
-    return s == CDEM_SENSE_REVERSE ? "reverse" : "normal";
-}
-
-static const char *other_sense_word(cdem_fault_sense s) {
-    return s == CDEM_SENSE_REVERSE ? "normal" : "reverse";
-}
-
-static const char *walls_word(cdem_walls_choice w) {
-    return w == CDEM_WALLS_BOTH ? "both walls" : "right wall";
 }
 
 static const char *sea_word(cdem_sea_level_rise s) {
@@ -59,82 +41,6 @@ static void contact_line(FILE *f, const char *label, const cdem_params *p,
     else
         line(f, label, "breaking strain %g (bond breaks when r - R >= %g R)", c->breaking_strain,
              c->breaking_strain);
-}
-
-static void fault_common(FILE *f, const cdem_params *p, const cdem_model *m) {
-    line(f, "sense", "%s", sense_word(p->fault_sense));
-    line(f, "fault location", "%g of the base = %.6g m from the left end", p->fault_location,
-         p->fault_location * m->width_m);
-}
-
-static void inversion_lines(FILE *f, const cdem_params *p, const cdem_model *m) {
-    if (!p->inversion) {
-        line(f, "inversion", "off");
-        return;
-    }
-    double before = m->total_displacement * p->inversion_percent / 100.0;
-    double after = m->total_displacement - before;
-    double net = before - after;
-    line(f, "inversion", "at %g %% of the displacement: %.4g m %s, then %.4g m %s",
-         p->inversion_percent, before, sense_word(p->fault_sense), after,
-         other_sense_word(p->fault_sense));
-    if (fabs(net) <= 1e-9 * m->total_displacement)
-        line(f, "net displacement", "0 m (the block returns to its starting position)");
-    else
-        line(f, "net displacement", "%.4g m %s", fabs(net),
-             net > 0 ? sense_word(p->fault_sense) : other_sense_word(p->fault_sense));
-}
-
-static void write_mode(FILE *f, const cdem_params *p, const cdem_model *m) {
-    heading(f, "Faulting / boundary conditions");
-    line(f, "mode", "%s", cdem_mode_name(p->mode));
-    switch (p->mode) {
-    case CDEM_MODE_PLANAR_FAULT:
-        fault_common(f, p, m);
-        line(f, "fault dip", "%g degrees", p->fault_dip);
-        inversion_lines(f, p, m);
-        break;
-    case CDEM_MODE_LISTRIC_FAULT:
-    case CDEM_MODE_IRREGULAR_FAULT:
-        fault_common(f, p, m);
-        if (p->mode == CDEM_MODE_LISTRIC_FAULT)
-            line(f, "fault dip", "%g degrees at the base, steepening to 90 degrees", p->fault_dip);
-        else
-            line(f, "fault vertices", "%s (x y in m, from the base up-dip)", p->fault_file);
-        line(f, "kinematics", "%s",
-             p->kinematics == CDEM_KIN_CD ? "constant displacement (CD, mylar sheet)"
-                                          : "constant heave (CH)");
-        line(f, "footwall", "removed (hanging-wall deformation only)");
-        inversion_lines(f, p, m);
-        break;
-    case CDEM_MODE_VERTICAL_FAULTS:
-        line(f, "sense", "%s",
-             p->vertical_sense == CDEM_VERT_PISTON ? "piston (block up, compression)"
-                                                   : "caldera (block down, extension)");
-        line(f, "first fault", "%g of the base = %.6g m from the left end",
-             p->vertical_fault_location, p->vertical_fault_location * m->width_m);
-        line(f, "second fault", "%g of the base = %.6g m from the left end",
-             p->vertical_fault_location + p->vertical_fault_spacing,
-             (p->vertical_fault_location + p->vertical_fault_spacing) * m->width_m);
-        line(f, "block width", "%.6g m", p->vertical_fault_spacing * m->width_m);
-        break;
-    case CDEM_MODE_DETACHMENT:
-        line(f, "moving walls", "%s, moving inward over the base",
-             p->detachment_walls == CDEM_WALLS_BOTH ? "both walls" : "right wall");
-        break;
-    case CDEM_MODE_REPOSE:
-        line(f, "walls removed", "%s, at the end of equilibration", walls_word(p->repose_walls));
-        break;
-    case CDEM_MODE_BIAXIAL:
-        line(f, "confining pressure",
-             "%g N/m (%g MPa in 3-D), ramped from zero at %g s to full at %g s",
-             p->confining_pressure, p->confining_pressure / 1e6, 0.5 * p->equilibration,
-             p->equilibration);
-        line(f, "axial strain", "%.4g at the end (platens shorten the %.6g m high sample)",
-             m->total_displacement / m->height_m, m->height_m);
-        line(f, "gravity", "off");
-        break;
-    }
 }
 
 cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
@@ -196,8 +102,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, "damping", "%.8g N s/m; x %g on deformation steps (physics.deformation_damping)",
              m->damping, p->deformation_damping);
     line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
-    line(f, "gravity", "%g m/s^2%s", m->gravity,
-         p->mode == CDEM_MODE_BIAXIAL ? " (off in the biaxial test)" : "");
+    line(f, "gravity", "%g m/s^2%s%s%s", m->gravity, m->mode.gravity_off ? " (" : "",
+         m->mode.gravity_off ? m->mode.gravity_off : "", m->mode.gravity_off ? ")" : "");
     line(f, "density", "%g kg/m^3", p->density);
     line(f, "stress calculation", "%s", on_off(p->calculate_stress));
 
@@ -208,8 +114,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "time-series sample", "every %d time steps", p->series_interval);
 
     heading(f, "Boundary displacement");
-    if (p->mode == CDEM_MODE_REPOSE) {
-        line(f, "boundary speed", "none (walls removed; the assembly collapses under gravity)");
+    if (m->mode.moving_boundaries == 0) {
+        line(f, "boundary speed", "none (%s)", m->mode.still ? m->mode.still : "no boundary moves");
     } else {
         line(f, "boundary speed", "%.6g m/s (%g m/s^2 x dt)", m->boundary_speed,
              CDEM_BOUNDARY_ACCEL);
@@ -219,7 +125,7 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     }
 
     heading(f, "Display increments");
-    if (p->mode == CDEM_MODE_REPOSE)
+    if (m->mode.moving_boundaries == 0) /* no boundary moves: the interval is in seconds */
         line(f, "display interval", "%g s = %.6g time steps", p->display_interval,
              m->display_steps);
     else
@@ -229,7 +135,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "increments", "%d, numbered 0..%d", m->n_increments_total + 1, m->n_increments_total);
     line(f, "end of equilibration", "increment %d", m->n_increments_equil);
 
-    write_mode(f, p, m);
+    heading(f, "Faulting / boundary conditions");
+    line(f, "mode", "%s", cdem_mode_name(p->mode));
+    cdem_bc_describe(p, m, f);
 
     heading(f, "Material");
     line(f, "model", "%s",

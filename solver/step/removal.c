@@ -116,7 +116,7 @@ cdem_status cdem_removal_mark_by_mode(cdem_removal *r, cdem_state *s, cdem_bc *b
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "boundary mode %s: begin_deformation reported %zu elements to remove "
                          "but marked %zu",
-                         bc->ops->name, nrem, check);
+                         bc->name, nrem, check);
     *count = nrem;
     return CDEM_OK;
 }
