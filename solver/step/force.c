@@ -80,8 +80,8 @@ typedef struct {
 /* Finishes element i from its contact-force sum (sx, sy): gravity and the other loads, the
  * damped second half kick (when e->kick) of its velocity (vx, vy), and the total force
  * stored in fx, fy. Boundary elements keep the sum. The written arrays are restrict
- * parameters rather than members of e: only so does the compiler know that the stores do
- * not touch what the loop reads next. */
+ * parameters rather than members of e: so the compiler knows the stores do not touch what
+ * the loop reads next (docs/performance.md, "Choices in the force pass"). */
 static inline void finish_element(const element_finish *e, long i, double sx, double sy,
                                   double *restrict vx, double *restrict vy, double *restrict fx,
                                   double *restrict fy) {
@@ -223,9 +223,8 @@ static long finish_chunk(force_pass *fp, const double *acc, long lo, long hi) {
  * earlier chunks (list[ca..cb-1], ascending, already evaluated) are subtracted first, then
  * the chunk's pairs are evaluated and scattered in order (a pair whose pj lies in a later
  * chunk was evaluated by that chunk's thread and only adds to its pi here). Then the chunk's
- * elements are finished. (A loop nested per element, accumulating each pi range in
- * registers and finishing the element right after it, was measured slower: the short inner
- * loops mispredict their exits.) */
+ * elements are finished (docs/performance.md, "Choices in the force pass", says why not per
+ * element). */
 static void chunk_pass_scalar(force_pass *fp, int chunk) {
     const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
     const int32_t *restrict list = fp->cross;
@@ -330,17 +329,16 @@ static void chunk_pass(force_pass *fp, int chunk) {
         chunk_pass_scalar(fp, chunk);
 }
 
-/* Relative costs of the work of a step (measured at 9,000 elements: a touching pair's law
- * ~10 ns, a list pair that does not touch ~3 ns, a free element's drift, rebuild test and
- * finish ~4 ns, a boundary element's ~1 ns); only their ratios matter. */
+/* Relative costs of the work of a step: a touching pair, a list pair that does not touch, a
+ * free element's drift, rebuild test and finish, a boundary element's (measured:
+ * docs/performance.md, "Choices in the force pass"); only their ratios matter. */
 enum { WORK_TOUCH = 10, WORK_APART = 3, WORK_FREE = 4, WORK_BOUNDARY = 1 };
 
 /* Each element's work in a threaded step, into work[0..n-1], and their total: its drift and
  * finish, and the pairs whose pj it is (each pair is evaluated by the chunk of its pj),
  * touching or not by the flags of the last evaluation (carried over by the build). One pass
  * over the pairs in slot order: sequential reads, and the adds to work stay in the cache
- * (going through each element's slots by jslot instead read the flags in scattered order: at
- * 34,500 elements the work and the cut took 278 us a build on 2 threads, now 175 us). */
+ * (rather than each element's slots by jslot, which reads the flags in scattered order). */
 static uint64_t elements_work(const cdem_neighbour *nb, const uint32_t *restrict flags, size_t n,
                               uint32_t *restrict work) {
     for (size_t e = 0; e < n; e++)
@@ -390,12 +388,9 @@ static void update_shares(cdem_force *f, int nchunk) {
 
 /* Splits the elements into nchunk ranges of about equal work (element_work) and lists the
  * cross pairs of each chunk. A pair is evaluated by the chunk of its pj: its own pairs and
- * the cross pairs coming in from earlier chunks. (When the walls were sorted after the free
- * elements, every element-wall pair went to the chunk of the walls: cutting at equal pair
- * counts by pi overloaded that chunk by 20 % at 9,000 elements, and equal pair counts by pj
- * still left 10 % more to the lower chunk; the element order is now by cell, walls
- * included, neighbour.c, and the work estimate still weighs what each element costs.) The
- * cut does not change any result (every element sum has the same additions in
+ * the cross pairs coming in from earlier chunks. The cut is by estimated work, since elements
+ * cost unequally (walls, pairs that touch; docs/performance.md, "Choices in the force
+ * pass"). The cut does not change any result (every element sum has the same additions in
  * the same order for any cut). Falls back to one chunk when the buffer is too small (never
  * after a list build: the stepper calls cdem_force_reserve after each). */
 static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t *flags, size_t n,

@@ -30,9 +30,8 @@ typedef struct {
 
 /* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
  * the common case of a list pair that does not touch is settled here, everything else by
- * the one contact kernel (contact.h). (A branch-free variant of the granular law,
- * evaluating every list pair and selecting the result, was measured 40-50 % slower: gcc -O2
- * still branches and does more work.) */
+ * the one contact kernel (contact.h); a branch-free evaluation of every list pair is slower
+ * (docs/performance.md, "Choices in the force pass"). */
 static CDEM_INLINE void cdem_force_pair(const cdem_contact_law *restrict law, long p, double dx,
                                         double dy, double dvx, double dvy,
                                         const double *restrict Rp, const uint8_t *restrict cls,
