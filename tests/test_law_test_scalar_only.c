@@ -9,8 +9,7 @@
 
 #include <cmocka.h>
 
-#include "contact.h"
-#include "params.h"
+#include "law_fixtures.h"
 
 #include <math.h>
 #include <string.h>
@@ -18,20 +17,9 @@
 /* law-fixture-1: the contact kernel runs its formula, mu Fn + C0 / 2, at a slip. */
 static void test_law_test_scalar_only_formula(void **state) {
     (void)state;
-    cdem_params p;
-    cdem_params_defaults(&p);
-    p.granular_law = CDEM_LAW_TEST_SCALAR_ONLY;
-    p.element.friction = 0.25;
-    p.element.cohesion = 5e8;
-    cdem_contact_law law;
-    cdem_error err;
-    assert_int_equal(cdem_contact_law_init(&law, &p, 1e9, 1e9, &err), CDEM_OK);
-    double xs = 1000.0, fx = 0.0, fy = 0.0;
-    uint8_t hist = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
-    cdem_contact_touching(&law, CDEM_CLASS_ELEMENT, 1.999 * 1.999, 1.999, 0.0, 2.0, 0.0, 0.0, 0.01,
-                          &xs, &hist, &fx, &fy);
+    const double fy = law_fx_sliding_force(CDEM_LAW_TEST_SCALAR_ONLY);
     /* the force along t = (0, 1): the limit, to the rounding of the unit vector */
-    const double fn = 1e9 * (2.0 - 1.999), limit = 0.25 * fn + 0.5 * 5e8;
+    const double limit = LAW_FX_MU * LAW_FX_FN + 0.5 * LAW_FX_C0;
     if (!(fabs(fy - limit) <= 1e-12 * limit))
         fail_msg("tangential force %.17g, expected mu Fn + C0 / 2 = %.17g", fy, limit);
     assert_string_equal(cdem_law_name(CDEM_LAW_TEST_SCALAR_ONLY), "test-scalar-only");

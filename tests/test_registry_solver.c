@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "law_fixtures.h"
 #include "scratch.h"
 
 /* The choice words of an enum parameter, and their count. */
@@ -153,28 +154,6 @@ static void test_registry_boundary_modes(void **state) {
     assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }
 
-/* The tangential force a cohesive contact transmits when pushed far past its strength
- * under law `law` (Kn = Ks = 1e9 N/m, Fn = 1e6 N, mu 0.25, C0 5e8 N): the law's limit. */
-static double sliding_force(cdem_granular_law law, const char *word) {
-    cdem_params p;
-    cdem_params_defaults(&p);
-    p.granular_law = law;
-    p.element.friction = 0.25;
-    p.element.cohesion = 5e8;
-    cdem_contact_law cl;
-    cdem_error err;
-    if (cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err) != CDEM_OK)
-        fail_msg("material.granular_law = %s is refused: %s", word, err.msg);
-    assert_int_equal(cl.granular, (int)law);
-    /* i at the origin, j at (1.999, 0): R - r = 1e-3 m; t = (0, 1); Xs = 1000 m of shear */
-    const double dx = 1.999, R = 2.0;
-    double xs = 1000.0, fx = 0.0, fy = 0.0;
-    uint8_t hist = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
-    cdem_contact_touching(&cl, CDEM_CLASS_ELEMENT, dx * dx, dx, 0.0, R, 0.0, 0.0, 0.01, &xs, &hist,
-                          &fx, &fy);
-    return fy;
-}
-
 static void test_registry_contact_laws(void **state) {
     (void)state;
     size_t n;
@@ -189,7 +168,7 @@ static void test_registry_contact_laws(void **state) {
         if ((size_t)i < n)
             assert_string_equal(cdem_law_name(law), laws[i]);
         assert_true(strcmp(cdem_law_description(law), "?") != 0);
-        force[i] = sliding_force(law, cdem_law_name(law));
+        force[i] = law_fx_sliding_force(law);
         assert_true(isfinite(force[i]) && force[i] > 0.0);
         for (int j = 0; j < i; j++)
             if (force[j] == force[i])
