@@ -9,7 +9,9 @@
  * Key names are the field names of cdem_params; nested contact materials are flattened
  * with an underscore (element.friction -> [material] element_friction).
  * Nothing here allocates except cdem_params_load (the file text).
- * Why one file of ~1150 lines: the table, its choice lists and the cross-field validation
+ * The laws' and the modes' words come from their registries (laws/laws.def, modes.def); a
+ * mode's rules are the mode's (solver/modes/), this file keeps the rules of no mode.
+ * Why one file of ~1100 lines: the table, its choice lists and the cross-field validation
  * rules are most of it, and the parser, the overrides and the writers are loops over the
  * table that must see its private layout (offsets, text defaults); splitting them would
  * export the table to every caller instead of keeping "one table, one owner". */
