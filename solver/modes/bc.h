@@ -103,8 +103,8 @@ typedef struct {
     double lateral_pressure; /* N/m: boundary.confining_pressure when ops->confined, else 0 */
 } cdem_bc;
 
-/* The ops of a mode; CDEM_ERR_UNSUPPORTED naming the mode and the implemented ones when it
- * has no implementation. */
+/* The ops of a registered mode (every row of common/modes.def has them); CDEM_ERR_RANGE
+ * naming the modes of parameter files for a value that is no mode. */
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err);
 
 /* The modes' parameter rules (a cdem_params_rules of cdem_params_validate): p's mode's

@@ -19,15 +19,10 @@ static const cdem_bc_ops *const *const registry[CDEM_MODE_COUNT] = {
 #undef CDEM_TEST_MODE
 };
 
-/* "planar-fault, ..., biaxial": the modes a parameter file can name. */
-static void implemented(char *buf, size_t cap) {
-    cdem_params_join_choices("boundary", "mode", buf, cap);
-}
-
 cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *err) {
     if ((int)mode < 0 || mode >= CDEM_MODE_COUNT) {
-        char words[256];
-        implemented(words, sizeof words);
+        char words[256]; /* the modes a parameter file can name */
+        cdem_params_join_choices("boundary", "mode", words, sizeof words);
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "boundary.mode = %d: unknown mode; implemented modes: %s", (int)mode,
                          words);
