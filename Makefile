@@ -1,5 +1,5 @@
 # cdem-c build. Plain GNU Make + pkg-config. Every .c file in common/, solver/ and
-# analysis/ (and its subfolders) is picked up automatically, so adding a module never
+# analysis/ (and their subfolders) is picked up automatically, so adding a module never
 # edits this file.
 #   make            build cdem-run and cdem-strain (build/)
 #   make test       build and run every cmocka test (tests/test_*.c)
@@ -59,11 +59,21 @@ CDEM_CFLAGS += -DCDEM_VERSION='"$(VERSION)"'
 # format in common/). Tests and fuzz harnesses see every layer. A file's layer is the first
 # folder of its path. (A header in the same folder as its includer is found without -I,
 # which is the same rule: a layer always sees itself.)
+# The solver is layered by its second folder too (docs/solver.md, "Source files"), each
+# seeing those before it: base/ (derived constants, checkpoint helpers), contact/ (the pair
+# force), modes/ (the boundary modes: base/ only), step/ (the time step), packing/ (the
+# assembly and the growth strata's deposits), run/ (the run loop) and main.c (all).
 # The analysis is layered again by its second folder (docs/analysis.md, "Source files"):
 # measure/ sees only itself, input/ and export/ see measure/, draw/ sees only itself, and
 # cli/ sees them all (each also sees common/).
 INC_common   := -Icommon
-INC_solver   := -Icommon -Isolver
+INC_solver_base    := -Icommon -Isolver/base
+INC_solver_contact := $(INC_solver_base) -Isolver/contact
+INC_solver_modes   := $(INC_solver_base) -Isolver/modes
+INC_solver_step    := $(INC_solver_contact) -Isolver/modes -Isolver/step
+INC_solver_packing := $(INC_solver_step) -Isolver/packing
+INC_solver_run     := $(INC_solver_packing) -Isolver/run
+INC_solver   := $(INC_solver_run)
 INC_analysis := -Icommon -Ianalysis
 INC_analysis_measure := $(INC_analysis) -Ianalysis/measure
 INC_analysis_input   := $(INC_analysis_measure) -Ianalysis/input
@@ -71,13 +81,13 @@ INC_analysis_export  := $(INC_analysis_measure) -Ianalysis/export
 INC_analysis_draw    := $(INC_analysis) -Ianalysis/draw
 INC_analysis_cli     := $(INC_analysis) -Ianalysis/measure -Ianalysis/input -Ianalysis/export \
                         -Ianalysis/draw -Ianalysis/cli
-INC_tests    := -Icommon -Isolver $(filter-out -Icommon,$(INC_analysis_cli))
+INC_tests    := $(INC_solver) $(filter-out -Icommon,$(INC_analysis_cli))
 path_words = $(subst /, ,$(1))
 layer_inc = $(or $(INC_$(word 1,$(call path_words,$(1)))_$(word 2,$(call path_words,$(1)))),$(INC_$(word 1,$(call path_words,$(1)))))
 compile_flags = $(CDEM_CFLAGS) $(1) $(PKG_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 
 COMMON_SRC   := $(wildcard common/*.c common/h5/*.c)
-SOLVER_SRC   := $(filter-out solver/main.c,$(wildcard solver/*.c))
+SOLVER_SRC   := $(filter-out solver/main.c,$(wildcard solver/*.c solver/*/*.c))
 ANALYSIS_SRC := $(filter-out analysis/cli/main.c,$(wildcard analysis/*.c analysis/*/*.c))
 TEST_SRC     := $(wildcard tests/test_*.c)
 
@@ -160,7 +170,7 @@ $(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(LIBS)
 	$(CC) $(call compile_flags,$(INC_tests)) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(LIBS) $(LDLIBS)
 
 format:
-	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] analysis/*/*.[ch] tests/*.[ch] 2>/dev/null || true
+	clang-format -i common/*.[ch] common/h5/*.[ch] solver/*.[ch] solver/*/*.[ch] analysis/*/*.[ch] tests/*.[ch] 2>/dev/null || true
 
 clean:
 	rm -rf build build-asan build-fuzz

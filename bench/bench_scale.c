@@ -71,7 +71,7 @@ static cdem_status setup(bench *b, double width, double height, int half, cdem_e
     b->p.width = width;
     b->p.height = height;
     b->p.half_radii = half;
-    CDEM_TRY(cdem_model_derive(&b->p, &b->m, err));
+    CDEM_TRY(cdem_bc_derive_model(&b->p, &b->m, err));
     CDEM_TRY(cdem_state_init(&b->s, 4096, 0, err));
     CDEM_TRY(cdem_assembly_build(&b->p, &b->m, &b->s, &b->info, err));
     CDEM_TRY(cdem_bc_init(&b->bc, &b->p, &b->m, &b->s, err));

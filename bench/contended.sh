@@ -8,7 +8,7 @@
 # Environment:
 #   WAITS="cdem"   wait settings to compare, each run in the same way:
 #                  cdem      the environment as it comes (cdem-run chooses: common/threads.h,
-#                            OMP_WAIT_POLICY=passive, and its thread governor, solver/governor.h,
+#                            OMP_WAIT_POLICY=passive, and its thread governor, solver/run/governor.h,
 #                            runs on one thread while that is faster)
 #                  cdem-fixed  the same with CDEM_THREAD_GOVERNOR=off: the threads asked for,
 #                            throughout (what the wait policy alone does)

@@ -129,7 +129,7 @@ int main(int argc, char **argv) {
     cdem_state s = {0};
     cdem_assembly_info info;
     cdem_integrator it = {0};
-    if (cdem_model_derive(&p, &m, &err) || cdem_state_init(&s, 4096, 0, &err) ||
+    if (cdem_bc_derive_model(&p, &m, &err) || cdem_state_init(&s, 4096, 0, &err) ||
         cdem_assembly_build(&p, &m, &s, &info, &err) || cdem_integrator_init(&it, &p, &m, &err)) {
         rc = fail(&err);
         goto done;

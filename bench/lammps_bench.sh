@@ -57,7 +57,7 @@ fi
 MPIRUN="mpirun -np 2 --bind-to core"
 [ "$(id -u)" = 0 ] && MPIRUN="mpirun --allow-run-as-root -np 2 --bind-to core"
 
-CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon -Isolver"
+CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon $(for d in solver/*/; do printf " -I%s" "${d%/}"; done)"
 cc $CFLAGS $(pkg-config --cflags hdf5 gsl) -o "$BUILD/export_lammps" bench/export_lammps.c \
     "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs hdf5 gsl) -lm
 

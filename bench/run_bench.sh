@@ -44,7 +44,7 @@ SETTLE=${SETTLE:-3000}
 PARTS=${PARTS:-"machine scale full lammps analysis contended"}
 WORK=${WORK:-/tmp/cdem_bench}
 PKGS="hdf5 gsl"
-CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon -Isolver"
+CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon $(for d in solver/*/; do printf " -I%s" "${d%/}"; done)"
 set -e
 mkdir -p "$WORK"
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_scale" bench/bench_scale.c \
@@ -196,7 +196,7 @@ fi
 if has contended; then
     echo
     echo "== 5. Threads on a busy machine (bench/contended.sh): cdem-run as it comes (passive wait policy,"
-    echo "      common/threads.h, and the thread governor, solver/governor.h), without the governor"
+    echo "      common/threads.h, and the thread governor, solver/run/governor.h), without the governor"
     echo "      (cdem-fixed), and with libgomp's default spin, idle and with one CPU-bound competitor"
     WAITS="cdem cdem-fixed libgomp" sh bench/contended.sh "$BUILD"
 fi

@@ -2,6 +2,8 @@
  * [...] is not a break point, so an optional group is never split across lines. */
 #include "cli_help.h"
 
+#include "suggest.h"
+
 #include <string.h>
 
 static const cdem_cli_option help_option = {"-h, --help", NULL, "print this help and exit"};
@@ -150,6 +152,36 @@ int cdem_cli_option_is(const cdem_cli_option *o, const char *name) {
         s += n;
     }
     return 0;
+}
+
+const char *cdem_cli_suggest_option(const cdem_cli_help *h, const char *arg, char *buf,
+                                    size_t cap) {
+    char name[128];
+    const size_t len = strcspn(arg, "=");
+    if (strncmp(arg, "--", 2) != 0 || len >= sizeof name || cap == 0)
+        return NULL; /* a one-letter option has no spelling near enough to offer */
+    memcpy(name, arg, len);
+    name[len] = '\0';
+    size_t best_d = cdem_edit_distance(name, "--help");
+    snprintf(buf, cap, "--help");
+    for (size_t k = 0; h->options && h->options[k].names; k++)
+        for (const char *s = h->options[k].names; *s;) {
+            while (*s == ' ' || *s == ',')
+                s++;
+            const size_t n = strcspn(s, ", ");
+            char spelling[128];
+            if (n > 2 && n < sizeof spelling && strncmp(s, "--", 2) == 0) {
+                memcpy(spelling, s, n);
+                spelling[n] = '\0';
+                const size_t d = cdem_edit_distance(name, spelling);
+                if (d < best_d) {
+                    best_d = d;
+                    snprintf(buf, cap, "%s", spelling);
+                }
+            }
+            s += n;
+        }
+    return cdem_suggest_close(best_d, name) ? buf : NULL;
 }
 
 const cdem_cli_option *cdem_cli_find_option(const cdem_cli_help *h, const char *arg,

@@ -13,6 +13,7 @@
 #ifndef CDEM_CLI_HELP_H
 #define CDEM_CLI_HELP_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 /* One option. names: the spellings, comma-separated ("-o, --output"); arg: the value's
@@ -59,6 +60,11 @@ int cdem_cli_wants_help(int argc, char *const *argv, int first, const cdem_cli_h
  * value); NULL when h has none. *inline_value gets the text after '=' or NULL. */
 const cdem_cli_option *cdem_cli_find_option(const cdem_cli_help *h, const char *arg,
                                             const char **inline_value);
+
+/* The long spelling of h's options (or --help) nearest to the unknown option arg ("--name"
+ * or "--name=value"), written into buf, when it is close enough to offer (suggest.h); NULL
+ * otherwise and for a one-letter option. */
+const char *cdem_cli_suggest_option(const cdem_cli_help *h, const char *arg, char *buf, size_t cap);
 
 /* 1 when option o has the spelling name (one of its comma-separated names). */
 int cdem_cli_option_is(const cdem_cli_option *o, const char *name);

@@ -1,7 +1,7 @@
 /* grid: the one uniform cell grid of the project. Every place that bins elements into
- * cells uses it: the packing of the assembly (solver/assembly.c), the neighbour search and
- * the re-sort of the state (solver/neighbour.c), the deposit columns of the sedimentation
- * (solver/sediment.c), the surface columns (common/surface.c: the overburden load and the
+ * cells uses it: the packing of the assembly (solver/packing/assembly.c), the neighbour search and
+ * the re-sort of the state (solver/step/neighbour.c), the deposit columns of the sedimentation
+ * (solver/packing/sediment.c), the surface columns (common/surface.c: the overburden load and the
  * analysis measurements) and the fixed-radius queries of the analysis (strain fit, axes,
  * cdem2D id matching: cdem_grid_index below).
  *

@@ -9,13 +9,15 @@
  * Key names are the field names of cdem_params; nested contact materials are flattened
  * with an underscore (element.friction -> [material] element_friction).
  * Nothing here allocates except cdem_params_load (the file text).
- * Why one file of ~1150 lines: the table, its choice lists and the cross-field validation
+ * The laws' and the modes' words come from their registries (laws/laws.def, modes.def); a
+ * mode's rules are the mode's (solver/modes/), this file keeps the rules of no mode.
+ * Why one file of ~1100 lines: the table, its choice lists and the cross-field validation
  * rules are most of it, and the parser, the overrides and the writers are loops over the
  * table that must see its private layout (offsets, text defaults); splitting them would
  * export the table to every caller instead of keeping "one table, one owner". */
 #include "params.h"
 
-#include "model.h"
+#include "suggest.h"
 
 #include <assert.h>
 #include <ctype.h>
@@ -34,14 +36,43 @@
 #define NOMAX HUGE_VAL
 
 static const char *const material_words[] = {"granular", "bonded", NULL};
-static const char *const law_words[] = {"normal-cohesion", "coulomb", "spring-cohesion", NULL};
+/* The laws' words, in enum order (the users' laws: a fixture of the tests has no word a
+ * file could use), and every law's row text. */
+static const char *const law_words[] = {
+#define CDEM_LAW(ID, word, description, scalar, lanes) word,
+#include "laws/laws.def"
+#undef CDEM_LAW
+    NULL};
+_Static_assert(sizeof law_words / sizeof law_words[0] == CDEM_LAW_WORDS + 1,
+               "one word per law of parameter files (laws.def)");
+static const struct {
+    const char *word, *description;
+} law_rows[CDEM_LAW_COUNT] = {
+#define CDEM_LAW(ID, word, description, scalar, lanes) [CDEM_LAW_##ID] = {word, description},
+#define CDEM_TEST_LAW                                  CDEM_LAW
+#include "laws/laws.def"
+#undef CDEM_LAW
+#undef CDEM_TEST_LAW
+};
 static const char *const cohesive_words[] = {"equilibrated", "formed", "initial", NULL};
 /* A real parameter whose row has choices accepts its one word instead of a number, stored as
  * NaN: "take the value of another parameter" (the base takes the lateral walls' values). */
 static const char *const as_wall_words[] = {"wall", NULL};
+/* The modes' words, in enum order (the users' modes), and every mode's word. */
 static const char *const mode_words[] = {
-    "planar-fault", "listric-fault", "irregular-fault", "vertical-faults",
-    "detachment",   "repose",        "biaxial",         NULL};
+#define CDEM_MODE(ID, id, word) word,
+#include "modes.def"
+#undef CDEM_MODE
+    NULL};
+_Static_assert(sizeof mode_words / sizeof mode_words[0] == CDEM_MODE_WORDS + 1,
+               "one word per mode of parameter files (modes.def)");
+static const char *const mode_names[CDEM_MODE_COUNT] = {
+#define CDEM_MODE(ID, id, word) [CDEM_MODE_##ID] = word,
+#define CDEM_TEST_MODE          CDEM_MODE
+#include "modes.def"
+#undef CDEM_MODE
+#undef CDEM_TEST_MODE
+};
 static const char *const sense_words[] = {"normal", "reverse", NULL};
 static const char *const kin_words[] = {"ch", "cd", NULL};
 static const char *const vert_words[] = {"caldera", "piston", NULL};
@@ -100,7 +131,11 @@ static const cdem_param_def param_table[] = {
     {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
      "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
-     "granular: shear strength mu (Fn + C0) (normal-cohesion), mu Fn + C0 (coulomb), or Fs = Ks Xs + C0 capped at mu Fn (spring-cohesion)"},
+     "granular: how the cohesion C0 enters a contact's shear strength"
+#define CDEM_LAW(ID, word, description, scalar, lanes) "; " word ": " description
+#include "laws/laws.def"
+#undef CDEM_LAW
+    },
     {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "initial", 0, 0, 0, 0, cohesive_words,
      "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)"},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
@@ -217,10 +252,29 @@ const cdem_param_def *cdem_params_find(const char *section, const char *key) {
     return NULL;
 }
 
+const char *cdem_law_name(cdem_granular_law law) {
+    return (int)law >= 0 && law < CDEM_LAW_COUNT ? law_rows[law].word : "?";
+}
+
+const char *cdem_law_description(cdem_granular_law law) {
+    return (int)law >= 0 && law < CDEM_LAW_COUNT ? law_rows[law].description : "?";
+}
+
 const char *cdem_mode_name(cdem_mode mode) {
-    if ((int)mode < 0 || (size_t)mode >= sizeof mode_words / sizeof mode_words[0] - 1)
-        return "unknown";
-    return mode_words[mode];
+    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_names[mode] : "unknown";
+}
+
+int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base) {
+    *base = p->base;
+    const int own =
+        !(isnan(base->friction) && isnan(base->cohesion) && isnan(base->breaking_strain));
+    if (isnan(base->friction))
+        base->friction = p->wall.friction;
+    if (isnan(base->cohesion))
+        base->cohesion = p->wall.cohesion;
+    if (isnan(base->breaking_strain))
+        base->breaking_strain = p->wall.breaking_strain;
+    return own;
 }
 
 /* ---------- small text helpers ---------- */
@@ -243,38 +297,6 @@ static void copy_trimmed(char *buf, size_t n, const char *text, size_t len) {
     buf[len] = '\0';
 }
 
-/* Levenshtein distance of the first 63 characters of a and b (no allocation). */
-static size_t edit_distance(const char *a, const char *b) {
-    enum { CAP = 63 };
-    size_t la = strlen(a), lb = strlen(b);
-    if (la > CAP)
-        la = CAP;
-    if (lb > CAP)
-        lb = CAP;
-    size_t prev[CAP + 1], cur[CAP + 1];
-    for (size_t j = 0; j <= lb; j++)
-        prev[j] = j;
-    for (size_t i = 1; i <= la; i++) {
-        cur[0] = i;
-        for (size_t j = 1; j <= lb; j++) {
-            size_t sub = prev[j - 1] +
-                         (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
-            size_t del = prev[j] + 1, ins = cur[j - 1] + 1;
-            size_t best = sub < del ? sub : del;
-            cur[j] = best < ins ? best : ins;
-        }
-        memcpy(prev, cur, (lb + 1) * sizeof prev[0]);
-    }
-    return prev[lb];
-}
-
-/* A suggestion is offered when the distance is small compared with the word. */
-static int close_enough(size_t dist, const char *word) {
-    size_t len = strlen(word);
-    size_t limit = len / 3 > 2 ? len / 3 : 2;
-    return dist <= limit;
-}
-
 /* Appends "w1, w2, w3" to buf. */
 static void join_words(const char *const *words, char *buf, size_t n) {
     size_t pos = 0;
@@ -287,8 +309,27 @@ static void join_words(const char *const *words, char *buf, size_t n) {
     }
 }
 
-/* Formats a double so that strtod gives back exactly the same value, as short as possible. */
-static void format_double(double v, char *buf, size_t n) {
+void cdem_words_or(const char *const *words, size_t n, char *buf, size_t cap) {
+    size_t pos = 0;
+    buf[0] = '\0';
+    for (size_t i = 0; i < n && pos < cap; i++) {
+        const char *sep = i == 0 ? "" : i + 1 == n ? " or " : ", ";
+        const int w = snprintf(buf + pos, cap - pos, "%s%s", sep, words[i]);
+        if (w < 0)
+            break;
+        pos += (size_t)w;
+    }
+}
+
+void cdem_params_join_choices(const char *section, const char *key, char *buf, size_t cap) {
+    const cdem_param_def *d = cdem_params_find(section, key);
+    size_t n = 0;
+    while (d && d->choices && d->choices[n])
+        n++;
+    cdem_words_or(d ? d->choices : NULL, n, buf, cap);
+}
+
+void cdem_params_format_number(double v, char *buf, size_t n) {
     if (v == floor(v) && fabs(v) < 1e7) { /* whole numbers up to 7 digits: "2000", not "2e+03" */
         snprintf(buf, n, "%.0f", v);
         return;
@@ -312,8 +353,8 @@ static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
         return;
     }
     char lo[32], hi[32];
-    format_double(d->min, lo, sizeof lo);
-    format_double(d->max, hi, sizeof hi);
+    cdem_params_format_number(d->min, lo, sizeof lo);
+    cdem_params_format_number(d->max, hi, sizeof hi);
     const char *sp = d->unit[0] ? " " : "";
     if (d->max == NOMAX)
         snprintf(buf, n, "%s %s%s%s", d->min_exclusive ? ">" : ">=", lo, sp, d->unit);
@@ -322,18 +363,6 @@ static void describe_range(const cdem_param_def *d, char *buf, size_t n) {
     else
         snprintf(buf, n, "%s %s and %s %s%s%s", d->min_exclusive ? ">" : ">=", lo,
                  d->max_exclusive ? "<" : "<=", hi, sp, d->unit);
-}
-
-/* Rounds v to 4 significant digits towards +inf (up = 1) or -inf (up = 0) and formats it, so
- * that advice such as "at least X" is itself sufficient. */
-static void format_safe(double v, int up, char *buf, size_t n) {
-    if (!(v > 0) || !isfinite(v)) {
-        snprintf(buf, n, "%g", v);
-        return;
-    }
-    double mag = pow(10.0, floor(log10(v)) - 3.0);
-    double r = (up ? ceil(v / mag) : floor(v / mag)) * mag;
-    snprintf(buf, n, "%.4g", r);
 }
 
 /* Short "allowed values" text for comments and the markdown table. */
@@ -358,8 +387,8 @@ static void describe_allowed(const cdem_param_def *d, char *buf, size_t n) {
         break;
     default: {
         char lo[32], hi[32];
-        format_double(d->min, lo, sizeof lo);
-        format_double(d->max, hi, sizeof hi);
+        cdem_params_format_number(d->min, lo, sizeof lo);
+        cdem_params_format_number(d->max, hi, sizeof hi);
         if (d->max == NOMAX)
             snprintf(buf, n, "%s %s", d->min_exclusive ? ">" : ">=", lo);
         else if (!d->min_exclusive && !d->max_exclusive)
@@ -543,13 +572,13 @@ static cdem_status fail_unknown_key(const char *where, const char *section, cons
             int same = strcmp(param_table[i].section, section) == 0;
             if (same != (pass == 0))
                 continue;
-            size_t dist = edit_distance(key, param_table[i].key);
+            size_t dist = cdem_edit_distance(key, param_table[i].key);
             if (dist < best_d) {
                 best_d = dist;
                 best = &param_table[i];
             }
         }
-    if (best && close_enough(best_d, key)) {
+    if (best && cdem_suggest_close(best_d, key)) {
         if (strcmp(best->section, section) == 0)
             return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [%s] %s: unknown key; did you mean '%s'?",
                              where, section, key, best->key);
@@ -570,16 +599,9 @@ static int known_section(const char *name) {
 }
 
 static cdem_status fail_unknown_section(const char *where, const char *name, cdem_error *err) {
-    const char *best = NULL;
-    size_t best_d = (size_t)-1;
-    for (size_t i = 0; section_names[i]; i++) {
-        size_t dist = edit_distance(name, section_names[i]);
-        if (dist < best_d) {
-            best_d = dist;
-            best = section_names[i];
-        }
-    }
-    if (best && close_enough(best_d, name))
+    const size_t n = sizeof section_names / sizeof section_names[0] - 1;
+    const char *best = cdem_suggest(name, section_names, n);
+    if (best)
         return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: unknown section [%s]; did you mean [%s]?", where,
                          name, best);
     char words[256];
@@ -835,7 +857,7 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
         if (isnan(v) && def->choices)
             snprintf(buf, n, "%s", def->choices[0]);
         else
-            format_double(v, buf, n);
+            cdem_params_format_number(v, buf, n);
         break;
     }
     case CDEM_PTYPE_INT: {
@@ -952,16 +974,7 @@ void cdem_params_write_markdown(FILE *out) {
 
 /* ---------- validation of combinations ---------- */
 
-/* Accumulates one message per violated rule, separated by newlines. */
-typedef struct {
-    char *buf;  /* destination (err->msg or a scratch buffer) */
-    size_t cap; /* its size */
-    size_t len; /* characters written */
-    int count;  /* rules violated so far */
-} rule_log;
-
-static void rule_add(rule_log *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void rule_add(rule_log *log, const char *fmt, ...) {
+void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) {
     log->count++;
     if (log->len + 2 >= log->cap)
         return;
@@ -975,23 +988,11 @@ static void rule_add(rule_log *log, const char *fmt, ...) {
         log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
 }
 
-/* Options the biaxial test excludes ({section, key}; all BOOL or ENUM with 0 = off). */
-static const char *const biaxial_excludes[][2] = {
-    {"heterogeneity", "flexural_slip"},    {"heterogeneity", "weak_interval"},
-    {"heterogeneity", "layered_friction"}, {"surface", "erosion"},
-    {"surface", "sedimentation"},
-};
-
-static int is_fault_mode(cdem_mode m) {
-    return m == CDEM_MODE_PLANAR_FAULT || m == CDEM_MODE_LISTRIC_FAULT ||
-           m == CDEM_MODE_IRREGULAR_FAULT;
-}
-
-cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
+cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err) {
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
     char msg[CDEM_ERROR_MSG_MAX];
-    rule_log log = {msg, sizeof msg, 0, 0};
+    cdem_rule_log log = {msg, sizeof msg, 0, 0};
     msg[0] = '\0';
     char v1[64], v2[64];
 
@@ -1019,142 +1020,65 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err) {
         case CDEM_PTYPE_BOOL:
             memcpy(&iv, field, sizeof iv);
             if (iv != 0 && iv != 1)
-                rule_add(&log, "[%s] %s = %d: must be 0 or 1 (off/on)", d->section, d->key, iv);
+                cdem_rule_add(&log, "[%s] %s = %d: must be 0 or 1 (off/on)", d->section, d->key,
+                              iv);
             continue;
         case CDEM_PTYPE_ENUM:
             memcpy(&iv, field, sizeof iv);
             while (d->choices[count])
                 count++;
             if (iv < 0 || iv >= count)
-                rule_add(&log, "[%s] %s = %d: not a valid choice", d->section, d->key, iv);
+                cdem_rule_add(&log, "[%s] %s = %d: not a valid choice", d->section, d->key, iv);
             continue;
         case CDEM_PTYPE_STRING:
             if (!memchr(field, '\0', d->size))
-                rule_add(&log, "[%s] %s: text not terminated within %zu characters", d->section,
-                         d->key, d->size);
+                cdem_rule_add(&log, "[%s] %s: text not terminated within %zu characters",
+                              d->section, d->key, d->size);
             continue;
         }
         if (!in_range(d, v)) {
             char range[160];
             describe_range(d, range, sizeof range);
-            format_double(v, v1, sizeof v1);
-            rule_add(&log, "[%s] %s = %s: must be %s", d->section, d->key, v1, range);
+            cdem_params_format_number(v, v1, sizeof v1);
+            cdem_rule_add(&log, "[%s] %s = %s: must be %s", d->section, d->key, v1, range);
         }
     }
     if (log.count > 0) /* ranges first: the cross rules below assume sane values */
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
 
     if (!(p->equilibration < p->runtime)) {
-        format_double(p->equilibration, v1, sizeof v1);
-        format_double(p->runtime, v2, sizeof v2);
-        rule_add(&log,
-                 "equilibration = %s s must be shorter than runtime = %s s: increase [time] "
-                 "runtime or reduce [time] equilibration",
-                 v1, v2);
+        cdem_params_format_number(p->equilibration, v1, sizeof v1);
+        cdem_params_format_number(p->runtime, v2, sizeof v2);
+        cdem_rule_add(&log,
+                      "equilibration = %s s must be shorter than runtime = %s s: increase [time] "
+                      "runtime or reduce [time] equilibration",
+                      v1, v2);
     }
     if (p->weak_interval != CDEM_WEAK_OFF && p->layered_friction)
-        rule_add(&log,
-                 "weak_interval = %s excludes layered_friction = on: set [heterogeneity] "
-                 "weak_interval = off or layered_friction = off",
-                 weak_words[p->weak_interval]);
+        cdem_rule_add(&log,
+                      "weak_interval = %s excludes layered_friction = on: set [heterogeneity] "
+                      "weak_interval = off or layered_friction = off",
+                      weak_words[p->weak_interval]);
     if (p->layered_friction && p->material != CDEM_MATERIAL_GRANULAR)
-        rule_add(&log,
-                 "layered_friction = on requires material = granular (got material = %s): set "
-                 "[heterogeneity] layered_friction = off or [material] material = granular",
-                 material_words[p->material]);
+        cdem_rule_add(&log,
+                      "layered_friction = on requires material = granular (got material = %s): set "
+                      "[heterogeneity] layered_friction = off or [material] material = granular",
+                      material_words[p->material]);
     if (p->overburden_pressure > 0) {
-        format_double(p->overburden_pressure, v1, sizeof v1);
-        if (p->mode == CDEM_MODE_REPOSE || p->mode == CDEM_MODE_BIAXIAL)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m cannot be used with mode = %s: set [surface] "
-                     "overburden_pressure = 0 or choose another mode",
-                     v1, mode_words[p->mode]);
+        cdem_params_format_number(p->overburden_pressure, v1, sizeof v1);
         if (p->erosion)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
-                     "overburden_pressure = 0 or erosion = off",
-                     v1);
+            cdem_rule_add(&log,
+                          "overburden_pressure = %s N/m excludes erosion = on: set [surface] "
+                          "overburden_pressure = 0 or erosion = off",
+                          v1);
         if (p->sedimentation)
-            rule_add(&log,
-                     "overburden_pressure = %s N/m excludes sedimentation = on: set [surface] "
-                     "overburden_pressure = 0 or sedimentation = off",
-                     v1);
+            cdem_rule_add(&log,
+                          "overburden_pressure = %s N/m excludes sedimentation = on: set [surface] "
+                          "overburden_pressure = 0 or sedimentation = off",
+                          v1);
     }
-    if (p->mode == CDEM_MODE_BIAXIAL) {
-        if (p->width != 10.0 || p->height != 5.0) {
-            format_double(p->width, v1, sizeof v1);
-            format_double(p->height, v2, sizeof v2);
-            rule_add(&log,
-                     "mode = biaxial requires width = 10 and height = 5 units (got width = %s, "
-                     "height = %s): set them in [assembly]",
-                     v1, v2);
-        }
-        for (size_t i = 0; i < sizeof biaxial_excludes / sizeof biaxial_excludes[0]; i++) {
-            const cdem_param_def *d =
-                cdem_params_find(biaxial_excludes[i][0], biaxial_excludes[i][1]);
-            int v;
-            memcpy(&v, (const char *)p + d->offset, sizeof v);
-            if (v) {
-                cdem_params_format_value(p, d, v1, sizeof v1);
-                rule_add(&log, "mode = biaxial excludes %s = %s: set [%s] %s = off", d->key, v1,
-                         d->section, d->key);
-            }
-        }
-    }
-    if (p->mode == CDEM_MODE_REPOSE) {
-        if (p->erosion)
-            rule_add(&log, "mode = repose excludes erosion = on: set [surface] erosion = off");
-        if (p->sedimentation)
-            rule_add(
-                &log,
-                "mode = repose excludes sedimentation = on: set [surface] sedimentation = off");
-    }
-    if (p->mode == CDEM_MODE_IRREGULAR_FAULT && p->fault_file[0] == '\0')
-        rule_add(&log, "mode = irregular-fault requires fault_file: set [boundary] fault_file to "
-                       "a text file of x y vertices in m");
-    if (p->mode == CDEM_MODE_VERTICAL_FAULTS &&
-        !(p->vertical_fault_location + p->vertical_fault_spacing < 1.0)) {
-        format_double(p->vertical_fault_location, v1, sizeof v1);
-        format_double(p->vertical_fault_spacing, v2, sizeof v2);
-        rule_add(&log,
-                 "mode = vertical-faults: vertical_fault_location + vertical_fault_spacing = %s + "
-                 "%s must be < 1 (the second fault must lie inside the base): reduce one of them",
-                 v1, v2);
-    }
-    if (p->inversion && !is_fault_mode(p->mode))
-        rule_add(&log,
-                 "inversion = on needs mode = planar-fault, listric-fault or irregular-fault "
-                 "(got mode = %s): set [boundary] inversion = off",
-                 mode_words[p->mode]);
-    if (p->sedimentation) {
-        cdem_model m;
-        cdem_error merr;
-        cdem_error_clear(&merr);
-        if (cdem_model_derive(p, &m, &merr) != CDEM_OK) {
-            rule_add(&log, "%s", merr.msg);
-        } else {
-            double settling = 0.2 * p->equilibration;
-            double between = m.sediment_interval / m.boundary_speed;
-            if (settling > between) {
-                char s_set[32], s_bet[32], s_speed[32], s_di[32], s_eq[32];
-                format_double(settling, s_set, sizeof s_set);
-                snprintf(s_bet, sizeof s_bet, "%.4g", between);
-                snprintf(s_speed, sizeof s_speed, "%.4g", m.boundary_speed);
-                /* smallest display interval / largest equilibration that satisfy the rule */
-                format_safe(settling * m.boundary_speed / 30.0, 1, s_di, sizeof s_di);
-                format_safe(between / 0.2, 0, s_eq, sizeof s_eq);
-                format_double(p->display_interval, v1, sizeof v1);
-                format_double(p->equilibration, v2, sizeof v2);
-                rule_add(&log,
-                         "settling > displacement: the settling time 0.2 x equilibration = 0.2 x "
-                         "%s s = %s s is longer than the time between sediment steps 30 x "
-                         "display_interval / boundary speed = 30 x %s m / %s m/s = %s s: increase "
-                         "[time] display_interval to at least %s m or reduce [time] "
-                         "equilibration to at most %s s",
-                         v2, s_set, v1, s_speed, s_bet, s_di, s_eq);
-            }
-        }
-    }
+    if (more)
+        more(p, &log);
     if (log.count > 0)
         return CDEM_FAIL(err, CDEM_ERR_CONFLICT, "%s", msg);
     return CDEM_OK;

@@ -21,13 +21,19 @@
 
 typedef enum { CDEM_MATERIAL_GRANULAR = 0, CDEM_MATERIAL_BONDED = 1 } cdem_material_model;
 
-/* Granular contact laws: how the cohesion C0 enters the shear strength of a contact
- * (docs/solver.md section 1; one file each, solver/law_*.h). */
+/* Granular contact laws: how the cohesion C0 enters the shear strength of a contact, one
+ * CDEM_LAW_<ID> per row of common/laws/laws.def (docs/solver.md section 1): the laws of
+ * parameter files first, then the tests' fixtures (CDEM_TEST_LAW). */
 typedef enum {
-    CDEM_LAW_NORMAL_COHESION = 0, /* |Fs| <= mu (Fn + C0): C0 in parallel with the normal force */
-    CDEM_LAW_COULOMB = 1,         /* |Fs| <= mu Fn + C0: a Mohr-Coulomb contact */
-    CDEM_LAW_SPRING_COHESION = 2, /* Fs = Ks Xs + C0, |Fs| <= mu Fn: manual Eq. 2 as printed */
-    CDEM_LAW_COUNT = 3
+#define CDEM_LAW(ID, word, description, scalar, lanes) CDEM_LAW_##ID,
+#include "laws/laws.def"
+#undef CDEM_LAW
+    CDEM_LAW_WORDS, /* the number of laws a parameter file can name */
+    CDEM_LAW_TESTS_BEFORE = CDEM_LAW_WORDS - 1,
+#define CDEM_TEST_LAW(ID, word, description, scalar, lanes) CDEM_LAW_##ID,
+#include "laws/laws.def"
+#undef CDEM_TEST_LAW
+    CDEM_LAW_COUNT /* every registered law, the tests' included */
 } cdem_granular_law;
 
 /* Granular: which contacts carry the cohesion C0. */
@@ -37,14 +43,18 @@ typedef enum {
     CDEM_COHESIVE_INITIAL = 2,      /* contacts of the built assembly still touching then */
 } cdem_cohesive_contacts;
 
+/* Boundary (faulting) modes, one CDEM_MODE_<ID> per row of common/modes.def (docs/solver.md
+ * section 4): the modes of parameter files first, then the tests' fixtures. */
 typedef enum {
-    CDEM_MODE_PLANAR_FAULT = 0, /* planar normal/reverse fault, optional inversion */
-    CDEM_MODE_LISTRIC_FAULT,    /* left wall sculpted into a listric fault, footwall removed */
-    CDEM_MODE_IRREGULAR_FAULT,  /* as listric, fault shape read from fault_file */
-    CDEM_MODE_VERTICAL_FAULTS,  /* two vertical faults: caldera or piston */
-    CDEM_MODE_DETACHMENT,       /* lateral wall(s) move inward over the base */
-    CDEM_MODE_REPOSE,           /* lateral wall(s) removed after equilibration */
-    CDEM_MODE_BIAXIAL,          /* platens shorten a 10 x 5 unit sample, gravity off */
+#define CDEM_MODE(ID, id, word) CDEM_MODE_##ID,
+#include "modes.def"
+#undef CDEM_MODE
+    CDEM_MODE_WORDS, /* the number of modes a parameter file can name */
+    CDEM_MODE_TESTS_BEFORE = CDEM_MODE_WORDS - 1,
+#define CDEM_TEST_MODE(ID, id, word) CDEM_MODE_##ID,
+#include "modes.def"
+#undef CDEM_TEST_MODE
+    CDEM_MODE_COUNT /* every registered mode, the tests' included */
 } cdem_mode;
 
 typedef enum { CDEM_SENSE_NORMAL = 0, CDEM_SENSE_REVERSE = 1 } cdem_fault_sense;
@@ -196,9 +206,36 @@ cdem_status cdem_params_load(cdem_params *p, const char *path, char **text_out, 
 /* Applies one "section.key=value" override (from -s on the command line). */
 cdem_status cdem_params_override(cdem_params *p, const char *assignment, cdem_error *err);
 
-/* Checks the exclusions and cross-parameter rules (equilibration < runtime, biaxial only on
- * 10 x 5, ...). Every violated rule is reported at once, one per line, in err->msg. */
-cdem_status cdem_params_validate(const cdem_params *p, cdem_error *err);
+/* The violated cross-parameter rules of one validation, one line each of one message. */
+typedef struct {
+    char *buf;  /* destination (err->msg or a scratch buffer) */
+    size_t cap; /* its size */
+    size_t len; /* characters written */
+    int count;  /* rules violated so far */
+} cdem_rule_log;
+
+/* Adds one violated rule (printf format) as a line of the log. */
+void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* A caller's own rules, added after the table's to the same log. */
+typedef void (*cdem_params_rules)(const cdem_params *p, cdem_rule_log *log);
+
+/* Checks every value against its row (CDEM_ERR_RANGE, all such values named at once), then
+ * the rules between parameters (equilibration < runtime, the heterogeneity and surface
+ * exclusions, ...) and, when more is not NULL, the caller's (cdem-run's: the mode's and the
+ * growth strata's, solver/run/validate.c). Every violated rule is reported at once, one per
+ * line, in err->msg (CDEM_ERR_CONFLICT). */
+cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err);
+
+/* "a, b or c" from words[0..n) into buf (cut at cap). */
+void cdem_words_or(const char *const *words, size_t n, char *buf, size_t cap);
+
+/* The words of an enum parameter (section.key), as cdem_words_or lists them. */
+void cdem_params_join_choices(const char *section, const char *key, char *buf, size_t cap);
+
+/* Formats a number so that strtod gives back exactly the same value, as short as possible
+ * (whole numbers up to 7 digits without exponent): the values quoted in messages. */
+void cdem_params_format_number(double v, char *buf, size_t n);
 
 /* Formats a parameter's current value as it would be written in a file. */
 void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, char *buf, size_t n);
@@ -210,7 +247,17 @@ void cdem_params_write(const cdem_params *p, FILE *out);
  * range/values, help) for docs/parameters.md. Added for `cdem-run --params-markdown`. */
 void cdem_params_write_markdown(FILE *out);
 
-/* Words of enum values (for summaries and messages). */
+/* The element-base material in force: material.base_* where set, the wall's value where a
+ * base key is the word "wall" (stored as NaN). Returns 1 when any base key has a value of its
+ * own, 0 when the base is the wall throughout. */
+int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base);
+
+/* A mode's word (a test fixture's too), from its row; "unknown" for a value that is none. */
 const char *cdem_mode_name(cdem_mode mode);
+
+/* A law's word (a test fixture's too) and its one-line description, from its row; "?" for
+ * a value that is no law. */
+const char *cdem_law_name(cdem_granular_law law);
+const char *cdem_law_description(cdem_granular_law law);
 
 #endif

@@ -43,7 +43,7 @@ typedef enum {
 
 /* The per-element arrays: the one list that declares them (cdem_state below), allocates,
  * grows, frees, copies and compacts them (state.c), stores them in every increment of the
- * run file (common/h5/h5_layout.c) and in checkpoints (solver/checkpoint.c). Adding a field is
+ * run file (common/h5/h5_layout.c) and in checkpoints (solver/base/checkpoint.c). Adding a field is
  * one row here (plus, for an in_increments field, its line in docs/format.md and a thought
  * about older files, which lack the dataset). The order is the order of the checkpoint blob
  * and of the run file's datasets: append new rows, do not reorder. Columns:

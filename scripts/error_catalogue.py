@@ -88,14 +88,14 @@ MESSAGE_CALLS = {
     "H5FAIL": 3,             # common/h5/h5_internal.h: the run file's errors
     "h5i_fail_at": 5,        # what H5FAIL calls
     "cdem_error_prefix": 2,  # context put before a message on its way up
-    "rule_add": 2,           # common/params.c: rules between keys, reported together
+    "cdem_rule_add": 2,      # common/params.c and the solver: rules between keys, reported together
     "usage_error": 1,        # solver/main.c: cdem-run's usage errors
     "cdem_cmd_usage": 2,     # analysis/cli/cmd_support.c: cdem-strain's usage errors
     "usage": 1,              # analysis/cli/cmd_render.c: cdem_cmd_usage with render's help
     "fprintf": 2,            # only fprintf(stderr, ...)
     "say_why": 3,            # common/h5/h5_layout.c: why a value of a run file is refused
 }
-KIND = {"rule_add": "rule", "cdem_error_prefix": "context", "usage_error": "usage",
+KIND = {"cdem_rule_add": "rule", "cdem_error_prefix": "context", "usage_error": "usage",
         "cdem_cmd_usage": "usage", "usage": "usage", "fprintf": "stderr", "say_why": "reason"}
 
 TOKEN = re.compile(r"""

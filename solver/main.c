@@ -2,12 +2,13 @@
  *
  * Reads a parameter file (or uses the built-in default model), applies -s overrides in
  * command-line order, validates, prints the model summary and runs the simulation through
- * cdem_run() (solver/run.h). This is the only place that prints messages and chooses exit
+ * cdem_run() (solver/run/run.h). This is the only place that prints messages and chooses exit
  * codes: 0 completed, 1 error, 2 usage error, 3 interrupted (SIGINT/SIGTERM/SIGHUP; the
  * output file is still valid and records where it stopped). An existing output is never
  * replaced without --force, and a file that is not a cdem run file never. Messages go to stderr as
  * "cdem-run: <message>", one line per problem; the summary and the --print-defaults /
  * --params-markdown texts go to stdout so they can be redirected into files. */
+#include "bc.h"
 #include "h5format.h"
 #include "model.h"
 #include "params.h"
@@ -127,9 +128,10 @@ static void print_error(const char *msg) {
         fprintf(stderr, "cdem-run: unknown error\n");
 }
 
-static int usage_error(const char *fmt, const char *arg) {
+/* fmt has one or two %s: arg and, for the second, hint. */
+static int usage_error(const char *fmt, const char *arg, const char *hint) {
     fprintf(stderr, "cdem-run: ");
-    fprintf(stderr, fmt, arg);
+    fprintf(stderr, fmt, arg, hint);
     fprintf(stderr, "\nTry 'cdem-run --help' for more information.\n");
     return EXIT_USAGE;
 }
@@ -192,11 +194,11 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->params_markdown = 1;
         } else if (strcmp(arg, "-o") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a file name", arg);
+                return usage_error("option %s needs a file name", arg, NULL);
             a->output_path = argv[++i];
         } else if (strcmp(arg, "-s") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs section.key=value", arg);
+                return usage_error("option %s needs section.key=value", arg, NULL);
             a->overrides[a->n_overrides++] = argv[++i];
         } else if (strncmp(arg, "-s", 2) == 0 && strchr(arg, '=')) {
             a->overrides[a->n_overrides++] = arg + 2; /* -ssection.key=value */
@@ -208,29 +210,34 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->no_fsync = 1;
         } else if (strcmp(arg, "--max-steps") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of time steps", arg);
+                return usage_error("option %s needs a number of time steps", arg, NULL);
             if (parse_count(arg, argv[++i], &a->max_steps) != EXIT_OK)
                 return EXIT_USAGE;
         } else if (strcmp(arg, "--resume") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs the run file to continue", arg);
+                return usage_error("option %s needs the run file to continue", arg, NULL);
             a->resume_path = argv[++i];
         } else if (strcmp(arg, "--threads") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of threads", arg);
+                return usage_error("option %s needs a number of threads", arg, NULL);
             if (cdem_threads_parse(argv[++i], &a->threads) != 0)
-                return usage_error("--threads %s: expected a whole number from 1 to 1024", argv[i]);
+                return usage_error("--threads %s: expected a whole number from 1 to 1024", argv[i],
+                                   NULL);
         } else if (strcmp(arg, "--par-min") == 0) {
             if (i + 1 >= argc)
-                return usage_error("option %s needs a number of items", arg);
+                return usage_error("option %s needs a number of items", arg, NULL);
             if (parse_count(arg, argv[++i], &a->par_min) != EXIT_OK)
                 return EXIT_USAGE;
         } else if (arg[0] == '-' && arg[1] != '\0') {
-            return usage_error("unknown option %s", arg);
+            char near[64];
+            return usage_error(cdem_cli_suggest_option(&run_help, arg, near, sizeof near)
+                                   ? "unknown option %s; did you mean %s?"
+                                   : "unknown option %s",
+                               arg, near);
         } else if (!a->model_path) {
             a->model_path = arg;
         } else {
-            return usage_error("more than one model file given (second: %s)", arg);
+            return usage_error("more than one model file given (second: %s)", arg, NULL);
         }
     }
     return EXIT_OK;
@@ -339,10 +346,9 @@ static int same_file(const char *a, const char *b) {
 /* Refuses an output that is one of the run's inputs, then (before the model is set up, so
  * the refusal is immediate) an output another run is writing or that may not be replaced.
  * The writer repeats the last two checks under its lock. */
-static int check_output(const cli_args *a, const cdem_params *p, const char *out, cdem_error *err) {
-    const char *inputs[2] = {a->model_path,
-                             p->mode == CDEM_MODE_IRREGULAR_FAULT ? p->fault_file : NULL};
-    const char *what[2] = {"the parameter file", "the fault vertex file (boundary.fault_file)"};
+static int check_output(const cli_args *a, const cdem_model *m, const char *out, cdem_error *err) {
+    const char *inputs[2] = {a->model_path, m->mode.input};
+    const char *what[2] = {"the parameter file", m->mode.input_what};
     for (int k = 0; k < 2; k++)
         if (inputs[k] && inputs[k][0] && same_file(out, inputs[k])) {
             fprintf(stderr,
@@ -464,7 +470,7 @@ int main(int argc, char **argv) {
         rc = EXIT_OK;
         goto done;
     }
-    if (cdem_params_validate(&p, &err) != CDEM_OK) {
+    if (cdem_run_validate(&p, &err) != CDEM_OK) {
         fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
                 !a.model_path               ? ""
                 : strcmp(a.model_path, "-") ? a.model_path
@@ -473,7 +479,7 @@ int main(int argc, char **argv) {
         goto fail;
     }
     cdem_model m;
-    if (cdem_model_derive(&p, &m, &err) != CDEM_OK)
+    if (cdem_bc_derive_model(&p, &m, &err) != CDEM_OK)
         goto fail;
     int running = !a.summary_only && !a.dry_run;
     if (running) {
@@ -482,7 +488,7 @@ int main(int argc, char **argv) {
             fprintf(stderr, "cdem-run: out of memory\n");
             goto done;
         }
-        rc = check_output(&a, &p, out_path, &err);
+        rc = check_output(&a, &m, out_path, &err);
         if (rc != EXIT_OK)
             goto done;
         rc = EXIT_ERROR;

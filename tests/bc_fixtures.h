@@ -183,7 +183,7 @@ __attribute__((unused)) static void fx_cdem_run(cdem_params p, const char *name,
     p.equilibration = 60.0;
     p.runtime = 100.0;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, m, &err), CDEM_OK);
     cdem_run_options o;
     memset(&o, 0, sizeof o);
     o.output_path = path;

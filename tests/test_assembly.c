@@ -1,4 +1,4 @@
-/* Tests of the assembly generator (solver/assembly.c): element counts against the original
+/* Tests of the assembly generator (solver/packing/assembly.c): element counts against the original
  * program's figures, geometry (inside the box, no overlap, no large gaps, every disc
  * supported), walls, ordering, size distribution, determinism, the largest assembly and
  * every error path. Params and model are filled by hand (radii 50..125 m at unit scaling
@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "assembly.h"
+#include "bc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -522,12 +523,19 @@ static void test_assembly_walls_complete(void **unused) {
         assert_true(info.wall_radius == rw && info.wall_spacing == rw);
         assert_true(info.base_spacing <= p.base_spacing * rw * (1.0 + 1e-12) &&
                     info.base_spacing > 0.9 * p.base_spacing * rw);
-        if (mult == 1) { /* the biaxial test's base row is a smooth platen, whatever is set */
+        if (mult == 1) { /* the biaxial test's base row is a smooth platen, whatever is set:
+                          * the mode's part of the model (its derive hook) says so */
             cdem_params pb = p;
             pb.mode = CDEM_MODE_BIAXIAL;
+            const cdem_bc_ops *ops = NULL;
+            cdem_error err;
+            assert_int_equal(cdem_bc_find(CDEM_MODE_BIAXIAL, &ops, &err), CDEM_OK);
+            cdem_model mb = m;
+            mb.mode = cdem_model_mode_default();
+            ops->derive(&pb, &mb.mode);
             cdem_state sb;
             cdem_assembly_info ib;
-            build(&pb, &m, &sb, &ib);
+            build(&pb, &mb, &sb, &ib);
             assert_true(ib.base_spacing <= rw * (1.0 + 1e-12) && ib.base_spacing > 0.9 * rw);
             cdem_state_free(&sb);
         }

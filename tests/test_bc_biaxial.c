@@ -1,4 +1,4 @@
-/* Tests of the biaxial mode (solver/bc_biaxial.c) and the confining pressure of the
+/* Tests of the biaxial mode (solver/modes/bc_biaxial.c) and the confining pressure of the
  * integrator: the ramp, the edge force on a hand-made pair (analytic), the edge search on a
  * real sample (sum of the lateral forces = p x height within one band), parameter errors, and
  * a short end-to-end 10 x 5 run (equilibration 100 s, runtime 150 s) read back: platen
@@ -58,7 +58,7 @@ static void test_bc_biaxial_edge_force_analytic(void **st) {
     cdem_params p = biaxial_params();
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     cdem_integrator it;
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
     cdem_state s;
@@ -120,7 +120,7 @@ static void test_bc_biaxial_servo_platens_carry_the_pressure(void **st) {
     cdem_params p = biaxial_params();
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     m.equil_steps = 200;
     m.total_steps = 600;
     cdem_state s;
@@ -184,7 +184,7 @@ static void test_bc_biaxial_uniaxial_sample_stays_packed(void **st) {
     p.runtime = 110.0;
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     cdem_run_options o;
     memset(&o, 0, sizeof o);
     o.output_path = path;
@@ -257,7 +257,7 @@ static void test_bc_biaxial_end_to_end(void **st) {
     cdem_params p = biaxial_params();
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     assert_true(m.gravity == 0.0);
     cdem_run_options o;
     memset(&o, 0, sizeof o);

@@ -1,6 +1,6 @@
-/* The boundary modes' `boundary_only` promise (solver/bc.h), on which the stepper relies to
+/* The boundary modes' `boundary_only` promise (solver/modes/bc.h), on which the stepper relies to
  * apply a mode before the drift and drift inside the force pass's parallel region
- * (solver/integrate.c): a mode that makes it
+ * (solver/step/integrate.c): a mode that makes it
  *   - writes no free element: every free element's fields are bit-unchanged by its apply;
  *   - reads no free element: its moves of the boundary elements and its net displacement
  *     are bit-identical whatever the free elements' positions, velocities and forces.
@@ -202,7 +202,7 @@ static void test_bc_boundary_only_flags(void **st) {
     assert_false(cdem_bc_apply_is_boundary_only(&biaxial, 0));
     assert_false(cdem_bc_apply_is_boundary_only(&biaxial, 5));
     /* a mode without the promise that does not move in equilibration: only k <= 0 */
-    const cdem_bc_ops quiet = {.name = "quiet", .moves_in_equilibration = 0, .boundary_only = 0};
+    const cdem_bc_ops quiet = {.moves_in_equilibration = 0, .boundary_only = 0};
     cdem_bc q = {.ops = &quiet};
     assert_true(cdem_bc_apply_is_boundary_only(&q, 0));
     assert_false(cdem_bc_apply_is_boundary_only(&q, 1));

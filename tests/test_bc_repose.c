@@ -13,6 +13,7 @@
 
 #include "bc_fixtures.h"
 #include "h5format.h"
+#include "bc.h"
 #include "model.h"
 #include "run.h"
 #include "scratch.h"
@@ -201,13 +202,13 @@ static void test_bc_repose_display_interval_seconds(void **st) {
     p.display_interval = 7.0;
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     for (int k = m.n_increments_equil; k < m.n_increments_total - 1; k++) {
         const long a = cdem_model_increment_step(&m, k), b = cdem_model_increment_step(&m, k + 1);
         assert_float_equal((double)(b - a) * m.dt, 7.0, 1.01 * m.dt); /* steps are rounded */
     }
     p.mode = CDEM_MODE_DETACHMENT;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     const int k = m.n_increments_equil;
     const long a = cdem_model_increment_step(&m, k), b = cdem_model_increment_step(&m, k + 1);
     assert_float_equal((double)(b - a) * m.displacement_per_step, 7.0,
@@ -230,7 +231,7 @@ static void test_bc_repose_run_removes_walls(void **st) {
     p.display_interval = 10.0; /* s */
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     char *logbuf = NULL;
     size_t loglen = 0;
     FILE *log = open_memstream(&logbuf, &loglen);

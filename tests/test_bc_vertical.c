@@ -101,7 +101,7 @@ static void test_bc_vertical_errors_and_view(void **st) {
     free(v);
     const cdem_bc_ops *ops = NULL;
     assert_int_equal(cdem_bc_find(CDEM_MODE_VERTICAL_FAULTS, &ops, &err), CDEM_OK);
-    assert_string_equal(ops->name, "vertical-faults");
+    assert_string_equal(cdem_mode_name(CDEM_MODE_VERTICAL_FAULTS), "vertical-faults");
     cdem_bc_free(&bc);
     cdem_state_free(&s);
 }

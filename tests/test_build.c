@@ -1,7 +1,8 @@
 /* The Makefile's promises (issue 20, item 8), checked on `make -n -B` (the commands make
  * would run; nothing is compiled): a user's CFLAGS are appended to the project's flags,
  * never replace them; each layer compiles with the include paths of the layers it may use
- * (common: itself; solver and analysis: common and themselves; inside the analysis,
+ * (common: itself; solver and analysis: common and themselves; inside the solver, base/ <
+ * contact/ < step/ < packing/ < run/ with modes/ on base/ alone; inside the analysis,
  * measure/ < input/, export/ < cli/ and draw/ < cli/); cdem-strain links no
  * solver code. Runs make from the repository root into a scratch BUILD. */
 #include <setjmp.h>
@@ -83,7 +84,32 @@ static void test_build_layer_include_paths(void **state) {
         const char *allowed[3], *forbidden[4];
     } layers[] = {
         {"common/state.o", "common/state.c", {"-Icommon"}, {"-Isolver", "-Ianalysis"}},
-        {"solver/run.o", "solver/run.c", {"-Icommon", "-Isolver"}, {"-Ianalysis"}},
+        /* the solver's layers: base/ < contact/ < step/ < packing/ < run/, and modes/ sees
+         * base/ only (step/ and above see it) */
+        {"solver/base/model.o",
+         "solver/base/model.c",
+         {"-Icommon", "-Isolver/base"},
+         {"-Ianalysis", "-Isolver/contact", "-Isolver/modes", "-Isolver/run"}},
+        {"solver/contact/contact.o",
+         "solver/contact/contact.c",
+         {"-Icommon", "-Isolver/base", "-Isolver/contact"},
+         {"-Ianalysis", "-Isolver/modes", "-Isolver/step", "-Isolver/run"}},
+        {"solver/modes/bc_registry.o",
+         "solver/modes/bc_registry.c",
+         {"-Icommon", "-Isolver/base", "-Isolver/modes"},
+         {"-Ianalysis", "-Isolver/contact", "-Isolver/step", "-Isolver/run"}},
+        {"solver/step/integrate.o",
+         "solver/step/integrate.c",
+         {"-Isolver/contact", "-Isolver/modes", "-Isolver/step"},
+         {"-Ianalysis", "-Isolver/packing", "-Isolver/run"}},
+        {"solver/packing/sediment.o",
+         "solver/packing/sediment.c",
+         {"-Isolver/step", "-Isolver/packing"},
+         {"-Ianalysis", "-Isolver/run"}},
+        {"solver/run/run.o",
+         "solver/run/run.c",
+         {"-Icommon", "-Isolver/packing", "-Isolver/run"},
+         {"-Ianalysis"}},
         /* the analysis's own layers (Makefile): measure/ sees none of the others, draw/
          * only itself, input/ and export/ the measures, cli/ everything of the analysis */
         {"analysis/measure/strain.o",

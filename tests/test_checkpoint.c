@@ -1,4 +1,4 @@
-/* Tests of checkpoints (solver/checkpoint.h and every module's snapshot_put/_get through
+/* Tests of checkpoints (solver/base/checkpoint.h and every module's snapshot_put/_get through
  * cdem_run_capture / cdem_run_open with a snapshot): a run of N steps straight and a run
  * captured at step k, freed, restored into a fresh run context and continued to N must hold
  * bit-identical state (every array of the capture: elements, pair list with histories,
@@ -16,6 +16,7 @@
 #include <cmocka.h>
 
 #include "checkpoint.h"
+#include "bc.h"
 #include "model.h"
 #include "run.h"
 #include "snapshot.h"
@@ -118,7 +119,7 @@ static void check_resume(const cdem_params *p, long k, long n) {
 static long model_steps(const cdem_params *p, long *equil) {
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(p, &m, &err), CDEM_OK);
     *equil = m.equil_steps;
     return m.total_steps;
 }
@@ -181,7 +182,7 @@ static void test_checkpoint_sedimentation_resume_is_bit_identical(void **st) {
     p.sea_level_rise = CDEM_SEA_MID;
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     const long first = m.equil_steps + m.sediment_steps; /* step of the first deposit */
     assert_true(first + m.settling_steps + 10 < m.total_steps);
     /* inside the first settling, on past its end (cohesion of the deposit made after the

@@ -178,7 +178,11 @@ static void test_cli_usage_errors_and_info(void **state) {
     cli_ctx *c = *state;
     assert_int_equal(run(c, "--bogus"), 2);
     char *err = slurp(c, "err.txt");
-    assert_has(err, "cdem-run: unknown option --bogus");
+    assert_has(err, "cdem-run: unknown option --bogus\n");
+    free(err);
+    assert_int_equal(run(c, "--thread 2"), 2);
+    err = slurp(c, "err.txt");
+    assert_has(err, "cdem-run: unknown option --thread; did you mean --threads?");
     free(err);
     assert_int_equal(run(c, "a.ini b.ini"), 2);
     assert_int_equal(run(c, "--max-steps zero"), 2);

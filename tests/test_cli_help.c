@@ -1,7 +1,7 @@
 /* Tests of common/cli_help: the help layout (80 columns, option text in column 23, usage
  * forms never broken inside [...], later forms and continuations indented), option lookup
  * (every spelling, --opt=value, a switch refusing a value), -h/--help detection that skips
- * option values, and the usage-error text. */
+ * option values, the usage-error text, and the nearest spelling of an unknown option. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -109,12 +109,23 @@ static void test_cli_help_usage_error(void **state) {
     free(t);
 }
 
+/* An unknown long option gets the nearest spelling of the table (or --help) when it is
+ * close; a far one and a one-letter option get none. */
+static void test_cli_help_suggest_option(void **state) {
+    (void)state;
+    char buf[64];
+    assert_string_equal(cdem_cli_suggest_option(&help, "--outptu", buf, sizeof buf), "--output");
+    assert_string_equal(cdem_cli_suggest_option(&help, "--flga=1", buf, sizeof buf), "--flag");
+    assert_string_equal(cdem_cli_suggest_option(&help, "--hlep", buf, sizeof buf), "--help");
+    assert_null(cdem_cli_suggest_option(&help, "--nothing-like-it", buf, sizeof buf));
+    assert_null(cdem_cli_suggest_option(&help, "-p", buf, sizeof buf));
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_cli_help_layout),
-        cmocka_unit_test(test_cli_help_find_option),
-        cmocka_unit_test(test_cli_help_wants_help),
-        cmocka_unit_test(test_cli_help_usage_error),
+        cmocka_unit_test(test_cli_help_layout),         cmocka_unit_test(test_cli_help_find_option),
+        cmocka_unit_test(test_cli_help_wants_help),     cmocka_unit_test(test_cli_help_usage_error),
+        cmocka_unit_test(test_cli_help_suggest_option),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,4 +1,4 @@
-/* The thread governor (solver/governor.c) on a simulated clock: a step takes t_n seconds on
+/* The thread governor (solver/run/governor.c) on a simulated clock: a step takes t_n seconds on
  * the N allowed threads and t_1 on one (the clock advances by the time of the count in use,
  * read every GOVERNOR_CHECK_EVERY steps and around the steps of a window, as the run loop
  * does; optionally a write between steps advances it further).

@@ -430,8 +430,8 @@ static void test_heterogeneity_run_end_to_end(void **st) {
     p.erosion_base_level = 1.0;
     cdem_error err;
     cdem_model m;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     cdem_run_options o;
     memset(&o, 0, sizeof o);
     o.output_path = path;

@@ -63,6 +63,7 @@ static void test_hints_in_messages_are_valid_values(void **state) {
     assert_int_equal(glob("common/*.c", 0, NULL, &g), 0);
     assert_int_equal(glob("common/h5/*.c", GLOB_APPEND, NULL, &g), 0);
     assert_int_equal(glob("solver/*.c", GLOB_APPEND, NULL, &g), 0);
+    assert_int_equal(glob("solver/*/*.c", GLOB_APPEND, NULL, &g), 0);
     assert_int_equal(glob("analysis/*/*.c", GLOB_APPEND, NULL, &g), 0);
     int hints = 0;
     for (size_t i = 0; i < g.gl_pathc; i++) {

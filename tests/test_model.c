@@ -1,4 +1,4 @@
-/* Tests of common/model.c: derived constants against hand-computed numbers, the boundary
+/* Tests of solver/base/model.c: derived constants against hand-computed numbers, the boundary
  * speed relation against the paper's worked examples, the increment schedule. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -7,6 +7,7 @@
 
 #include <cmocka.h>
 
+#include "bc.h"
 #include "model.h"
 #include "params.h"
 
@@ -19,7 +20,7 @@ static cdem_model derive(const cdem_params *p) {
     cdem_model m;
     cdem_error err;
     cdem_error_clear(&err);
-    cdem_status st = cdem_model_derive(p, &m, &err);
+    cdem_status st = cdem_bc_derive_model(p, &m, &err);
     if (st != CDEM_OK)
         print_error("%s\n", err.msg);
     assert_int_equal(st, CDEM_OK);
@@ -250,15 +251,16 @@ static void test_model_derive_rejects_unusable(void **state) {
     cdem_error err;
     cdem_params_defaults(&p);
     p.unit_scaling = 0.0;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "unit_scaling = 0 m"));
     cdem_params_defaults(&p);
     p.display_interval = -1.0;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "display_interval = -1"));
     p.display_interval = NAN;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_ERR_RANGE);
-    assert_int_equal(cdem_model_derive(NULL, &m, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_bc_derive_model(NULL, &m, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_model_derive(NULL, NULL, &m, &err), CDEM_ERR_INVALID);
 }
 
 int main(void) {

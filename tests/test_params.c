@@ -1,4 +1,5 @@
-/* Tests of common/params.c: the table, the INI parser, overrides, validation, the writers
+/* Tests of common/params.c: the table, the INI parser, overrides, validation (with the
+ * solver's rules, cdem_run_validate, as cdem-run checks a parameter set), the writers
  * and the docs/parameters.md table. Range tests are driven by the table itself, so a new
  * parameter is covered without editing this file. */
 #include <setjmp.h>
@@ -10,6 +11,7 @@
 
 #include "model.h"
 #include "params.h"
+#include "run.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -132,7 +134,7 @@ static void test_params_defaults_are_the_paper_model(void **state) {
     assert_true(p.total_strain_max == 2.0);
     cdem_error err;
     cdem_error_clear(&err);
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_OK);
 }
 
 /* ---------- every range boundary of every numeric parameter ---------- */
@@ -414,7 +416,7 @@ static void test_params_crlf_file(void **state) {
     assert_int_equal(p.detachment_walls, CDEM_WALLS_BOTH);
     assert_true(p.wall.friction == 0.0 && p.wall.cohesion == 0.0);
     assert_string_equal(p.prefix, "detach");
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_OK);
 }
 
 static void test_params_load_errors(void **state) {
@@ -491,10 +493,20 @@ static void test_params_base_material_word(void **state) {
     assert_int_equal(cdem_params_override(&p, "material.base_friction=walls", &err),
                      CDEM_ERR_PARSE);
     assert_msg_has(&err, "base_friction = walls: not a number");
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_OK);
+    /* the material in force: the base's own friction, the wall's cohesion and strain */
+    cdem_contact_material base;
+    p.wall.cohesion = 7e8;
+    assert_int_equal(cdem_params_base_material(&p, &base), 1);
+    assert_true(base.friction == 0.0 && base.cohesion == 7e8 &&
+                base.breaking_strain == p.wall.breaking_strain);
+    cdem_params q;
+    cdem_params_defaults(&q);
+    assert_int_equal(cdem_params_base_material(&q, &base), 0);
+    assert_true(base.friction == q.wall.friction && base.cohesion == q.wall.cohesion);
     /* a NaN in a row without the word is still refused */
     p.wall.friction = NAN;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_ERR_RANGE);
     assert_msg_has(&err, "wall_friction = nan");
 }
 
@@ -589,7 +601,7 @@ static void test_params_validate_each_rule(void **state) {
         cdem_params_defaults(&p);
         cdem_error_clear(&err);
         apply_overrides(&p, rule_cases[i].overrides);
-        cdem_status st = cdem_params_validate(&p, &err);
+        cdem_status st = cdem_run_validate(&p, &err);
         if (st != CDEM_ERR_CONFLICT)
             print_error("case %s: status %d\n", rule_cases[i].name, st);
         assert_int_equal(st, CDEM_ERR_CONFLICT);
@@ -616,7 +628,7 @@ static void test_params_validate_allowed_combinations(void **state) {
         cdem_params_defaults(&p);
         cdem_error_clear(&err);
         apply_overrides(&p, ok_sets[i]);
-        cdem_status st = cdem_params_validate(&p, &err);
+        cdem_status st = cdem_run_validate(&p, &err);
         if (st != CDEM_OK)
             print_error("set %zu: %s\n", i, err.msg);
         assert_int_equal(st, CDEM_OK);
@@ -632,7 +644,7 @@ static void test_params_validate_reports_all_rules_at_once(void **state) {
                                      "assembly.width=20",       "surface.erosion=on",
                                      "boundary.inversion=on",   NULL};
     apply_overrides(&p, ov);
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_CONFLICT);
+    assert_int_equal(cdem_run_validate(&p, &err), CDEM_ERR_CONFLICT);
     assert_msg_has(&err, "equilibration = 2500 s must be shorter than runtime = 2000 s");
     assert_msg_has(&err, "\nmode = biaxial requires width = 10");
     assert_msg_has(&err, "\nmode = biaxial excludes erosion");
@@ -651,19 +663,19 @@ static void test_params_validate_settling_numbers(void **state) {
     p.sedimentation = 1;
     /* Default model: v = 25 dt = 0.70461 m/s, so 30 x 5 m take 212.9 s; settling is
      * 0.2 x 400 = 80 s: accepted. With equilibration 1100 s the settling (220 s) is longer. */
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_run_validate(&p, &err), CDEM_OK);
     p.equilibration = 1100;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_CONFLICT);
+    assert_int_equal(cdem_run_validate(&p, &err), CDEM_ERR_CONFLICT);
     assert_msg_has(&err, "settling > displacement:");
     assert_msg_has(&err, "= 30 x 5 m / 0.7046 m/s = 212.9 s");
     assert_msg_has(&err, "increase [time] display_interval to at least 5.168 m");
     assert_msg_has(&err, "reduce [time] equilibration to at most 1064 s");
     /* following the advice exactly fixes it (the numbers are rounded to the safe side) */
     p.display_interval = 5.168;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_run_validate(&p, &err), CDEM_OK);
     p.display_interval = 5.0;
     p.equilibration = 1064;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_OK);
+    assert_int_equal(cdem_run_validate(&p, &err), CDEM_OK);
 }
 
 static void test_params_validate_checks_ranges_of_coded_values(void **state) {
@@ -674,11 +686,11 @@ static void test_params_validate_checks_ranges_of_coded_values(void **state) {
     p.gravity = 40;
     p.mode = (cdem_mode)42;
     p.half_radii = 3;
-    assert_int_equal(cdem_params_validate(&p, &err), CDEM_ERR_RANGE);
+    assert_int_equal(cdem_params_validate(&p, NULL, &err), CDEM_ERR_RANGE);
     assert_msg_has(&err, "[physics] gravity = 40: must be between 0.5 and 25 m/s^2");
     assert_msg_has(&err, "[boundary] mode = 42: not a valid choice");
     assert_msg_has(&err, "[assembly] half_radii = 3: must be 0 or 1");
-    assert_int_equal(cdem_params_validate(NULL, &err), CDEM_ERR_INVALID);
+    assert_int_equal(cdem_params_validate(NULL, NULL, &err), CDEM_ERR_INVALID);
 }
 
 /* ---------- writers ---------- */

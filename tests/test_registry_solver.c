@@ -1,9 +1,11 @@
 /* The registration tables of cdem-run are complete (issue 20): every boundary mode and every
  * granular contact law that the parameter table offers (the words of boundary.mode and
  * material.granular_law, common/params.c) is
- *   - implemented: the mode has a row in the boundary-mode registry (solver/bc_registry.c,
- *     cdem_bc_find succeeds); the law is accepted by the contact kernel
- *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact;
+ *   - implemented: the mode's row of common/modes.def has its ops (cdem_bc_find succeeds, the
+ *     required hooks are there, what it excludes are parameters; every registered mode, the
+ *     tests' fixtures too); the law is accepted by the contact kernel
+ *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact
+ *     (every registered law: also the tests' fixtures, which no parameter file names);
  *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
  *   - tested: a test source under tests/ (other than this file) names its enum constant
  *     (CDEM_MODE_<NAME> / CDEM_LAW_<NAME>, '-' as '_').
@@ -24,10 +26,12 @@
 #include <ctype.h>
 #include <glob.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "law_fixtures.h"
 #include "scratch.h"
 
 /* The choice words of an enum parameter, and their count. */
@@ -109,13 +113,43 @@ static void test_registry_boundary_modes(void **state) {
     (void)state;
     size_t n;
     const char *const *modes = choices_of("boundary", "mode", &n);
-    for (size_t i = 0; i < n; i++) {
+    assert_int_equal(n, CDEM_MODE_WORDS);
+    /* every registered mode, the tests' fixtures too, has its ops with the required hooks;
+     * what it excludes are parameters of the table; a mode that moves no boundary says what
+     * happens instead (the summary's words) */
+    for (int i = 0; i < CDEM_MODE_COUNT; i++) {
+        const cdem_mode mode = (cdem_mode)i;
+        const char *word = cdem_mode_name(mode);
         const cdem_bc_ops *ops = NULL;
         cdem_error err;
-        if (cdem_bc_find((cdem_mode)i, &ops, &err) != CDEM_OK)
-            fail_msg("boundary.mode = %s has no implementation: %s", modes[i], err.msg);
+        if (cdem_bc_find(mode, &ops, &err) != CDEM_OK)
+            fail_msg("boundary.mode = %s has no implementation: %s", word, err.msg);
         assert_non_null(ops);
-        assert_string_equal(cdem_mode_name((cdem_mode)i), modes[i]);
+        if ((size_t)i < n)
+            assert_string_equal(word, modes[i]);
+        if (!ops->init || !ops->net_displacement || !ops->view || ops->state_size == 0 ||
+            !(ops->apply || (ops->step_begin && ops->step_move)))
+            fail_msg("boundary.mode = %s: a required hook of cdem_bc_ops is missing (bc.h)", word);
+        for (size_t k = 0; ops->excludes && ops->excludes[k]; k++) {
+            char section[32];
+            const char *dot = strchr(ops->excludes[k], '.');
+            assert_non_null(dot);
+            snprintf(section, sizeof section, "%.*s", (int)(dot - ops->excludes[k]),
+                     ops->excludes[k]);
+            if (!cdem_params_find(section, dot + 1))
+                fail_msg("boundary.mode = %s excludes %s, which is no parameter", word,
+                         ops->excludes[k]);
+        }
+        cdem_params p;
+        cdem_params_defaults(&p);
+        p.mode = mode;
+        cdem_model_mode mm = cdem_model_mode_default();
+        if (ops->derive)
+            ops->derive(&p, &mm);
+        if (mm.moving_boundaries == 0 && !mm.still)
+            fail_msg("boundary.mode = %s moves no boundary but does not say what happens", word);
+        if (mm.input && !mm.input_what)
+            fail_msg("boundary.mode = %s names an input file without saying what it is", word);
     }
     assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }
@@ -124,41 +158,31 @@ static void test_registry_contact_laws(void **state) {
     (void)state;
     size_t n;
     const char *const *laws = choices_of("material", "granular_law", &n);
-    assert_int_equal(n, CDEM_LAW_COUNT);
-    /* each law is accepted and is a law of its own: a cohesive contact pushed past its
-     * strength transmits a different tangential force under each law */
+    assert_int_equal(n, CDEM_LAW_WORDS);
+    /* every registered law, the tests' fixtures too, is accepted by the contact kernel, has
+     * its word and its description, and is a law of its own: a cohesive contact pushed past
+     * its strength transmits a different tangential force under each law */
     double force[CDEM_LAW_COUNT];
-    for (size_t i = 0; i < n; i++) {
-        cdem_params p;
-        cdem_params_defaults(&p);
-        p.granular_law = (cdem_granular_law)i;
-        cdem_contact_law law;
-        cdem_error err;
-        if (cdem_contact_law_init(&law, &p, 1e9, 1e9, &err) != CDEM_OK)
-            fail_msg("material.granular_law = %s is refused: %s", laws[i], err.msg);
-        assert_int_equal(law.granular, (int)i);
-        force[i] = 0.0;
-        switch (law.granular) {
-        case CDEM_LAW_COULOMB:
-            force[i] = cdem_law_coulomb(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        case CDEM_LAW_SPRING_COHESION:
-            force[i] = cdem_law_spring_cohesion(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        case CDEM_LAW_NORMAL_COHESION:
-            force[i] = cdem_law_normal_cohesion(1e12, 1e9, 0.25, 5e8).force;
-            break;
-        default:
-            fail_msg("material.granular_law = %s: no case in this test or in the kernel's "
-                     "switch (solver/contact.h)",
-                     laws[i]);
-        }
+    for (int i = 0; i < CDEM_LAW_COUNT; i++) {
+        const cdem_granular_law law = (cdem_granular_law)i;
+        if ((size_t)i < n)
+            assert_string_equal(cdem_law_name(law), laws[i]);
+        assert_true(strcmp(cdem_law_description(law), "?") != 0);
+        force[i] = law_fx_sliding_force(law);
         assert_true(isfinite(force[i]) && force[i] > 0.0);
-        for (size_t j = 0; j < i; j++)
+        for (int j = 0; j < i; j++)
             if (force[j] == force[i])
-                fail_msg("laws %s and %s give the same sliding force %g", laws[j], laws[i],
-                         force[i]);
+                fail_msg("laws %s and %s give the same sliding force %g", cdem_law_name(j),
+                         cdem_law_name(law), force[i]);
     }
+    /* a value that is no law is refused, naming the laws */
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.granular_law = CDEM_LAW_COUNT;
+    cdem_contact_law cl;
+    cdem_error err;
+    assert_int_equal(cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb or spring-cohesion"));
     assert_documented_and_tested("material.granular_law", laws, n, "CDEM_LAW_");
 }
 

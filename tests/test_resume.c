@@ -128,7 +128,15 @@ static void same_array(const void *a, const void *b, size_t n, size_t size, cons
 
 /* Every increment (attributes and datasets), the series and the texts of two
  * files are identical bit for bit; only the creation time may differ. */
+static void compare_contents(const char *pa, const char *pb, int with_texts);
+
 static void compare_files(const char *pa, const char *pb) {
+    compare_contents(pa, pb, 1);
+}
+
+/* The same, texts (summary, parameter file text) left out when with_texts is 0: a file
+ * written by an earlier build has the same values but may word its help comments otherwise. */
+static void compare_contents(const char *pa, const char *pb, int with_texts) {
     cdem_error err;
     cdem_h5_reader *a = NULL, *b = NULL;
     if (cdem_h5_reader_open(pa, &a, &err) != CDEM_OK)
@@ -137,8 +145,10 @@ static void compare_files(const char *pa, const char *pb) {
         fail_msg("%s", err.msg);
     assert_string_equal(cdem_h5_reader_stop_reason(a), cdem_h5_reader_stop_reason(b));
     assert_string_equal(cdem_h5_reader_stop_detail(a), cdem_h5_reader_stop_detail(b));
-    assert_string_equal(cdem_h5_reader_summary(a), cdem_h5_reader_summary(b));
-    assert_string_equal(cdem_h5_reader_params_text(a), cdem_h5_reader_params_text(b));
+    if (with_texts) {
+        assert_string_equal(cdem_h5_reader_summary(a), cdem_h5_reader_summary(b));
+        assert_string_equal(cdem_h5_reader_params_text(a), cdem_h5_reader_params_text(b));
+    }
     assert_string_equal(cdem_h5_reader_program_version(a), cdem_h5_reader_program_version(b));
     const size_t n = cdem_h5_reader_increment_count(a);
     assert_int_equal(n, cdem_h5_reader_increment_count(b));
@@ -554,7 +564,8 @@ static void test_resume_torn_index_evidence(void **state) {
                      0);
     char fresh[1200];
     path_of(c, "k20fresh.h5", fresh, sizeof fresh);
-    compare_files(fresh, p);
+    /* the evidence was written before the law rows worded the help of granular_law */
+    compare_contents(fresh, p, 0);
 }
 
 /* Stop reason and increment count of the run file at path. */

@@ -11,6 +11,7 @@
 
 #include "force.h"
 #include "h5format.h"
+#include "bc.h"
 #include "xdmf.h"
 #include "model.h"
 #include "run.h"
@@ -49,7 +50,7 @@ static void test_run_small_model_end_to_end(void **st) {
     p.calculate_stress = 1;
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     char *logbuf = NULL;
     size_t loglen = 0;
     FILE *log = open_memstream(&logbuf, &loglen);
@@ -142,7 +143,7 @@ static void test_run_stops_early_and_on_signal(void **st) {
     cdem_error err;
     cdem_run_options o = quiet_options(path);
     cdem_model m;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     o.max_steps = m.equil_steps + 40; /* just past the end of equilibration */
     /* on a tty: one line redrawn in place (carriage return, erase line) */
     char *logbuf = NULL;

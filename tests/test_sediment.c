@@ -15,6 +15,7 @@
 #include "assembly.h"
 #include "h5format.h"
 #include "integrate.h"
+#include "bc.h"
 #include "model.h"
 #include "run.h"
 #include "sediment.h"
@@ -42,7 +43,7 @@ static cdem_params small_params(void) {
 /* A built assembly with the sediment context of p. */
 static void setup(const cdem_params *p, cdem_model *m, cdem_state *s, cdem_sediment *sd) {
     cdem_error err;
-    assert_int_equal(cdem_model_derive(p, m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(p, m, &err), CDEM_OK);
     assert_int_equal(cdem_state_init(s, 1024, 0, &err), CDEM_OK);
     assert_int_equal(cdem_assembly_build(p, m, s, NULL, &err), CDEM_OK);
     assert_int_equal(cdem_sediment_init(sd, p, m, &err), CDEM_OK);
@@ -260,7 +261,7 @@ static void test_sediment_cohesion_only_for_the_deposit(void **st) {
     p.layered_friction = 1;
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     cdem_state s;
     assert_int_equal(cdem_state_init(&s, 8, 0, &err), CDEM_OK);
     const double r = m.radius[1], d = 1.99 * r;
@@ -320,7 +321,7 @@ static void test_sediment_end_to_end_reproducible(void **st) {
     cdem_params p = small_params();
     cdem_model m;
     cdem_error err;
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     /* at least one event whose settling ends before the run does */
     const long events = (m.total_steps - m.equil_steps - m.settling_steps) / m.sediment_steps;
     assert_true(events >= 1);

@@ -373,7 +373,14 @@ static void test_strain_cli_errors(void **state) {
     assert_non_null(strstr(out, "--increment"));
     snprintf(cmd, sizeof cmd, "%s frobnicate", g_exe);
     assert_int_equal(run(cmd, out, sizeof out), 2);
-    assert_non_null(strstr(out, "unknown command 'frobnicate'"));
+    assert_non_null(strstr(out, "unknown command 'frobnicate' (and not an existing file)\n"));
+    snprintf(cmd, sizeof cmd, "%s rendr", g_exe);
+    assert_int_equal(run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "unknown command 'rendr' (and not an existing file); did you "
+                                "mean 'render'?"));
+    snprintf(cmd, sizeof cmd, "%s render %s --colr x", g_exe, g_run);
+    assert_int_equal(run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "unknown option '--colr'; did you mean '--color'?"));
     snprintf(cmd, sizeof cmd, "%s info %s/missing.h5", g_exe, g_scratch.dir);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "missing.h5"));

@@ -1,4 +1,4 @@
-/* Tests of common/summary.c: the key lines of the model summary for the default model and
+/* Tests of solver/run/summary.c: the key lines of the model summary for the default model and
  * for every boundary mode, with numbers checked against the model (not hard-coded output). */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -7,6 +7,7 @@
 
 #include <cmocka.h>
 
+#include "bc.h"
 #include "model.h"
 #include "params.h"
 #include "summary.h"
@@ -19,7 +20,7 @@ static char *summary_of(const cdem_params *p, long n, long nw, int estimated) {
     cdem_model m;
     cdem_error err;
     cdem_error_clear(&err);
-    assert_int_equal(cdem_model_derive(p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(p, &m, &err), CDEM_OK);
     char *text = NULL;
     assert_int_equal(cdem_summary_text(p, &m, n, nw, estimated, &text, &err), CDEM_OK);
     assert_non_null(text);
@@ -176,7 +177,7 @@ static void test_summary_rejects_null(void **state) {
     cdem_model m;
     cdem_error err;
     cdem_params_defaults(&p);
-    assert_int_equal(cdem_model_derive(&p, &m, &err), CDEM_OK);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
     char *t = (char *)&p;
     assert_int_equal(cdem_summary_text(NULL, &m, 1, 1, 0, &t, &err), CDEM_ERR_INVALID);
     assert_null(t);

@@ -17,11 +17,14 @@ cdem_cmd_arg cdem_cmd_next_arg(const cdem_cli_help *h, int argc, char **argv, in
     const char *arg = argv[*i];
     *val = NULL;
     *opt = cdem_cli_find_option(h, arg, val);
-    char msg[160];
+    char msg[256];
     if (!*opt) {
         if (arg[0] != '-' || !arg[1])
             return CDEM_CMD_ARG_POSITIONAL;
-        snprintf(msg, sizeof msg, "unknown option '%.100s'", arg);
+        char near[64];
+        const char *s = cdem_cli_suggest_option(h, arg, near, sizeof near);
+        snprintf(msg, sizeof msg, "unknown option '%.100s'%s%s%s", arg, s ? "; did you mean '" : "",
+                 s ? s : "", s ? "'?" : "");
         cdem_cmd_usage(h, msg);
         return CDEM_CMD_ARG_USAGE;
     }

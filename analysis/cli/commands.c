@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include "cmd_support.h"
+#include "suggest.h"
 
 #include <string.h>
 
@@ -62,6 +63,19 @@ const cdem_command *cdem_command_find(const char *name) {
     return NULL;
 }
 
+const char *cdem_command_suggest(const char *name) {
+    const char *names[N_COMMANDS];
+    for (size_t k = 0; k < N_COMMANDS; k++)
+        names[k] = table[k]->name;
+    return cdem_suggest(name, names, N_COMMANDS);
+}
+
+void cdem_command_unknown(const char *name, const char *more, char *msg, size_t cap) {
+    const char *near = cdem_command_suggest(name);
+    snprintf(msg, cap, "unknown command '%.100s'%s%s%s%s", name, more,
+             near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "");
+}
+
 static const char *const strain_forms[] = {"COMMAND [ARGS]...",
                                            "RUN.h5 --increment K --quantity NAME [...]",
                                            "help [COMMAND]", "-V|--version | -h|--help", NULL};
@@ -100,8 +114,10 @@ static int cmd_help(int argc, char **argv) {
     const cdem_command *c = cdem_command_find(argv[1]);
     if (!c || argc > 2) {
         char msg[200];
-        snprintf(msg, sizeof msg, c ? "one command at a time" : "unknown command '%.100s'",
-                 argv[1]);
+        if (c)
+            snprintf(msg, sizeof msg, "one command at a time");
+        else
+            cdem_command_unknown(argv[1], "", msg, sizeof msg);
         return cdem_cmd_usage(&help_help, msg);
     }
     cdem_cli_help_print(stdout, c->help);

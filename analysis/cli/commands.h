@@ -32,6 +32,14 @@ const cdem_command *const *cdem_commands(size_t *n);
 /* The row named name, or NULL. */
 const cdem_command *cdem_command_find(const char *name);
 
+/* The command name nearest to an unknown one, when close enough to offer (suggest.h), else
+ * NULL. */
+const char *cdem_command_suggest(const char *name);
+
+/* The usage error of an unknown command into msg: "unknown command 'NAME'" + more, and the
+ * nearest command when there is one to offer. */
+void cdem_command_unknown(const char *name, const char *more, char *msg, size_t cap);
+
 /* The general help of cdem-strain (usage forms, the command list, options). */
 void cdem_commands_print_help(FILE *f);
 

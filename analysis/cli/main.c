@@ -48,7 +48,7 @@ int main(int argc, char **argv) {
         }
         return cdem_cmd_compute_file_first(argc - 1, argv + 1);
     }
-    char msg[200];
-    snprintf(msg, sizeof msg, "unknown command '%.100s' (and not an existing file)", argv[1]);
+    char msg[256];
+    cdem_command_unknown(argv[1], " (and not an existing file)", msg, sizeof msg);
     return cdem_cmd_usage(&cdem_strain_help, msg);
 }

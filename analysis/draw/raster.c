@@ -4,7 +4,8 @@
 #include <math.h>
 #include <stdint.h>
 
-int cdem_raster_target_get(cairo_t *cr, const cdem_render_layout *lay, cdem_raster_target *rt) {
+int cdem_raster_target_get(cairo_t *cr, double x, double y, double w, double h,
+                           cdem_raster_target *rt) {
     cairo_surface_t *t = cairo_get_target(cr);
     if (cairo_surface_get_type(t) != CAIRO_SURFACE_TYPE_IMAGE)
         return 0;
@@ -23,11 +24,11 @@ int cdem_raster_target_get(cairo_t *cr, const cdem_render_layout *lay, cdem_rast
     rt->data = cairo_image_surface_get_data(t);
     rt->stride = cairo_image_surface_get_stride(t);
     rt->opaque = f == CAIRO_FORMAT_RGB24;
-    int w = cairo_image_surface_get_width(t), h = cairo_image_surface_get_height(t);
-    rt->x0 = (int)fmax(0.0, ceil(lay->plot_x - 0.5));
-    rt->y0 = (int)fmax(0.0, ceil(lay->plot_y - 0.5));
-    rt->x1 = (int)fmin((double)w, floor(lay->plot_x + lay->plot_w + 0.5));
-    rt->y1 = (int)fmin((double)h, floor(lay->plot_y + lay->plot_h + 0.5));
+    const int sw = cairo_image_surface_get_width(t), sh = cairo_image_surface_get_height(t);
+    rt->x0 = (int)fmax(0.0, ceil(x - 0.5));
+    rt->y0 = (int)fmax(0.0, ceil(y - 0.5));
+    rt->x1 = (int)fmin((double)sw, floor(x + w + 0.5));
+    rt->y1 = (int)fmin((double)sh, floor(y + h + 0.5));
     return rt->data != NULL;
 }
 
@@ -100,11 +101,8 @@ void cdem_raster_segment(const cdem_raster_target *rt, double x0, double y0, dou
     }
 }
 
-void cdem_raster_disc(const cdem_raster_target *rt, const cdem_render_layout *lay, double x,
-                      double y, double radius, const cdem_rgba *c, double ring_width) {
-    double cx, cy;
-    cdem_render_layout_to_device(lay, x, y, &cx, &cy);
-    double r = radius * lay->scale;
+void cdem_raster_disc(const cdem_raster_target *rt, double cx, double cy, double r,
+                      const cdem_rgba *c, double ring_width) {
     double reach = r + 0.5 * ring_width + 1.0;
     int px0 = clamp_px(floor(cx - reach), rt->x0, rt->x1);
     int px1 = clamp_px(ceil(cx + reach), rt->x0, rt->x1);

@@ -425,12 +425,15 @@ static cdem_status draw_elements(cairo_t *cr, const cdem_raster_target *rtp,
         for (int k = 0; o->show_fill && k < SLOT_N; k++)
             for (size_t j = start[k]; j < start[k + 1]; j++) {
                 size_t i = order[j];
-                cdem_raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &pal[k], 0.0);
+                double cx, cy;
+                cdem_render_layout_to_device(lay, s->x[i], s->y[i], &cx, &cy);
+                cdem_raster_disc(&rt, cx, cy, s->radius[i] * lay->scale, &pal[k], 0.0);
             }
         for (size_t j = 0; outline && j < n_visible; j++) {
             size_t i = order[j];
-            cdem_raster_disc(&rt, lay, s->x[i], s->y[i], s->radius[i], &o->outline,
-                             o->outline_width);
+            double cx, cy;
+            cdem_render_layout_to_device(lay, s->x[i], s->y[i], &cx, &cy);
+            cdem_raster_disc(&rt, cx, cy, s->radius[i] * lay->scale, &o->outline, o->outline_width);
         }
         cairo_surface_mark_dirty(rt.surface);
     } else {
@@ -641,7 +644,9 @@ cdem_status cdem_render_draw(cairo_t *cr, double width, double height, const cde
     cairo_rectangle(cr, lay.plot_x, lay.plot_y, lay.plot_w, lay.plot_h);
     cairo_clip(cr);
     cdem_raster_target rt;
-    const cdem_raster_target *rtp = cdem_raster_target_get(cr, &lay, &rt) ? &rt : NULL;
+    const cdem_raster_target *rtp =
+        cdem_raster_target_get(cr, lay.plot_x, lay.plot_y, lay.plot_w, lay.plot_h, &rt) ? &rt
+                                                                                        : NULL;
     cdem_status st = draw_elements(cr, rtp, &lay, sc, o, err);
     if (st != CDEM_OK) {
         cairo_restore(cr);

@@ -1,5 +1,8 @@
-/* quantity: see quantity.h. The suggestion uses the Levenshtein distance over the table. */
+/* quantity: see quantity.h. The suggestion is the nearest name by the one edit distance
+ * (common/suggest.h), offered whatever its distance: the message lists every name anyway. */
 #include "quantity.h"
+
+#include "suggest.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -71,30 +74,6 @@ const cdem_quantity *cdem_quantity_table(size_t *count) {
     return quantities;
 }
 
-static size_t edit_distance(const char *a, const char *b) {
-    size_t la = strlen(a), lb = strlen(b);
-    if (la > 63 || lb > 63)
-        return la > lb ? la : lb;
-    size_t row[64];
-    for (size_t j = 0; j <= lb; j++)
-        row[j] = j;
-    for (size_t i = 1; i <= la; i++) {
-        size_t diag = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= lb; j++) {
-            size_t up = row[j];
-            size_t best = diag + (a[i - 1] != b[j - 1]);
-            if (row[j] + 1 < best)
-                best = row[j] + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            row[j] = best;
-            diag = up;
-        }
-    }
-    return row[lb];
-}
-
 cdem_status cdem_quantity_find(const char *name, const cdem_quantity **out, cdem_error *err) {
     size_t n;
     const cdem_quantity *t = cdem_quantity_table(&n);
@@ -108,7 +87,7 @@ cdem_status cdem_quantity_find(const char *name, const cdem_quantity **out, cdem
         }
     size_t best = 0, bestd = (size_t)-1;
     for (size_t i = 0; i < n; i++) {
-        size_t d = edit_distance(name, t[i].name);
+        size_t d = cdem_edit_distance(name, t[i].name);
         if (d < bestd) {
             bestd = d;
             best = i;

@@ -1,4 +1,4 @@
-/* fuzz_fault_file: the irregular-fault vertex reader (solver/fault_file.c). The input is
+/* fuzz_fault_file: the irregular-fault vertex reader (solver/modes/fault_file.c). The input is
  * written to a temporary file and read with the first vertex expected at x0 = 1400 m
  * (tolerance 25 m, as tests/test_fault_file.c). Invariants checked on success: at least two
  * finite vertices, x strictly decreasing, y increasing from 0, and the curve queries

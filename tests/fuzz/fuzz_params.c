@@ -3,8 +3,10 @@
  * Input: an INI text; after the first NUL byte, further NUL-separated strings are applied as
  * "-s section.key=value" overrides. Invariant checked: a file that parses and validates
  * writes back (cdem_params_write) to a text that parses to the same values. */
+#include "bc.h"
 #include "model.h"
 #include "params.h"
+#include "run.h"
 #include "summary.h"
 
 #include "fuzz_util.h"
@@ -75,14 +77,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             FUZZ_CHECK(err.msg[0] != '\0');
     }
     if (st == CDEM_OK) {
-        st = cdem_params_validate(&p, &err);
+        st = cdem_run_validate(&p, &err);
         if (st != CDEM_OK)
             FUZZ_CHECK(err.msg[0] != '\0');
     }
     if (st == CDEM_OK) {
         fuzz_params_roundtrip(&p);
         cdem_model m;
-        if (cdem_model_derive(&p, &m, &err) == CDEM_OK) {
+        if (cdem_bc_derive_model(&p, &m, &err) == CDEM_OK) {
             char *summary = NULL;
             if (cdem_summary_text(&p, &m, 1000, 100, 1, &summary, &err) == CDEM_OK)
                 FUZZ_CHECK(summary && strlen(summary) > 0);

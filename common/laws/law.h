@@ -1,0 +1,84 @@
+/* law: what a granular contact law is. A law turns the trial elastic shear force of a
+ * touching contact, spring = Ks Xs with Xs already advanced by this step's tangential
+ * displacement, the compressive normal force fn (N, >= 0), the friction coefficient mu and the
+ * cohesion c0 of the contact (N; 0 when the contact is not cohesive) into
+ *   force  - the tangential force the contact transmits (N, signed along t),
+ *   spring - the elastic shear force to keep (the kernel stores Xs = spring / Ks),
+ *   slid   - 1 when the trial force exceeded the law's limit (a slip: cohesion is lost here
+ *            when first_slip is on).
+ * The shared kernel (solver/contact/contact.h) does everything else: normal force,
+ * separation, cohesion bookkeeping.
+ * A law is one file, common/laws/law_<name>.h, listed by one line in laws.def. The file has
+ * three parts, each compiled only where it is asked for:
+ *   CDEM_LAW_SCALAR  its scalar kernel, cdem_law_<name>(spring, fn, mu, c0) -> cdem_shear
+ *                    (the contact kernel of both force paths);
+ *   CDEM_LAW_LANES   its AVX2 kernel, the same operations on four contacts in the lanes of
+ *                    __m256d -> cdem_shear4 (solver/step/force_avx2.c), or none: a law without
+ *                    one is evaluated by its scalar kernel on the vector path too;
+ *   CDEM_LAW         its row CDEM_LAW(ID, word, description, scalar kernel, AVX2 kernel or
+ *                    NULL), from which the enum (params.h), the parameter words and help
+ *                    (params.c), the summary line and both kernels' dispatch are made.
+ * A fixture of the tests writes CDEM_TEST_LAW instead of CDEM_LAW: it is registered (the
+ * kernels, the enum after the users' laws) but no parameter file can name it.
+ * The laws live in common/ because both programs read their words (the analysis reads the
+ * parameters stored in a run file); only cdem-run evaluates them.
+ * Pure functions; units N. */
+#ifndef CDEM_LAW_H
+#define CDEM_LAW_H
+
+#include <math.h>
+
+/* The per-pair kernel and the laws are inlined into the force loop whatever the compiler's
+ * inlining budget says (a call per touching pair is a measurable part of a step). */
+#if defined(__GNUC__)
+#define CDEM_INLINE inline __attribute__((always_inline))
+#else
+#define CDEM_INLINE inline
+#endif
+
+typedef struct {
+    double force;  /* N, tangential force on the contact */
+    double spring; /* N, elastic shear force kept for the next step (Ks Xs) */
+    int slid;      /* 1: the contact slid this step */
+} cdem_shear;
+
+/* The end of every law so far: the trial force f transmitted while |f| <= limit, else the
+ * limit with f's sign, which is then also the spring kept (a slip; unloading starts from
+ * the limit). spring is the elastic force kept when there is no slip. */
+static CDEM_INLINE cdem_shear cdem_law_cap(double f, double spring, double limit) {
+    cdem_shear s = {f, spring, 0};
+    if (fabs(f) > limit) {
+        s.force = f > 0.0 ? limit : -limit;
+        s.spring = s.force;
+        s.slid = 1;
+    }
+    return s;
+}
+
+#endif
+
+/* The lanes' types, when a file asks for the AVX2 kernels (x86-64 with GCC or clang only). */
+#if defined(CDEM_LAW_LANES) && !defined(CDEM_LAW_LANES_H)
+#define CDEM_LAW_LANES_H
+
+#include <immintrin.h>
+
+#define CDEM_LANES static inline __attribute__((always_inline, target("avx2")))
+
+typedef struct {
+    __m256d force;  /* N per lane, as cdem_shear */
+    __m256d spring; /* N per lane */
+    __m256d slid;   /* all bits set in a lane that slid, else 0 (a blend mask) */
+} cdem_shear4;
+
+/* cdem_law_cap on four lanes: the same comparisons, with masks where it branches. */
+CDEM_LANES cdem_shear4 cdem_law_cap4(__m256d f, __m256d spring, __m256d limit) {
+    const __m256d zero = _mm256_setzero_pd(), sign = _mm256_set1_pd(-0.0);
+    const __m256d slid = _mm256_cmp_pd(_mm256_andnot_pd(sign, f), limit, _CMP_GT_OQ);
+    const __m256d capped =
+        _mm256_blendv_pd(_mm256_xor_pd(limit, sign), limit, _mm256_cmp_pd(f, zero, _CMP_GT_OQ));
+    const __m256d force = _mm256_blendv_pd(f, capped, slid);
+    return (cdem_shear4){force, _mm256_blendv_pd(spring, force, slid), slid};
+}
+
+#endif

@@ -1,0 +1,239 @@
+/* summary: the model summary text (the original program's Summary view).
+ *
+ * Written into a memory stream (open_memstream), so the caller gets one malloc'd string
+ * that cdem-run prints and the file writer stores. Every number carries its unit; nothing
+ * depends on the clock or the machine, so the text of a model is reproducible and can be
+ * diffed (examples keep their expected summary next to them). Lines are "  label: value"
+ * with the label padded to a fixed column (summary_line.h), under unindented headings; the
+ * boundary mode writes its own section's lines and says what it changes elsewhere (gravity,
+ * a still boundary and the display interval in seconds: its derive hook, in m->mode). */
+#include "summary.h"
+
+#include "bc.h"
+#include "summary_line.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One line of the summary (summary_line.h). */
+#define line cdem_summary_line
+
+static void heading(FILE *f, const char *title) {
+    fprintf(f, "\n%s\n", title);
+}
+
+static const char *on_off(int v) {
+    return v ? "on" : "off";
+}
+
+static const char *sea_word(cdem_sea_level_rise s) {
+    static const char *const words[] = {"null", "low", "mid", "high", "very high"};
+    return (unsigned)s < 5 ? words[s] : "?";
+}
+
+static void contact_line(FILE *f, const char *label, const cdem_params *p,
+                         const cdem_contact_material *c) {
+    if (p->material == CDEM_MATERIAL_GRANULAR)
+        line(f, label, "friction %g, cohesion %g N", c->friction, c->cohesion);
+    else
+        line(f, label, "breaking strain %g (bond breaks when r - R >= %g R)", c->breaking_strain,
+             c->breaking_strain);
+}
+
+cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
+                              long n_wall_elements, int elements_estimated, char **text,
+                              cdem_error *err) {
+    /* n_elements: free elements; n_wall_elements: wall, fault and other boundary elements */
+    if (text)
+        *text = NULL;
+    if (!p || !m || !text)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_summary_text: NULL argument");
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "model summary: cannot open a memory stream");
+
+    fprintf(f, "cdem-c model summary\n");
+
+    /* One count everywhere (docs/format.md, "Counting"): the elements stored in increment 0,
+     * after the boundary mode has added its fault elements; the progress line and
+     * cdem-strain info count the same. */
+    heading(f, "Elements");
+    line(f, "elements", "%ld in increment 0%s", n_elements + n_wall_elements,
+         elements_estimated ? " (estimated from the packing density; the exact count is known "
+                              "once the assembly is generated)"
+                            : " (escaping, eroded and deposited elements change it later)");
+    line(f, "free elements", "%ld%s", n_elements, elements_estimated ? " (estimated)" : "");
+    line(f, "wall and fault elements", "%ld%s", n_wall_elements,
+         elements_estimated ? " (estimated)" : "");
+
+    heading(f, "Model dimensions");
+    line(f, "assembly", "%g x %g units = %.6g x %.6g m", p->width, p->height, m->width_m,
+         m->height_m);
+    line(f, "unit scaling", "%g m per unit", p->unit_scaling);
+    line(f, "lateral wall height", "%.6g m (%d x the assembly height)",
+         p->wall_height_multiplier * m->height_m, p->wall_height_multiplier);
+    line(f, "random seed", "%ld", p->seed);
+
+    heading(f, "Element radii and masses");
+    line(f, "radii", "%s", p->half_radii ? "half (0.025-0.0625 units)" : "full (0.05-0.125 units)");
+    for (int i = 0; i < CDEM_NUM_RADII; i++) {
+        char label[32];
+        snprintf(label, sizeof label, "radius %d", i + 1);
+        line(f, label, "%.6g m, mass %.6g kg/m", m->radius[i], m->mass[i]);
+    }
+    line(f, "average radius", "%.6g m", m->average_radius);
+    line(f, "smallest mass", "%.6g kg/m%s", m->min_mass,
+         m->min_mass < m->mass[0] ? " (light interval)" : "");
+
+    heading(f, "Constants");
+    const char *kn_origin = p->unit_scaling >= 1000.0 ? "default constant"
+                            : p->keep_constants       ? "default constant (keep_constants = on)"
+                                                      : "scaled with the average radius";
+    line(f, "normal stiffness Kn", "%.10g N/m (%s)", m->kn, kn_origin);
+    line(f, "shear stiffness Ks", "%.10g N/m", m->ks);
+    if (p->deformation_damping == 1.0)
+        line(f, "damping", "%.8g N s/m", m->damping);
+    else
+        line(f, "damping", "%.8g N s/m; x %g on deformation steps (physics.deformation_damping)",
+             m->damping, p->deformation_damping);
+    line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
+    line(f, "gravity", "%g m/s^2%s%s%s", m->gravity, m->mode.gravity_off ? " (" : "",
+         m->mode.gravity_off ? m->mode.gravity_off : "", m->mode.gravity_off ? ")" : "");
+    line(f, "density", "%g kg/m^3", p->density);
+    line(f, "stress calculation", "%s", on_off(p->calculate_stress));
+
+    heading(f, "Time");
+    line(f, "equilibration", "%g s = %ld time steps", p->equilibration, m->equil_steps);
+    line(f, "runtime", "%g s = %ld time steps (%ld after equilibration)", p->runtime,
+         m->total_steps, m->total_steps - m->equil_steps);
+    line(f, "time-series sample", "every %d time steps", p->series_interval);
+
+    heading(f, "Boundary displacement");
+    if (m->mode.moving_boundaries == 0) {
+        line(f, "boundary speed", "none (%s)", m->mode.still ? m->mode.still : "no boundary moves");
+    } else {
+        line(f, "boundary speed", "%.6g m/s (%g m/s^2 x dt)", m->boundary_speed,
+             CDEM_BOUNDARY_ACCEL);
+        line(f, "displacement per step", "%.6g m", m->displacement_per_step);
+        line(f, "total displacement", "%.6g m (first-order estimate%s)", m->total_displacement,
+             p->sedimentation ? "; settling pauses make it smaller" : "");
+    }
+
+    heading(f, "Display increments");
+    if (m->mode.moving_boundaries == 0) /* no boundary moves: the interval is in seconds */
+        line(f, "display interval", "%g s = %.6g time steps", p->display_interval,
+             m->display_steps);
+    else
+        line(f, "display interval", "%g m = %.6g time steps", p->display_interval,
+             m->display_steps);
+    /* increments are numbered 0..N and the file holds N + 1 of them (0 = before equilibration) */
+    line(f, "increments", "%d, numbered 0..%d", m->n_increments_total + 1, m->n_increments_total);
+    line(f, "end of equilibration", "increment %d", m->n_increments_equil);
+
+    heading(f, "Faulting / boundary conditions");
+    line(f, "mode", "%s", cdem_mode_name(p->mode));
+    cdem_bc_describe(p, m, f);
+
+    heading(f, "Material");
+    line(f, "model", "%s",
+         p->material == CDEM_MATERIAL_GRANULAR ? "granular frictional-cohesive"
+                                               : "initially bonded");
+    if (p->material == CDEM_MATERIAL_GRANULAR) {
+        line(f, "contact law", "%s: %s", cdem_law_name(p->granular_law),
+             cdem_law_description(p->granular_law));
+        line(f, "cohesive contacts", "%s",
+             p->cohesive_contacts == CDEM_COHESIVE_FORMED
+                 ? "those of the end of equilibration and every contact formed later"
+             : p->cohesive_contacts == CDEM_COHESIVE_INITIAL
+                 ? "the contacts of the built assembly that never separated, at the end of "
+                   "equilibration"
+                 : "those of the end of equilibration");
+        line(f, "cohesion lost", "%s",
+             p->first_slip ? "at the first slip (first slip on)"
+                           : "when the pair separates (first slip off)");
+        if (p->settling_friction != 1.0)
+            line(f, "settling friction", "friction x %g during equilibration",
+                 p->settling_friction);
+    }
+    contact_line(f, "element-element", p, &p->element);
+    contact_line(f, "element-wall", p, &p->wall);
+    cdem_contact_material base;
+    if (cdem_params_base_material(p, &base))
+        contact_line(f, "element-base", p, &base);
+    else
+        line(f, "element-base", "as element-wall");
+    contact_line(f, "element-fault", p, &p->fault);
+
+    heading(f, "Heterogeneity");
+    line(f, "flexural slip", "%s",
+         !p->flexural_slip ? "off"
+         : p->flexural_slip_style == CDEM_FLEX_WEAK_LAYERS
+             ? "on, weak layers (no strength on contacts of layers 4, 8, 12, 16 and 20, from "
+               "the end of equilibration)"
+             : "on (no strength between pre-growth layers, from the end of equilibration)");
+    if (p->weak_interval == CDEM_WEAK_OFF) {
+        line(f, "weak/light interval", "off");
+    } else {
+        line(f, "weak/light interval",
+             "%s %g %% of the height = %.6g m (of the initial span of element centres; "
+             "fixed at assembly, flagged weak)",
+             p->weak_interval == CDEM_WEAK_LOWER ? "lower" : "upper", p->weak_thickness_percent,
+             p->weak_thickness_percent / 100.0 * m->height_m);
+        line(f, "mixed pairs", "a pair with one weak element uses the weak values");
+        line(f, "interval strength", "%g %% of the material values", p->weak_strength_percent);
+        line(f, "interval density", "%g %% = %g kg/m^3", p->weak_density_percent,
+             p->weak_density_percent / 100.0 * p->density);
+    }
+    if (p->layered_friction)
+        line(f, "layered friction",
+             "layers 5-8, 13-16, 21-24 friction %g (a pair with either element in such a "
+             "layer)",
+             p->layered_friction_value);
+    else
+        line(f, "layered friction", "off");
+    line(f, "pre-growth layers", "%d of equal thickness", CDEM_PREGROWTH_LAYERS);
+
+    heading(f, "Surface processes");
+    if (p->overburden_pressure > 0)
+        line(f, "overburden pressure",
+             "%g N/m on the top surface: %g N on the highest element of each %g m column "
+             "(2 x the largest radius), found again at every neighbour-list rebuild",
+             p->overburden_pressure, p->overburden_pressure * 2.0 * m->max_radius,
+             2.0 * m->max_radius);
+    else
+        line(f, "overburden pressure", "off");
+    if (p->erosion)
+        line(f, "erosion",
+             "above %g x the assembly height = %.6g m (exactly: the level x the span of "
+             "element centres at the end of equilibration, above the lowest centre); "
+             "elements above it removed before each deformation increment",
+             p->erosion_base_level, p->erosion_base_level * m->height_m);
+    else
+        line(f, "erosion", "off");
+    if (p->sedimentation) {
+        line(f, "sedimentation", "on (growth strata)");
+        line(f, "sediment interval", "%g m of boundary displacement = %ld time steps",
+             m->sediment_interval, m->sediment_steps);
+        line(f, "settling time", "%g s = %ld time steps (boundaries still)", 0.2 * p->equilibration,
+             m->settling_steps);
+        if (m->boundary_speed > 0)
+            line(f, "time between sediments", "%.6g s", m->sediment_interval / m->boundary_speed);
+        line(f, "sea-level rise", "%s (factor %g of the boundary displacement)",
+             sea_word(p->sea_level_rise), m->sea_level_factor);
+        line(f, "growth sequence 1", "%d layers", p->growth_sequence1_layers);
+    } else {
+        line(f, "sedimentation", "off");
+    }
+
+    if (fclose(f) != 0 || !buf) {
+        free(buf);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "model summary: out of memory");
+    }
+    *text = buf;
+    return CDEM_OK;
+}
