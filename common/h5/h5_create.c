@@ -157,23 +157,6 @@ static cdem_status create_layout(cdem_h5_writer *w, cdem_error *err) {
     return st;
 }
 
-hid_t h5i_writer_fapl(void) {
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_V110);
-    /* No sieve buffer: a write to a contiguous dataset (the commit record) goes to the file
-     * as it is made, alone; with one, --resume's row-by-row blanking of the record, last row
-     * first, would reach the file as one write in ascending order (h5_commit.c). */
-    H5Pset_sieve_buf_size(fapl, 0);
-    return fapl;
-}
-
-cdem_status h5i_start_swmr(cdem_h5_writer *w, cdem_error *err) {
-    if (H5Fstart_swmr_write(w->file) < 0)
-        return H5FAIL(err, CDEM_ERR_IO, "%s: cannot enter single-writer/multiple-reader mode",
-                      w->path);
-    return CDEM_OK;
-}
-
 /* Puts tmp at path: rename when an existing file may be replaced (replace = 1), otherwise
  * a rename that fails instead of replacing a file that appeared after the checks. */
 static int put_in_place(const char *tmp, const char *path, int replace) {
@@ -271,41 +254,6 @@ static cdem_status writer_setup(cdem_h5_writer *w, const cdem_run_meta *meta, co
     if (w->sync)
         h5i_sync_folder_of(w->path);
     return h5i_write_xmf(w, err);
-}
-
-/* Allocates a writer with every handle unset. */
-cdem_status h5i_writer_alloc(const char *path, cdem_h5_writer **out, cdem_error *err) {
-    cdem_h5_writer *w = calloc(1, sizeof *w);
-    if (!w)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
-    w->file = w->index = w->index_mtype = w->stop_reason = w->stop_detail = -1;
-    w->commit = w->commit_mtype = -1;
-    w->commit_capacity = COMMIT_DEFAULT_CAPACITY;
-    w->ckpt_data[0] = w->ckpt_data[1] = w->ckpt_index = w->ckpt_mtype = -1;
-    for (size_t c = 0; c < N_SERIES; c++)
-        w->series[c] = -1;
-    for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
-        w->data[k] = -1;
-    w->last_number = -1;
-    w->last_sample_step = -1;
-    w->chunk_rows = CHUNK_ELEMS;
-    w->sync = 1;
-    w->path = h5i_dup_str(path);
-    w->xmf_path = cdem_xdmf_path_for(path);
-    w->buf = malloc(SERIES_BUFFER * sizeof *w->buf);
-    w->column = malloc(SERIES_BUFFER * 8);
-    w->index_mtype = h5i_make_compound(h5i_index_members, N_INDEX_MEMBERS, sizeof(index_row), 0);
-    w->ckpt_mtype = h5i_make_compound(h5i_ckpt_members, N_CKPT_MEMBERS, sizeof(ckpt_row), 0);
-    w->commit_mtype = h5i_commit_type(0);
-    if (!w->path || !w->xmf_path || !w->buf || !w->column || w->index_mtype < 0 ||
-        w->ckpt_mtype < 0 || w->commit_mtype < 0) {
-        h5i_writer_release(w);
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory creating a writer for %s", path);
-    }
-    const char *slash = strrchr(w->path, '/');
-    w->h5_name = slash ? slash + 1 : w->path;
-    *out = w;
-    return CDEM_OK;
 }
 
 cdem_status cdem_h5_writer_create(const char *path, const cdem_run_meta *meta, cdem_h5_writer **out,

@@ -1,15 +1,19 @@
 /* h5_internal: what the files of common/h5/ share, and nothing outside them includes. The run
  * file's public interface is common/h5format.h; docs/format.md is the authority on the layout.
- * One concept per file: h5_util.c (HDF5 calls: errors, attributes, rows, dataset creation),
- * h5_layout.c (the tables of datasets and index members, the checks of an index row),
- * h5_create.c (a new file: layout, then SWMR, then the rename into place), h5_writer.c
- * (appending increments and series; the commit protocol: data, flush, index row, flush),
- * h5_resume.c (re-opening a file for --resume), h5_checkpoint.c (the two checkpoint slots),
- * h5_compact.c (a completed run's file rewritten without its checkpoints),
- * h5_ckpt_codec.c (a snapshot as bytes), h5_superblock.c (the superblock read before HDF5
- * does), h5_reader.c (open, index, increments, series, texts), h5_reader_v1.c (the version-1
- * layout), h5_sidecar.c (the XDMF grids; the XML itself is common/xdmf.c) and h5_output.c
- * (before a run: may the path be written, is there space).
+ * One concept per file, and no two of them call each other in a loop: h5_util.c (HDF5 calls:
+ * errors, attributes, rows, dataset creation), h5_layout.c (the tables of datasets and index
+ * members, the checks of a row and of a value), h5_commit.c (the commit record, and the
+ * recovery of a torn index chunk in older files), h5_file.c (the writer's file: allocation
+ * and release, access properties, SWMR, flush and sync), h5_create.c (a new file: layout,
+ * then SWMR, then the rename into place), h5_writer.c (appending increments and series, the
+ * stop reason, the close), h5_resume.c (re-opening a file for --resume), h5_checkpoint.c (the
+ * two checkpoint slots), h5_compact.c (a completed run's file rewritten without its
+ * checkpoints), h5_ckpt_codec.c (a snapshot as bytes), h5_superblock.c (the superblock read
+ * before HDF5 does), h5_reader.c (open, texts, an increment's elements), h5_reader_list.c
+ * (the list of increments), h5_reader_series.c (the time series), h5_reader_v1.c (the
+ * version-1 layout), h5_sidecar.c (the XDMF grids; the XML itself is common/xdmf.c)
+ * and h5_output.c (before a run: may the path be written, is there space; the kept-aside
+ * run of --force).
  * Names are h5i_*: internal, global only because the concept spans several files.
  * Ownership, threads, units: as h5format.h (one handle per thread; SI units). */
 #ifndef CDEM_H5_INTERNAL_H
@@ -26,20 +30,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Compression settings, chosen by measurement (docs/format.md, "Size"): element data deflate
- * level 4 after byte shuffle (level 6 saved 0.3 % of the default run's file for 25 % more
- * writing CPU, level 9 about 0.4 % for 85 %); checkpoints level 6 (h5_ckpt_codec.c: 8 KB less
- * than level 4 per run for 3 ms per checkpoint; level 9 saved nothing more and took 2.3 times
- * as long). An increment of the element datasets starts at a chunk boundary and is one chunk
- * up to CHUNK_ELEMS elements (4096 doubles = 32 KiB): the rows up to the next boundary are
- * padding, and deflate still spends bytes on zeros (a match per 258 bytes: about 250 bytes for
- * the 5770 padding rows of a double dataset with 8192-row chunks), so the chunk should be near
- * the element count; a larger count spans several chunks (each split costs about 70 bytes
- * per dataset). For the default run (2422 elements) 4096 rows took 143 KB less than 8192
- * (files written before), a chunk of exactly 2422 rows 78 KB less again; 2048 rows (two
- * chunks) 80 KB more. The series, index and checkpoint-slot chunks are allocated whole, so
- * their last chunk is partly empty: 128 samples (1 KiB), 64 index rows (4.75 KiB) and 4 KiB
- * of slot keep that small (512, 256 and 16 KiB before: 51 KB more in the default run's file). */
+/* Compression, chunk and buffer sizes: each chosen by measuring the default run's file and
+ * its writing time (the measurements are in docs/format.md, "Size", and
+ * docs/performance.md). An increment of the element datasets starts at a chunk boundary and
+ * is one chunk up to CHUNK_ELEMS elements, so a compressed chunk is written once; small
+ * chunks keep the partly empty last chunk of the series, the index and the checkpoint slots
+ * small. The index chunk (48 rows of 84 bytes) fits one file-space page. */
 #define DEFLATE_LEVEL      4
 #define CKPT_DEFLATE_LEVEL 6
 #define CHUNK_ELEMS        4096
@@ -98,6 +94,12 @@ int h5i_write_rows(hid_t ds, hid_t mtype, hsize_t start, hsize_t count, const vo
 int h5i_read_rows(hid_t ds, hid_t mtype, hsize_t start, hsize_t count, void *dst);
 int h5i_read_all_rows(hid_t ds, hid_t mt, hsize_t n, void *dst);
 hsize_t h5i_extent_of(hid_t ds);
+/* h5i_read_all_rows of rows [0, n) of a checksummed dataset; with swmr (a live writer, which
+ * rewrites the last chunk of the index and of the series in place) a read whose checksum
+ * fails is tried again for about 0.6 s. 0 or -1. */
+int h5i_read_rows_retrying(int swmr, hid_t ds, hid_t mt, hsize_t n, void *dst);
+/* "integer", "float", ... for messages. */
+const char *h5i_class_name(H5T_class_t c);
 
 /* Filters of an extendible dataset. */
 typedef enum {
@@ -321,12 +323,11 @@ struct cdem_h5_writer {
     size_t row_cap;                 /* rows allocated in row_order and row_buf */
 };
 
-/* h5_create.c */
+/* h5_file.c */
 cdem_status h5i_writer_alloc(const char *path, cdem_h5_writer **out, cdem_error *err);
 hid_t h5i_writer_fapl(void);
 cdem_status h5i_start_swmr(cdem_h5_writer *w, cdem_error *err);
 
-/* h5_writer.c */
 cdem_status h5i_flush_file(cdem_h5_writer *w, cdem_error *err);
 cdem_status h5i_commit_flush(cdem_h5_writer *w, cdem_error *err);
 void h5i_sync_folder_of(const char *path);
@@ -386,6 +387,13 @@ struct cdem_h5_reader {
     size_t n_incr;                /* entries in incr */
     size_t cap_incr;              /* allocated entries */
 };
+
+/* h5_reader_list.c: the list of increments into r->incr (r->n_incr, r->n_skipped), the
+ * stop texts already read. */
+cdem_status h5i_reader_scan(cdem_h5_reader *r, cdem_error *err);
+/* A run that completed, or was stopped and wrote its final increment, holds increments: a
+ * file of such a run that lists none is refused, saying why (either version). */
+cdem_status h5i_reader_check_not_empty(cdem_h5_reader *r, cdem_error *err);
 
 /* h5_superblock.c */
 cdem_status h5i_precheck_superblock(const char *path, int *status, cdem_error *err);

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ------------------------------------------------------------------ errors */
 
@@ -430,4 +431,30 @@ char *h5i_printable(const char *text) {
     }
     *o = '\0';
     return out;
+}
+
+/* "integer", "float", ... for messages. */
+const char *h5i_class_name(H5T_class_t c) {
+    return c == H5T_INTEGER    ? "integer"
+           : c == H5T_FLOAT    ? "float"
+           : c == H5T_STRING   ? "string"
+           : c == H5T_COMPOUND ? "compound"
+           : c == H5T_ARRAY    ? "array"
+                               : "other";
+}
+
+/* Reads rows [0, n) of a checksummed dataset. A live writer rewrites the last chunk of the
+ * index and of the series in place at every append, so a SWMR reader can catch a chunk
+ * half-written, and its Fletcher-32 check then fails: such a read is tried again a few times
+ * (about 0.6 s in all); a file without a live writer is read once. 0 or -1. */
+int h5i_read_rows_retrying(int swmr, hid_t ds, hid_t mt, hsize_t n, void *dst) {
+    for (int attempt = 0;; attempt++) {
+        if (h5i_read_all_rows(ds, mt, n, dst) == 0)
+            return 0;
+        if (!swmr || attempt >= 6)
+            return -1;
+        H5Eclear2(H5E_DEFAULT);
+        struct timespec ts = {0, (long)(10 * 1000 * 1000) << attempt}; /* 10 .. 320 ms */
+        nanosleep(&ts, NULL);
+    }
 }
