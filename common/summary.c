@@ -124,6 +124,8 @@ static void write_mode(FILE *f, const cdem_params *p, const cdem_model *m) {
         break;
     case CDEM_MODE_REPOSE:
         line(f, "walls removed", "%s, at the end of equilibration", walls_word(p->repose_walls));
+        line(f, "base", "extends %.6g m (the assembly's width) beyond %s", m->width_m,
+             p->repose_walls == CDEM_WALLS_BOTH ? "each removed wall" : "the removed wall");
         break;
     case CDEM_MODE_BIAXIAL:
         line(f, "confining pressure",

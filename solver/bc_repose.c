@@ -3,9 +3,10 @@
  * deformation step 1) the right wall (repose_walls = right) or both lateral walls (both)
  * are removed from the state, through the solver's escape-removal path, so contact
  * histories of the remaining pairs are kept. Nothing moves afterwards: the material
- * collapses under gravity; elements that run off the ends of the base are removed by the
- * escape rule. Net displacement is always 0; the display interval is in seconds
- * (common/model.c). */
+ * collapses under gravity over the base, which extends beyond each removed wall by the
+ * assembly's width (solver/assembly.c, base_extension), so the pile spreads and comes to
+ * rest on it; elements that run off the ends of the base are removed by the escape rule.
+ * Net displacement is always 0; the display interval is in seconds (common/model.c). */
 #include "bc.h"
 #include "checkpoint.h"
 
@@ -36,7 +37,7 @@ static cdem_status repose_init(void *vctx, const cdem_params *p, const cdem_mode
     cdem_bc_walls w;
     CDEM_TRY(cdem_bc_find_walls(s, m, "repose", &w, err));
     c->walls = p->repose_walls;
-    c->x_mid = w.x_mid;
+    c->x_mid = 0.5 * m->width_m; /* not the walls' middle: the base may extend past a wall */
     c->y_base = w.y_base;
     c->tol = w.tol;
     for (size_t i = 0; i < s->n; i++) {
