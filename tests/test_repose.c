@@ -339,12 +339,15 @@ static void test_repose_command_says_when_moving_or_poor(void **state) {
     assert_non_null(strstr(out, "angle over the last third of the collapse (increments 6 to 9, "
                                 "360 to 540 s)"));
     assert_non_null(strstr(out, "slope: still moving"));
+    assert_null(strstr(out, "at rest since"));
     assert_non_null(strstr(errs, "warning: "));
     assert_non_null(strstr(errs, "the slope is still moving at increment 9"));
     double stopped[9] = {0, 50, 100, 150, 200, 200, 200, 200, 200};
     write_collapse(h5, &pile, stopped, 9);
     assert_int_equal(run_repose_captured(argv, 2, out, sizeof out, errs, sizeof errs), 0);
     assert_non_null(strstr(out, ": at rest (the limit"));
+    assert_non_null(
+        strstr(out, "at rest since increment 6 (360 s, 360 s after the end of equilibration)"));
     assert_non_null(strstr(out, "deg: stable (within 2 deg)"));
     assert_non_null(strstr(out, "slope: settled"));
     assert_non_null(strstr(out, "0 left the model"));

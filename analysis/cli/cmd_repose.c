@@ -97,6 +97,38 @@ static void print_measure(const char *file, const cdem_repose_result *res,
     }
 }
 
+/* Walks back from increment index k (state s) while the slope was at rest in each
+ * increment (the motion from the one before under CDEM_REPOSE_REST_FRACTION x r_max, none
+ * lost), down to the first increment after ke: *since = the index from which it has been at
+ * rest (k + 1 when it moved in the last increment); *last = the motion in the last one. */
+static cdem_status rest_since(cdem_h5_reader *r, size_t ke, size_t k, const cdem_state *s,
+                              double r_max, size_t *since, cdem_repose_motion *last,
+                              cdem_error *err) {
+    cdem_state later = {0}, earlier = {0};
+    CDEM_TRY(cdem_state_copy(&later, s, err));
+    cdem_status st = CDEM_OK;
+    *since = k + 1;
+    for (size_t q = k; q > ke && st == CDEM_OK; q--) {
+        cdem_repose_motion m;
+        st = cdem_h5_reader_load_increment(r, q - 1, &earlier, NULL, err);
+        if (st == CDEM_OK)
+            st = cdem_repose_motion_between(&earlier, &later, &m, err);
+        if (st != CDEM_OK)
+            break;
+        if (q == k)
+            *last = m;
+        if (!(m.mean < CDEM_REPOSE_REST_FRACTION * r_max && m.n_matched == m.n_before))
+            break;
+        *since = q;
+        cdem_state tmp = later;
+        later = earlier;
+        earlier = tmp;
+    }
+    cdem_state_free(&later);
+    cdem_state_free(&earlier);
+    return st;
+}
+
 /* Judges whether the slope of increment index k has settled: its motion since the previous
  * increment, and its angle over the last third of the collapse (the increments after the
  * end of equilibration whose time is at least t_k - (t_k - t_equil) / 3). Prints the
@@ -112,17 +144,17 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
         return CDEM_OK;
     }
     cdem_increment_info ie, ip;
-    cdem_state se = {0}, sp = {0};
+    cdem_state se = {0};
     cdem_repose_motion lost, last;
+    size_t since;
     cdem_status st = cdem_h5_reader_load_increment(r, ke, &se, &ie, err);
     if (st == CDEM_OK)
         st = cdem_repose_motion_between(&se, s, &lost, err);
     cdem_state_free(&se);
     if (st == CDEM_OK)
-        st = cdem_h5_reader_load_increment(r, k - 1, &sp, &ip, err);
+        st = cdem_h5_reader_increment_info(r, k - 1, &ip, err);
     if (st == CDEM_OK)
-        st = cdem_repose_motion_between(&sp, s, &last, err);
-    cdem_state_free(&sp);
+        st = rest_since(r, ke, k, s, res->r_max, &since, &last, err);
     CDEM_TRY(st);
     double t_from = info->time - (info->time - ie.time) / 3.0;
     size_t k0 = k;
@@ -167,6 +199,12 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
            "limit is %g %% of the largest radius, %.4g m)\n",
            (int)ip.number, (int)info->number, last.mean, last.max, v.at_rest ? "at rest" : "moving",
            100.0 * CDEM_REPOSE_REST_FRACTION, res->r_max);
+    if (since <= k) {
+        cdem_increment_info is;
+        CDEM_TRY(cdem_h5_reader_increment_info(r, since, &is, err));
+        printf("  at rest since increment %d (%.0f s, %.0f s after the end of equilibration)\n",
+               (int)is.number, is.time, is.time - ie.time);
+    }
     printf("  angle over the last third of the collapse (increments %d to %d, %.0f to %.0f s): "
            "%.2f to %.2f deg: %s\n",
            (int)i0.number, (int)info->number, i0.time, info->time, v.angle_min, v.angle_max,
