@@ -319,7 +319,7 @@ static void write_collapse(const char *h5, const cdem_state *pile, const double 
     assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
 }
 
-/* The command judges the settling over the last third of the collapse: a pile that still
+/* The command judges the settling over the last third of the run: a pile that still
  * sags is "still moving" (with a warning on stderr), one that stopped is "settled"; a poor
  * fit is said on stdout and stderr. */
 static void test_repose_command_says_when_moving_or_poor(void **state) {
@@ -336,7 +336,7 @@ static void test_repose_command_says_when_moving_or_poor(void **state) {
     assert_non_null(strstr(out, "right flank: good fit"));
     assert_non_null(strstr(out, "motion in the last increment (8 to 9): mean "));
     assert_non_null(strstr(out, ": moving (the limit is 1 % of the largest radius, 125 m)"));
-    assert_non_null(strstr(out, "angle over the last third of the collapse (increments 6 to 9, "
+    assert_non_null(strstr(out, "angle over the last third of the run (increments 6 to 9, "
                                 "360 to 540 s)"));
     assert_non_null(strstr(out, "slope: still moving"));
     assert_null(strstr(out, "at rest since"));

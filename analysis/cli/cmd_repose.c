@@ -25,7 +25,7 @@ static const cdem_cli_help help = {
     .about = "Angle of repose: the slope of the free surface of a repose-collapse run, fitted "
              "on each flank, with the fit's quality (a curved, rough or uncertain slope is a "
              "poor fit) and whether the slope has settled (at rest in the last increment, its "
-             "angle within 2 deg over the last third of the collapse); both warnings also go to "
+             "angle within 2 deg over the last third of the run); both warnings also go to "
              "stderr (docs/rendering.md, \"cdem-strain repose\").",
     .options = repose_options,
 };
@@ -130,8 +130,8 @@ static cdem_status rest_since(cdem_h5_reader *r, size_t ke, size_t k, const cdem
 }
 
 /* Judges whether the slope of increment index k has settled: its motion since the previous
- * increment, and its angle over the last third of the collapse (the increments after the
- * end of equilibration whose time is at least t_k - (t_k - t_equil) / 3). Prints the
+ * increment, and its angle over the last third of the run (the increments after the end of
+ * equilibration whose time is at least 2/3 t_k; t counts from the start of the run). Prints the
  * judgement (a warning on stderr when the slope still moves) and sets *moving. */
 static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
                                   const cdem_state *s, const cdem_increment_info *info,
@@ -156,7 +156,7 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
     if (st == CDEM_OK)
         st = rest_since(r, ke, k, s, res->r_max, &since, &last, err);
     CDEM_TRY(st);
-    double t_from = info->time - (info->time - ie.time) / 3.0;
+    double t_from = info->time * 2.0 / 3.0;
     size_t k0 = k;
     while (k0 > ke + 1) { /* the first increment of the window */
         cdem_increment_info ii;
@@ -205,7 +205,7 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
         printf("  at rest since increment %d (%.0f s, %.0f s after the end of equilibration)\n",
                (int)is.number, is.time, is.time - ie.time);
     }
-    printf("  angle over the last third of the collapse (increments %d to %d, %.0f to %.0f s): "
+    printf("  angle over the last third of the run (increments %d to %d, %.0f to %.0f s): "
            "%.2f to %.2f deg: %s\n",
            (int)i0.number, (int)info->number, i0.time, info->time, v.angle_min, v.angle_max,
            v.stable  ? "stable (within 2 deg)"
@@ -216,7 +216,7 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
         printf("  slope: still moving: the angle is not yet the angle of repose\n");
         fprintf(stderr,
                 "cdem-strain repose: warning: %s: the slope is still moving at increment %d "
-                "(%s; angle %.2f to %.2f deg over the last third of the collapse)\n",
+                "(%s; angle %.2f to %.2f deg over the last third of the run)\n",
                 file, (int)info->number,
                 v.at_rest ? "at rest in the last increment" : "moving in the last increment",
                 v.angle_min, v.angle_max);

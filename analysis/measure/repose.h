@@ -27,7 +27,7 @@
  * the slope is at rest when the free elements moved on average less than 1 % of the
  * largest radius in the last increment and none left the model in it, and its angle is
  * stable when it varies by at most 2 degrees over the increments given (cdem-strain repose
- * gives those of the last third of the collapse).
+ * gives those of the last third of the run).
  * Ownership: the caller owns the states and arrays. Thread safety: pure functions; scratch
  * memory is allocated per call. Units: m; angles in degrees. */
 #ifndef CDEM_REPOSE_H
