@@ -587,6 +587,70 @@ static void test_assembly_walls_complete(void **unused) {
 
 /* ---------------------------------------------------------------- determinism, size */
 
+/* In the repose test the base runs on past each removed wall by the assembly's width, at the
+ * base's spacing, appended after the lateral walls; the packing and the other walls are
+ * those of any other mode, element for element. */
+static void test_assembly_repose_base_extends(void **unused) {
+    (void)unused;
+    cdem_params p;
+    cdem_model m;
+    fill_params(&p, 10, 5, 1000, 0, 1);
+    fill_model(&m, 1000, 0);
+    cdem_state s0;
+    cdem_assembly_info i0;
+    build(&p, &m, &s0, &i0); /* the default mode: the base ends under the lateral walls */
+    const double w = p.width * p.unit_scaling, rw = m.radius[0];
+    for (int both = 0; both < 2; both++) {
+        cdem_params pr = p;
+        pr.mode = CDEM_MODE_REPOSE;
+        pr.repose_walls = both ? CDEM_WALLS_BOTH : CDEM_WALLS_RIGHT;
+        /* the extension is the mode's (its derive hook): taken from the derived model */
+        cdem_params full;
+        cdem_params_defaults(&full);
+        full.mode = pr.mode;
+        full.repose_walls = pr.repose_walls;
+        cdem_model derived, mr = m;
+        cdem_error err;
+        if (cdem_bc_derive_model(&full, &derived, &err) != CDEM_OK)
+            fail_msg("%s", err.msg);
+        mr.mode = derived.mode;
+        assert_true(mr.mode.base_beyond_right == 1.0);
+        assert_true(mr.mode.base_beyond_left == (both ? 1.0 : 0.0));
+        cdem_state s;
+        cdem_assembly_info info;
+        build(&pr, &mr, &s, &info);
+        assert_int_equal(info.n_internal, i0.n_internal);
+        assert_true(s.n > s0.n);
+        for (size_t i = 0; i < s0.n; i++) /* the same elements first */
+            assert_true(s.x[i] == s0.x[i] && s.y[i] == s0.y[i] && s.flags[i] == s0.flags[i]);
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = s0.n; i < s.n; i++) { /* then base discs beyond the walls */
+            assert_int_equal(s.flags[i], CDEM_FLAG_WALL | CDEM_FLAG_BASE);
+            assert_true(s.y[i] == -rw && s.radius[i] == rw);
+            assert_true(s.x[i] > w + rw || (both && s.x[i] < -rw));
+            lo = fmin(lo, s.x[i]);
+            hi = fmax(hi, s.x[i]);
+        }
+        assert_true(hi >= 2.0 * w + rw && hi < 2.0 * w + rw + i0.base_spacing * (1 + 1e-9));
+        if (both)
+            assert_true(lo <= -w - rw && lo > -w - rw - i0.base_spacing * (1 + 1e-9));
+        else
+            assert_true(lo > w + rw);
+        assert_int_equal(s.n, (size_t)(info.n_internal + info.n_wall));
+        /* the extension keeps the base's spacing: the whole row, sorted */
+        double *base = malloc(s.n * sizeof *base);
+        size_t nb = 0;
+        for (size_t i = 0; i < s.n; i++)
+            if (s.flags[i] & CDEM_FLAG_BASE)
+                base[nb++] = s.x[i];
+        qsort(base, nb, sizeof *base, cmp_double);
+        check_wall_line(base, nb, both ? -w - rw : -rw, 2.0 * w + rw, rw, p.base_spacing);
+        free(base);
+        cdem_state_free(&s);
+    }
+    cdem_state_free(&s0);
+}
+
 static void test_assembly_deterministic_by_seed(void **unused) {
     (void)unused;
     cdem_params p;
@@ -725,6 +789,7 @@ int main(void) {
         cmocka_unit_test(test_assembly_size_distribution),
         cmocka_unit_test(test_assembly_sorted_by_cell),
         cmocka_unit_test(test_assembly_walls_complete),
+        cmocka_unit_test(test_assembly_repose_base_extends),
         cmocka_unit_test(test_assembly_deterministic_by_seed),
         cmocka_unit_test(test_assembly_largest_builds),
         cmocka_unit_test(test_assembly_errors),

@@ -192,6 +192,39 @@ static void test_bc_repose_escape_beyond_base(void **st) {
     cdem_state_free(&s);
 }
 
+/* The walls to remove are told apart by the assembly's middle, not by the middle of the
+ * walls' extent: with the base extended far past the right wall (as assembly.c builds it
+ * for this mode), the right wall is still the one removed and the base stays whole. */
+static void test_bc_repose_extended_base_keeps_right_wall_choice(void **st) {
+    (void)st;
+    cdem_params p = fx_params(CDEM_MODE_REPOSE);
+    p.repose_walls = CDEM_WALLS_RIGHT;
+    cdem_model m = fx_model(200);
+    cdem_error err;
+    cdem_state s;
+    cdem_bc bc;
+    cdem_integrator it;
+    fx_assembly(&s);
+    for (int k = 1; k <= 60; k++) /* 6 km of base beyond the right wall */
+        assert_int_equal(cdem_state_append(&s, -1, WIDTH + 2.0 * RW * k, 0.0, RW, fx_mass(RW), 0,
+                                           CDEM_FLAG_WALL, 0, NULL, &err),
+                         CDEM_OK);
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    cdem_integrator_enable_escape(&it);
+    size_t nrem = 0;
+    assert_int_equal(cdem_integrator_begin_deformation(&it, &s, &bc, &nrem, &err), CDEM_OK);
+    assert_int_equal(nrem, 15);
+    assert_int_equal(count_lateral(&s, WIDTH), 0);
+    assert_int_equal(count_lateral(&s, 0.0), 15);
+    assert_int_equal(count_base(&s), 41 + 60);
+    assert_int_equal(cdem_integrator_step(&it, &s, &bc, 1, m.displacement_per_step, &err), CDEM_OK);
+    assert_float_equal(it.removal.escape_xmax, WIDTH + 2.0 * RW * 60, 1e-9); /* its end */
+    cdem_integrator_free(&it);
+    cdem_bc_free(&bc);
+    cdem_state_free(&s);
+}
+
 /* For repose the display interval is seconds: increments are display_interval apart in time;
  * for the other modes it is metres of boundary displacement. */
 static void test_bc_repose_display_interval_seconds(void **st) {
@@ -268,6 +301,9 @@ static void test_bc_repose_run_removes_walls(void **st) {
             xmin = fmin(xmin, s.x[i]);
             xmax = fmax(xmax, s.x[i]);
         }
+    /* the base runs on past the right wall by the assembly's width */
+    assert_true(xmax >= 2.0 * m.width_m + m.radius[0] * (1 - 1e-9));
+    assert_true(xmin == -m.radius[0]);
     long right = 0;
     for (size_t i = 0; i < s.n; i++)
         right += (s.flags[i] & CDEM_FLAG_WALL) && s.y[i] > ymin + 0.5 * m.radius[0] &&
@@ -295,6 +331,7 @@ int main(void) {
         cmocka_unit_test(test_bc_repose_right_wall_removed),
         cmocka_unit_test(test_bc_repose_both_walls_removed),
         cmocka_unit_test(test_bc_repose_escape_beyond_base),
+        cmocka_unit_test(test_bc_repose_extended_base_keeps_right_wall_choice),
         cmocka_unit_test(test_bc_repose_display_interval_seconds),
         cmocka_unit_test(test_bc_repose_run_removes_walls),
     };

@@ -6,10 +6,12 @@
 
 #include <cairo.h>
 #include <cmocka.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "analysis_fixtures.h"
 #include "assert_near.h"
@@ -25,6 +27,13 @@ static const double deg = 3.14159265358979323846 / 180.0;
 /* Surface heights (m) of the test piles. */
 static double wedge_surface(double x) { /* flat crest 2500 m, 30 degree slope, 200 m toe */
     return fmax(200.0, fmin(2500.0, 200.0 + (7000.0 - x) * tan(30 * deg)));
+}
+
+static double convex_surface(double x) { /* 12 degrees from the crest, then 50 degrees */
+    double y = 2500.0 - fmax(0.0, x - 1000.0) * tan(12 * deg);
+    if (x > 4500.0)
+        y = 2500.0 - 3500.0 * tan(12 * deg) - (x - 4500.0) * tan(50 * deg);
+    return fmax(200.0, y);
 }
 
 static double mound_surface(double x) { /* 30 degree cone on both sides, crest at 4000 m */
@@ -148,6 +157,221 @@ static void test_repose_command_prints_and_draws(void **state) {
     cdem_state_free(&s);
 }
 
+/* A straight slope is a good fit: narrow confidence interval, halves alike, no flags. */
+static void test_repose_straight_slope_is_a_good_fit(void **state) {
+    (void)state;
+    for (unsigned long seed = 1; seed <= 3; seed++) {
+        cdem_state s = {0};
+        make_pile(&s, wedge_surface, seed);
+        cdem_repose_result r;
+        cdem_error err;
+        assert_int_equal(cdem_repose_measure(&s, &r, &err), CDEM_OK);
+        const cdem_repose_flank *f = &r.flank[1];
+        assert_int_equal(r.poor, 0);
+        assert_int_equal(f->poor, 0);
+        assert_near(r.r_max, 125.0, 1e-9);
+        assert_true(f->angle_ci_deg > 0 && f->angle_ci_deg < CDEM_REPOSE_MAX_CI_DEG);
+        assert_near(f->angle_upper_deg, 30.0, 6.0);
+        assert_near(f->angle_lower_deg, 30.0, 6.0);
+        assert_true(fabs(f->angle_upper_deg - f->angle_lower_deg) < CDEM_REPOSE_MAX_BEND_DEG);
+        char why[256] = "x";
+        cdem_repose_poor_text(f, r.r_max, why, sizeof why);
+        assert_string_equal(why, "");
+        cdem_state_free(&s);
+    }
+}
+
+/* A convex slope (12 degrees below the crest, then 50) is flagged: its halves differ, and
+ * the text says so with both angles. */
+static void test_repose_curved_slope_is_a_poor_fit(void **state) {
+    (void)state;
+    cdem_state s = {0};
+    make_pile(&s, convex_surface, 5);
+    cdem_repose_result r;
+    cdem_error err;
+    assert_int_equal(cdem_repose_measure(&s, &r, &err), CDEM_OK);
+    const cdem_repose_flank *f = &r.flank[1];
+    assert_true(f->poor & CDEM_REPOSE_CURVED);
+    assert_true(r.poor & CDEM_REPOSE_CURVED);
+    assert_true(f->angle_lower_deg - f->angle_upper_deg > CDEM_REPOSE_MAX_BEND_DEG);
+    char why[512];
+    cdem_repose_poor_text(f, r.r_max, why, sizeof why);
+    assert_non_null(strstr(why, "the slope is curved: upper half "));
+    char tiny[8];
+    cdem_repose_poor_text(f, r.r_max, tiny, sizeof tiny); /* truncated, terminated */
+    assert_int_equal(strlen(tiny), 7);
+    /* too few columns: a short steep step */
+    cdem_repose_flank few = {.n = 4, .poor = CDEM_REPOSE_FEW};
+    cdem_repose_poor_text(&few, 125.0, why, sizeof why);
+    assert_string_equal(why, "only 4 columns on the slope, fewer than 6");
+    cdem_state_free(&s);
+}
+
+static void test_repose_motion_between_increments(void **state) {
+    (void)state;
+    cdem_state a = {0}, b = {0};
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&a, 16, 0, &err), CDEM_OK);
+    for (int i = 0; i < 4; i++)
+        cdem_state_append(&a, -1, 100.0 * i, 50.0, 50.0, 1.0, 1, 0, 0, NULL, &err);
+    cdem_state_append(&a, -1, -50.0, -50.0, 50.0, 1.0, 0, CDEM_FLAG_WALL, 0, NULL, &err);
+    assert_int_equal(cdem_state_copy(&b, &a, &err), CDEM_OK);
+    b.x[0] += 3.0; /* moved 3 m and 4 m: 5 m */
+    b.y[0] += 4.0;
+    b.x[4] += 1000.0; /* a wall does not count */
+    unsigned char keep[5] = {1, 1, 1, 0, 1};
+    cdem_state_compact(&b, keep, NULL); /* element 3 left the model */
+    cdem_repose_motion m;
+    assert_int_equal(cdem_repose_motion_between(&a, &b, &m, &err), CDEM_OK);
+    assert_int_equal(m.n_before, 4);
+    assert_int_equal(m.n_after, 3);
+    assert_int_equal(m.n_matched, 3);
+    assert_near(m.max, 5.0, 1e-12);
+    assert_near(m.mean, 5.0 / 3.0, 1e-12);
+    cdem_repose_settling v;
+    double steady[3] = {30.0, 30.5, 31.9}, drifting[3] = {30.0, 31.0, 32.1};
+    cdem_repose_motion still = {.mean = 1.0, .n_matched = 3, .n_before = 3, .n_after = 3};
+    cdem_repose_settled(steady, 3, &still, 125.0, &v);
+    assert_true(v.stable && v.at_rest);
+    assert_near(v.angle_min, 30.0, 0);
+    assert_near(v.angle_max, 31.9, 0);
+    cdem_repose_settled(drifting, 3, &still, 125.0, &v);
+    assert_false(v.stable);
+    cdem_repose_settled(steady, 3, &m, 125.0, &v); /* one element lost: not at rest */
+    assert_false(v.at_rest);
+    still.mean = 1.25; /* 1 % of the largest radius: moving */
+    cdem_repose_settled(steady, 3, &still, 125.0, &v);
+    assert_false(v.at_rest);
+    double gap[2] = {30.0, NAN};
+    cdem_repose_settled(gap, 2, &still, 125.0, &v);
+    assert_false(v.stable);
+    cdem_repose_settled(steady, 1, &still, 125.0, &v); /* one increment: not judged stable */
+    assert_false(v.stable);
+    b.id[0] = -1;
+    assert_int_equal(cdem_repose_motion_between(&a, &b, &m, &err), CDEM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "ids must be >= 0"));
+    cdem_state_free(&a);
+    cdem_state_free(&b);
+}
+
+/* Runs the command with stdout and stderr to files; returns its status, the texts in out
+ * and errs. */
+static int run_repose_captured(char **argv, int argc, char *out, size_t n_out, char *errs,
+                               size_t n_errs) {
+    char path_out[512], path_err[512];
+    scratch_path(path_out, sizeof path_out, "repose-out.txt");
+    scratch_path(path_err, sizeof path_err, "repose-err.txt");
+    fflush(stdout);
+    fflush(stderr);
+    int so = dup(1), se = dup(2);
+    int fo = open(path_out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int fe = open(path_err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(so >= 0 && se >= 0 && fo >= 0 && fe >= 0);
+    dup2(fo, 1);
+    dup2(fe, 2);
+    int rc = cdem_cmd_plot_repose(argc, argv);
+    fflush(stdout);
+    fflush(stderr);
+    dup2(so, 1);
+    dup2(se, 2);
+    close(fo);
+    close(fe);
+    close(so);
+    close(se);
+    const char *paths[2] = {path_out, path_err};
+    char *texts[2] = {out, errs};
+    size_t sizes[2] = {n_out, n_errs};
+    for (int k = 0; k < 2; k++) {
+        FILE *f = fopen(paths[k], "r");
+        assert_non_null(f);
+        size_t got = fread(texts[k], 1, sizes[k] - 1, f);
+        texts[k][got] = 0;
+        fclose(f);
+    }
+    return rc;
+}
+
+/* A run file of the pile: increment 0 ends the equilibration, then `n` increments of the
+ * collapse 60 s apart, in which the free elements move down by drop[k] m (cumulative). */
+static void write_collapse(const char *h5, const cdem_state *pile, const double *drop, int n) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_REPOSE;
+    cdem_run_meta meta = {&p, "", "repose test", "0", "test", 0};
+    cdem_h5_writer *w;
+    cdem_error err;
+    assert_int_equal(cdem_h5_writer_create(h5, &meta, &w, &err), CDEM_OK);
+    for (int k = 0; k <= n; k++) {
+        cdem_state s = {0};
+        assert_int_equal(cdem_state_copy(&s, pile, &err), CDEM_OK);
+        for (size_t i = 0; i < s.n; i++)
+            if (!(s.flags[i] & CDEM_FLAG_WALL) && k > 0)
+                s.y[i] -= drop[k - 1] * s.y[i] / 3000.0; /* a slope that sags */
+        cdem_increment_info info = {.number = k,
+                                    .step = 100 * k,
+                                    .time = 60.0 * k,
+                                    .phase = k ? CDEM_PHASE_DEFORMATION : CDEM_PHASE_EQUILIBRATION,
+                                    .sea_level = NAN,
+                                    .n_elements = (int64_t)s.n};
+        assert_int_equal(cdem_h5_writer_write_increment(w, &info, &s, &err), CDEM_OK);
+        cdem_state_free(&s);
+    }
+    assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
+}
+
+/* The command judges the settling over the last third of the run: a pile that still
+ * sags is "still moving" (with a warning on stderr), one that stopped is "settled"; a poor
+ * fit is said on stdout and stderr. */
+static void test_repose_command_says_when_moving_or_poor(void **state) {
+    (void)state;
+    char h5[512];
+    scratch_path(h5, sizeof h5, "repose-collapse.h5");
+    cdem_state pile = {0};
+    make_pile(&pile, wedge_surface, 3);
+    char out[8192], errs[4096];
+    char *argv[] = {"repose", h5};
+    double sagging[9] = {0, 50, 100, 150, 200, 250, 300, 350, 400};
+    write_collapse(h5, &pile, sagging, 9);
+    assert_int_equal(run_repose_captured(argv, 2, out, sizeof out, errs, sizeof errs), 0);
+    assert_non_null(strstr(out, "right flank: good fit"));
+    assert_non_null(strstr(out, "motion in the last increment (8 to 9): mean "));
+    assert_non_null(strstr(out, ": moving (the limit is 1 % of the largest radius, 125 m)"));
+    assert_non_null(strstr(out, "angle over the last third of the run (increments 6 to 9, "
+                                "360 to 540 s)"));
+    assert_non_null(strstr(out, "slope: still moving"));
+    assert_null(strstr(out, "at rest since"));
+    assert_non_null(strstr(errs, "warning: "));
+    assert_non_null(strstr(errs, "the slope is still moving at increment 9"));
+    double stopped[9] = {0, 50, 100, 150, 200, 200, 200, 200, 200};
+    write_collapse(h5, &pile, stopped, 9);
+    assert_int_equal(run_repose_captured(argv, 2, out, sizeof out, errs, sizeof errs), 0);
+    assert_non_null(strstr(out, ": at rest (the limit"));
+    assert_non_null(
+        strstr(out, "at rest since increment 6 (360 s, 360 s after the end of equilibration)"));
+    assert_non_null(strstr(out, "deg: stable (within 2 deg)"));
+    assert_non_null(strstr(out, "slope: settled"));
+    assert_non_null(strstr(out, "0 left the model"));
+    assert_string_equal(errs, "");
+    char *argv_equil[] = {"repose", h5, "--increment", "0"};
+    assert_int_equal(run_repose_captured(argv_equil, 4, out, sizeof out, errs, sizeof errs), 0);
+    assert_non_null(strstr(out, "settling: not judged (increment 0 is not after the end"));
+    cdem_state_free(&pile);
+    cdem_state convex = {0};
+    make_pile(&convex, convex_surface, 5);
+    write_collapse(h5, &convex, stopped, 9);
+    assert_int_equal(run_repose_captured(argv, 2, out, sizeof out, errs, sizeof errs), 0);
+    assert_non_null(strstr(out, "right flank: poor fit: the slope is curved"));
+    assert_non_null(strstr(errs, "poor fit of the right flank: the slope is curved"));
+    cdem_state_free(&convex);
+    const char *names[4] = {"repose-collapse.h5", "repose-collapse.xmf", "repose-out.txt",
+                            "repose-err.txt"};
+    for (int k = 0; k < 4; k++) {
+        char path[512];
+        scratch_path(path, sizeof path, names[k]);
+        remove(path);
+    }
+}
+
 /* fontconfig, which cairo's text uses, keeps a process-lifetime configuration that only
  * FcFini releases (as in test_render.c). LeakSanitizer reads this hook in the asan build. */
 const char *__lsan_default_suppressions(void);
@@ -161,6 +385,10 @@ int main(void) {
         cmocka_unit_test(test_repose_mound_two_flanks),
         cmocka_unit_test(test_repose_bad_states_messages),
         cmocka_unit_test(test_repose_command_prints_and_draws),
+        cmocka_unit_test(test_repose_straight_slope_is_a_good_fit),
+        cmocka_unit_test(test_repose_curved_slope_is_a_poor_fit),
+        cmocka_unit_test(test_repose_motion_between_increments),
+        cmocka_unit_test(test_repose_command_says_when_moving_or_poor),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     cairo_debug_reset_static_data(); /* drop cairo's font caches before LeakSanitizer looks */

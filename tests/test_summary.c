@@ -123,6 +123,13 @@ static void test_summary_modes_geometry(void **state) {
          "walls removed",
          "both walls"},
         {{"boundary.mode=repose", NULL}, "display interval", "5 s ="},
+        {{"boundary.mode=repose", NULL},
+         "base",
+         "extends 10000 m (the assembly's width) beyond "
+         "the removed wall"},
+        {{"boundary.mode=repose", "boundary.repose_walls=both", NULL},
+         "base",
+         "extends 10000 m (the assembly's width) beyond each removed wall"},
         {{"boundary.mode=biaxial", "boundary.confining_pressure=2e7", NULL},
          "confining pressure",
          "2e+07 N/m (20 MPa in 3-D), ramped from zero at 200 s to full at 400 s"},

@@ -23,12 +23,15 @@ static const cdem_cli_help help = {
     .program = "cdem-strain repose",
     .forms = repose_forms,
     .about = "Angle of repose: the slope of the free surface of a repose-collapse run, fitted "
-             "on each flank (docs/rendering.md, \"cdem-strain repose\").",
+             "on each flank, with the fit's quality (a curved, rough or uncertain slope is a "
+             "poor fit) and whether the slope has settled (at rest in the last increment, its "
+             "angle within 2 deg over the last third of the run); both warnings also go to "
+             "stderr (docs/rendering.md, \"cdem-strain repose\").",
     .options = repose_options,
 };
 
 static cdem_status repose_figure(const cdem_plot_args *a, const cdem_state *s, int number,
-                                 const cdem_repose_result *res, cdem_error *err) {
+                                 const cdem_repose_result *res, int moving, cdem_error *err) {
     cdem_render_format fmt;
     CDEM_TRY(cdem_render_format_from_path(a->out, &fmt, err));
     cdem_render_options o;
@@ -36,8 +39,8 @@ static cdem_status repose_figure(const cdem_plot_args *a, const cdem_state *s, i
     o.width = a->width ? a->width : 1200;
     o.height = a->height;
     char label[160];
-    snprintf(label, sizeof label, "Increment %d   Angle of repose %.1f deg", number,
-             res->angle_deg);
+    snprintf(label, sizeof label, "Increment %d   Angle of repose %.1f deg%s%s", number,
+             res->angle_deg, res->poor ? "   (poor fit)" : "", moving ? "   (still moving)" : "");
     cdem_render_scene sc = {.state = s, .label = label};
     int h = o.height;
     if (!h)
@@ -67,6 +70,161 @@ static cdem_status repose_figure(const cdem_plot_args *a, const cdem_state *s, i
     return cdem_render_target_close(&t, st, err);
 }
 
+/* Prints the measure of increment `info` and each fitted flank with its fit quality; a poor
+ * fit is also a warning on stderr. */
+static void print_measure(const char *file, const cdem_repose_result *res,
+                          const cdem_increment_info *info) {
+    printf("angle of repose = %.2f deg (increment %d, %zu surface elements fitted, columns "
+           "%.4g m wide)\n",
+           res->angle_deg, (int)info->number, res->n_fitted, res->column_width);
+    for (int side = 0; side < 2; side++) {
+        const cdem_repose_flank *f = &res->flank[side];
+        if (f->n < 2)
+            continue;
+        const char *name = side ? "right" : "left";
+        printf("  %s flank: %.2f deg +- %.2g (95 %%), %zu elements, x %.4g .. %.4g m, rms misfit "
+               "%.4g m; upper half %.1f deg, lower half %.1f deg\n",
+               name, f->angle_deg, f->angle_ci_deg, f->n, f->x_first, f->x_last, f->residual_rms,
+               f->angle_upper_deg, f->angle_lower_deg);
+        char why[512];
+        cdem_repose_poor_text(f, res->r_max, why, sizeof why);
+        if (f->poor) {
+            printf("  %s flank: poor fit: %s\n", name, why);
+            fprintf(stderr, "cdem-strain repose: warning: %s: poor fit of the %s flank: %s\n", file,
+                    name, why);
+        } else
+            printf("  %s flank: good fit (a straight slope)\n", name);
+    }
+}
+
+/* Walks back from increment index k (state s) while the slope was at rest in each
+ * increment (the motion from the one before under CDEM_REPOSE_REST_FRACTION x r_max, none
+ * lost), down to the first increment after ke: *since = the index from which it has been at
+ * rest (k + 1 when it moved in the last increment); *last = the motion in the last one. */
+static cdem_status rest_since(cdem_h5_reader *r, size_t ke, size_t k, const cdem_state *s,
+                              double r_max, size_t *since, cdem_repose_motion *last,
+                              cdem_error *err) {
+    cdem_state later = {0}, earlier = {0};
+    CDEM_TRY(cdem_state_copy(&later, s, err));
+    cdem_status st = CDEM_OK;
+    *since = k + 1;
+    for (size_t q = k; q > ke && st == CDEM_OK; q--) {
+        cdem_repose_motion m;
+        st = cdem_h5_reader_load_increment(r, q - 1, &earlier, NULL, err);
+        if (st == CDEM_OK)
+            st = cdem_repose_motion_between(&earlier, &later, &m, err);
+        if (st != CDEM_OK)
+            break;
+        if (q == k)
+            *last = m;
+        if (!(m.mean < CDEM_REPOSE_REST_FRACTION * r_max && m.n_matched == m.n_before))
+            break;
+        *since = q;
+        cdem_state tmp = later;
+        later = earlier;
+        earlier = tmp;
+    }
+    cdem_state_free(&later);
+    cdem_state_free(&earlier);
+    return st;
+}
+
+/* Judges whether the slope of increment index k has settled: its motion since the previous
+ * increment, and its angle over the last third of the run (the increments after the end of
+ * equilibration whose time is at least 2/3 t_k; t counts from the start of the run). Prints the
+ * judgement (a warning on stderr when the slope still moves) and sets *moving. */
+static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
+                                  const cdem_state *s, const cdem_increment_info *info,
+                                  const cdem_repose_result *res, int *moving, cdem_error *err) {
+    *moving = 0;
+    size_t ke;
+    if (cdem_h5_reader_find_increment(r, "equil", &ke, err) != CDEM_OK || k <= ke) {
+        printf("  settling: not judged (increment %d is not after the end of equilibration)\n",
+               (int)info->number);
+        return CDEM_OK;
+    }
+    cdem_increment_info ie, ip;
+    cdem_state se = {0};
+    cdem_repose_motion lost, last;
+    size_t since;
+    cdem_status st = cdem_h5_reader_load_increment(r, ke, &se, &ie, err);
+    if (st == CDEM_OK)
+        st = cdem_repose_motion_between(&se, s, &lost, err);
+    cdem_state_free(&se);
+    if (st == CDEM_OK)
+        st = cdem_h5_reader_increment_info(r, k - 1, &ip, err);
+    if (st == CDEM_OK)
+        st = rest_since(r, ke, k, s, res->r_max, &since, &last, err);
+    CDEM_TRY(st);
+    double t_from = info->time * 2.0 / 3.0;
+    size_t k0 = k;
+    while (k0 > ke + 1) { /* the first increment of the window */
+        cdem_increment_info ii;
+        CDEM_TRY(cdem_h5_reader_increment_info(r, k0 - 1, &ii, err));
+        if (ii.time < t_from)
+            break;
+        k0--;
+    }
+    double *angles = malloc((k - k0 + 1) * sizeof *angles);
+    if (!angles)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "repose: no memory for %zu angles", k - k0 + 1);
+    cdem_increment_info i0 = *info;
+    for (size_t q = k0; q <= k && st == CDEM_OK; q++) {
+        if (q == k) {
+            angles[q - k0] = res->angle_deg;
+            continue;
+        }
+        cdem_state sq = {0};
+        cdem_increment_info iq;
+        cdem_repose_result rq;
+        cdem_error ignored;
+        st = cdem_h5_reader_load_increment(r, q, &sq, &iq, err);
+        if (q == k0)
+            i0 = iq;
+        if (st == CDEM_OK)
+            angles[q - k0] =
+                cdem_repose_measure(&sq, &rq, &ignored) == CDEM_OK ? rq.angle_deg : NAN;
+        cdem_state_free(&sq);
+    }
+    cdem_repose_settling v;
+    if (st == CDEM_OK)
+        cdem_repose_settled(angles, k - k0 + 1, &last, res->r_max, &v);
+    free(angles);
+    CDEM_TRY(st);
+    long gone = (long)lost.n_before - (long)lost.n_matched;
+    printf("  free elements: %zu at the end of equilibration (increment %d), %zu now; %ld left "
+           "the model\n",
+           lost.n_before, (int)ie.number, lost.n_after, gone);
+    printf("  motion in the last increment (%d to %d): mean %.3g m, largest %.3g m: %s (the "
+           "limit is %g %% of the largest radius, %.4g m)\n",
+           (int)ip.number, (int)info->number, last.mean, last.max, v.at_rest ? "at rest" : "moving",
+           100.0 * CDEM_REPOSE_REST_FRACTION, res->r_max);
+    if (since <= k) {
+        cdem_increment_info is;
+        CDEM_TRY(cdem_h5_reader_increment_info(r, since, &is, err));
+        printf("  at rest since increment %d (%.0f s, %.0f s after the end of equilibration)\n",
+               (int)is.number, is.time, is.time - ie.time);
+    }
+    printf("  angle over the last third of the run (increments %d to %d, %.0f to %.0f s): "
+           "%.2f to %.2f deg: %s\n",
+           (int)i0.number, (int)info->number, i0.time, info->time, v.angle_min, v.angle_max,
+           v.stable  ? "stable (within 2 deg)"
+           : v.n < 2 ? "not judged (fewer than 2 increments)"
+                     : "changing (more than 2 deg, or an increment without a slope)");
+    *moving = !(v.at_rest && v.stable);
+    if (*moving) {
+        printf("  slope: still moving: the angle is not yet the angle of repose\n");
+        fprintf(stderr,
+                "cdem-strain repose: warning: %s: the slope is still moving at increment %d "
+                "(%s; angle %.2f to %.2f deg over the last third of the run)\n",
+                file, (int)info->number,
+                v.at_rest ? "at rest in the last increment" : "moving in the last increment",
+                v.angle_min, v.angle_max);
+    } else
+        printf("  slope: settled\n");
+    return CDEM_OK;
+}
+
 int cdem_cmd_plot_repose(int argc, char **argv) {
     cdem_plot_args a = {.cmd = "repose", .help = &help};
     int rc = cdem_cmd_plot_parse_one(argc, argv, &a);
@@ -88,19 +246,16 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
                 a.files[0], cdem_mode_name(prm.mode));
     if (st == CDEM_OK)
         st = cdem_repose_measure(&s, &res, &err);
+    int moving = 0;
     if (st == CDEM_OK) {
-        printf("angle of repose = %.2f deg (increment %d, %zu surface elements fitted, columns "
-               "%.4g m wide)\n",
-               res.angle_deg, (int)info.number, res.n_fitted, res.column_width);
-        for (int side = 0; side < 2; side++)
-            if (res.flank[side].n >= 2)
-                printf("  %s flank: %.2f deg, %zu elements, x %.4g .. %.4g m, rms misfit %.4g m\n",
-                       side ? "right" : "left", res.flank[side].angle_deg, res.flank[side].n,
-                       res.flank[side].x_first, res.flank[side].x_last,
-                       res.flank[side].residual_rms);
+        print_measure(a.files[0], &res, &info);
+        size_t k;
+        st = cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &k, &err);
+        if (st == CDEM_OK)
+            st = judge_settling(r, a.files[0], k, &s, &info, &res, &moving, &err);
     }
     if (st == CDEM_OK && a.out)
-        st = repose_figure(&a, &s, (int)info.number, &res, &err);
+        st = repose_figure(&a, &s, (int)info.number, &res, moving, &err);
     cdem_state_free(&s);
     cdem_h5_reader_close(r);
     return st == CDEM_OK ? 0 : cdem_cmd_fail(a.cmd, a.files[0], &err);

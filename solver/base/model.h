@@ -43,13 +43,16 @@ typedef struct {
     const char *still;       /* with 0 moving boundaries: what happens instead (summary) */
     double base_spacing;     /* > 0: the base's centre spacing in wall radii, whatever
                                 assembly.base_spacing says; 0: the parameter's */
-    const char *input;       /* a file the run reads besides the parameter file, or NULL */
-    const char *input_what;  /* how messages name it */
+    double base_beyond_left, base_beyond_right; /* the base runs on past the left / right
+                                wall by this many assembly widths (>= 0; repose: the pile
+                                comes to rest on it) */
+    const char *input;      /* a file the run reads besides the parameter file, or NULL */
+    const char *input_what; /* how messages name it */
 } cdem_model_mode;
 
 /* The mode part of a mode without a derive hook. */
 static inline cdem_model_mode cdem_model_mode_default(void) {
-    return (cdem_model_mode){NULL, 1, NULL, 0.0, NULL, NULL};
+    return (cdem_model_mode){NULL, 1, NULL, 0.0, 0.0, 0.0, NULL, NULL};
 }
 
 typedef struct {

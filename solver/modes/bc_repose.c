@@ -3,9 +3,10 @@
  * deformation step 1) the right wall (repose_walls = right) or both lateral walls (both)
  * are removed from the state, through the solver's escape-removal path, so contact
  * histories of the remaining pairs are kept. Nothing moves afterwards: the material
- * collapses under gravity; elements that run off the ends of the base are removed by the
- * escape rule. Net displacement is always 0; the display interval is in seconds
- * (solver/base/model.c). */
+ * collapses under gravity over the base, which extends beyond each removed wall by the
+ * assembly's width (solver/packing/assembly.c, base_extension), so the pile spreads and comes
+ * to rest on it; elements that run off the ends of the base are removed by the escape rule.
+ * Net displacement is always 0; the display interval is in seconds (solver/base/model.c). */
 #include "bc.h"
 #include "checkpoint.h"
 #include "summary_line.h"
@@ -37,7 +38,7 @@ static cdem_status repose_init(void *vctx, const cdem_params *p, const cdem_mode
     cdem_bc_walls w;
     CDEM_TRY(cdem_bc_find_walls(s, m, "repose", &w, err));
     c->walls = p->repose_walls;
-    c->x_mid = w.x_mid;
+    c->x_mid = 0.5 * m->width_m; /* not the walls' middle: the base may extend past a wall */
     c->y_base = w.y_base;
     c->tol = w.tol;
     for (size_t i = 0; i < s->n; i++) {
@@ -111,15 +112,21 @@ static const char *const repose_excludes[] = {"surface.overburden_pressure", "su
 /* No boundary moves: the walls go and the assembly collapses, so the display interval is in
  * seconds (cdem_model_mode). */
 static void repose_derive(const cdem_params *p, cdem_model_mode *out) {
-    (void)p;
     out->moving_boundaries = 0;
     out->still = "walls removed; the assembly collapses under gravity";
+    /* the base runs on past each removed wall by the assembly's width, so that the pile
+     * spreads and comes to rest on it instead of draining over the base's end, where the
+     * slope stood 7 deg steeper than the material (issue 34; docs/solver.md) */
+    out->base_beyond_right = 1.0;
+    out->base_beyond_left = p->repose_walls == CDEM_WALLS_BOTH ? 1.0 : 0.0;
 }
 
 static void repose_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
-    (void)m;
     cdem_summary_line(out, "walls removed", "%s, at the end of equilibration",
                       p->repose_walls == CDEM_WALLS_BOTH ? "both walls" : "right wall");
+    cdem_summary_line(out, "base", "extends %.6g m (the assembly's width) beyond %s", m->width_m,
+                      p->repose_walls == CDEM_WALLS_BOTH ? "each removed wall"
+                                                         : "the removed wall");
 }
 
 static const cdem_bc_ops repose_ops = {

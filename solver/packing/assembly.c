@@ -503,17 +503,38 @@ static long base_disc_count(double w, double rw, double spacing) {
     return (long)ceil((w + 2.0 * rw) / (spacing * rw)) + 1;
 }
 
+/* In the repose test the base runs on past each lateral wall that the mode removes, by the
+ * assembly's width: the collapsing pile spreads over the base and comes to rest on it,
+ * instead of draining over the base's end where the wall stood (which pins the toe there
+ * and keeps the slope moving; issue 34, examples/calibration/README.md). Sets the number of
+ * extra base discs beyond the left (*left) and the right (*right) wall, spaced like the
+ * base (sb): 0 in every other mode. */
+/* The discs the base runs on past the left and right walls (the mode's base_beyond_*, in
+ * assembly widths; repose: the collapse comes to rest on them instead of draining over the
+ * base's end, docs/solver.md), at the base's spacing sb. */
+static void base_extension(const cdem_model_mode *mode, double w, double sb, long *left,
+                           long *right) {
+    *right = mode->base_beyond_right > 0.0 ? (long)ceil(mode->base_beyond_right * w / sb) : 0;
+    *left = mode->base_beyond_left > 0.0 ? (long)ceil(mode->base_beyond_left * w / sb) : 0;
+}
+
 /* Appends the walls: base (y = -rw, x from -rw to w + rw, centres at most base_spacing * rw
  * apart), left (x = -rw) and right (x = w + rw) walls from just above the base corner up to
- * wall height hw, centres at most rw apart. The base's spacing sets its roughness: the
- * base has no other way to resist sliding when its friction is zero (Fig. 12). */
-static cdem_status append_walls(cdem_state *s, double w, double hw, double rw, double mw,
-                                double base_spacing, long *n_wall, cdem_error *err) {
+ * wall height hw, centres at most rw apart, then the mode's extension of the base past the
+ * walls (base_extension; after the lateral walls, so that the other walls keep their
+ * indices).
+ * The base's spacing sets its roughness: the base has no other way to resist sliding when
+ * its friction is zero (Fig. 12). */
+static cdem_status append_walls(cdem_state *s, const cdem_model_mode *mode, double w, double hw,
+                                double rw, double mw, double base_spacing, long *n_wall,
+                                cdem_error *err) {
     long nb = base_disc_count(w, rw, base_spacing);
     double sb = (w + 2.0 * rw) / (double)(nb - 1);
     long nl = (long)ceil((hw + rw) / rw);
     double sl = (hw + rw) / (double)nl;
-    CDEM_TRY(cdem_state_reserve(s, s->n + (size_t)(nb + 2 * nl), err));
+    long ext_left, ext_right;
+    base_extension(mode, w, sb, &ext_left, &ext_right);
+    CDEM_TRY(cdem_state_reserve(s, s->n + (size_t)(nb + 2 * nl + ext_left + ext_right), err));
     for (long i = 0; i < nb; i++)
         CDEM_TRY(cdem_state_append(s, -1, -rw + (double)i * sb, -rw, rw, mw, 0,
                                    CDEM_FLAG_WALL | CDEM_FLAG_BASE, 0, NULL, err));
@@ -523,7 +544,13 @@ static cdem_status append_walls(cdem_state *s, double w, double hw, double rw, d
             CDEM_TRY(cdem_state_append(s, -1, xw, -rw + (double)i * sl, rw, mw, 0, CDEM_FLAG_WALL,
                                        0, NULL, err));
     }
-    *n_wall = nb + 2 * nl;
+    for (long i = 1; i <= ext_right; i++)
+        CDEM_TRY(cdem_state_append(s, -1, w + rw + (double)i * sb, -rw, rw, mw, 0,
+                                   CDEM_FLAG_WALL | CDEM_FLAG_BASE, 0, NULL, err));
+    for (long i = 1; i <= ext_left; i++)
+        CDEM_TRY(cdem_state_append(s, -1, -rw - (double)i * sb, -rw, rw, mw, 0,
+                                   CDEM_FLAG_WALL | CDEM_FLAG_BASE, 0, NULL, err));
+    *n_wall = nb + 2 * nl + ext_left + ext_right;
     return CDEM_OK;
 }
 
@@ -552,7 +579,7 @@ static cdem_status fill_state(const packer *pk, const cdem_params *p, const cdem
     CDEM_TRY(st);
     long n_wall = 0;
     double rw = m->radius[0];
-    CDEM_TRY(append_walls(s, pk->w, p->wall_height_multiplier * pk->h, rw, m->mass[0],
+    CDEM_TRY(append_walls(s, &m->mode, pk->w, p->wall_height_multiplier * pk->h, rw, m->mass[0],
                           base_spacing_of(p, m), &n_wall, err));
     if (info) {
         memset(info, 0, sizeof *info);
