@@ -988,6 +988,15 @@ void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) {
         log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
 }
 
+int cdem_params_prefix_ok(const char *prefix) {
+    if (!prefix || !prefix[0] || prefix[0] == '.' || prefix[0] == '-' || strlen(prefix) > 64)
+        return 0;
+    for (const char *c = prefix; *c; c++)
+        if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-' && *c != '.')
+            return 0;
+    return 1;
+}
+
 cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err) {
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
@@ -1046,6 +1055,9 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
     if (log.count > 0) /* ranges first: the cross rules below assume sane values */
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
 
+    /* a file-name prefix, not a path (issue 35, item 8: "../../etc/x" was accepted) */
+    if (!cdem_params_prefix_ok(p->prefix))
+        cdem_rule_add(&log, "[output] prefix = \"%.60s\": %s", p->prefix, CDEM_PREFIX_RULE);
     if (!(p->equilibration < p->runtime)) {
         cdem_params_format_number(p->equilibration, v1, sizeof v1);
         cdem_params_format_number(p->runtime, v2, sizeof v2);

@@ -260,4 +260,13 @@ const char *cdem_mode_name(cdem_mode mode);
 const char *cdem_law_name(cdem_granular_law law);
 const char *cdem_law_description(cdem_granular_law law);
 
+/* A file-name prefix of per-increment files (output.prefix, export-sspx and render
+ * --prefix): letters, digits, '_', '-' and '.', 1 to 64 of them, not starting with '.' or
+ * '-': a name inside the folder the files go to, never a path out of it. 1 when prefix is
+ * one; CDEM_PREFIX_RULE says the rule in messages. */
+int cdem_params_prefix_ok(const char *prefix);
+#define CDEM_PREFIX_RULE                                                                           \
+    "must be a file-name prefix: 1 to 64 letters, digits, '_', '-' or '.', not starting with "     \
+    "'.' or '-' (e.g. cdem)"
+
 #endif

@@ -501,8 +501,15 @@ int main(int argc, char **argv) {
         cdem_error cerr;
         cdem_error_clear(&cerr);
         if (cdem_run_count_elements(&p, &n_int, &n_wall, &cerr) != CDEM_OK) {
-            /* The summary must not fail because the packing could not be generated here;
-             * the run itself reports that properly. */
+            /* The summary checks everything the run checks (issue 35, item 6: a missing,
+             * folder or invalid fault file gave a summary and exit 0, then the run refused
+             * it): an error of the inputs fails it as it would fail the run. Only the room
+             * to build the packing here is not the run's problem: then the count is the
+             * estimate. */
+            if (cerr.code != CDEM_ERR_NOMEM) {
+                err = cerr;
+                goto fail;
+            }
             n_int = cdem_model_estimate_elements(&p);
             n_wall = 0;
             estimated = 1;

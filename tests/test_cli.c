@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 typedef struct {
@@ -44,15 +45,15 @@ static int teardown(void **state) {
 }
 
 /* Runs cdem-run with args (shell syntax), stdout and stderr to files in tmp; returns the
- * exit status. */
+ * exit status (124 when it ran for 10 minutes: a hang fails instead of stalling the tests). */
 static int run(const cli_ctx *c, const char *args) {
     if (access(c->bin, X_OK) != 0) {
         print_error("%s is missing: build it first (make build/cdem-run)\n", c->bin);
         fail();
     }
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "'%s' %s >'%s/out.txt' 2>'%s/err.txt'", c->bin, args, c->scratch.dir,
-             c->scratch.dir);
+    snprintf(cmd, sizeof cmd, "timeout 600 '%s' %s >'%s/out.txt' 2>'%s/err.txt'", c->bin, args,
+             c->scratch.dir, c->scratch.dir);
     int st = system(cmd);
     assert_true(WIFEXITED(st));
     return WEXITSTATUS(st);
@@ -149,6 +150,57 @@ static void test_cli_bad_override_and_rules(void **state) {
     assert_has(err, "cdem-run: mode = biaxial requires width = 10");
     assert_has(err, "\ncdem-run: mode = biaxial excludes erosion");
     free(err);
+}
+
+/* --summary checks every input the run checks, and never waits on one (issue 35, item 6: a
+ * fault file that is a FIFO hung --summary and the run; a missing, folder, device or invalid
+ * one gave a summary and exit 0, then the run refused it). */
+static void test_cli_summary_checks_the_fault_file(void **state) {
+    const cli_ctx *c = *state;
+    char fifo[1100], args[2400];
+    snprintf(fifo, sizeof fifo, "%s/fault.fifo", c->scratch.dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    write_file(c, "bad.txt", "1400 0\n1000 800\n"); /* first point not at the fault location */
+    const struct {
+        const char *file; /* under the scratch folder unless absolute */
+        const char *said;
+    } cases[] = {
+        {"fault.fifo", "is a pipe (FIFO), not a text file of x y points"},
+        {"missing.txt", "cannot open: No such file or directory"},
+        {".", "is a folder, not a text file of x y points"},
+        {"/dev/zero", "is a device, not a text file of x y points"},
+        {"bad.txt", "line 1: first point (1400, 0) m must be at the fault location"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        for (int summary = 0; summary < 2; summary++) {
+            char path[1200];
+            if (cases[k].file[0] == '/')
+                snprintf(path, sizeof path, "%s", cases[k].file);
+            else
+                snprintf(path, sizeof path, "%s/%s", c->scratch.dir, cases[k].file);
+            /* run()'s timeout: a hang fails the test (exit 124) instead of stalling it */
+            snprintf(args, sizeof args,
+                     "-s boundary.mode=irregular-fault -s 'boundary.fault_file=%s' %s", path,
+                     summary ? "--summary" : "-q -o '/nonexistent-folder-of-the-test/x.h5'");
+            const int rc = run(c, args);
+            if (rc != 1)
+                fail_msg("%s with fault file %s: exit %d, expected 1",
+                         summary ? "--summary" : "run", cases[k].file, rc);
+            char *e = slurp(c, "err.txt");
+            assert_has(e, cases[k].said);
+            free(e);
+        }
+    }
+}
+
+/* output.prefix names files inside an output folder, never a path (issue 35, item 8). */
+static void test_cli_output_prefix_is_a_name(void **state) {
+    const cli_ctx *c = *state;
+    assert_int_equal(run(c, "-s output.prefix=../../etc/x --summary"), 1);
+    char *e = slurp(c, "err.txt");
+    assert_has(e, "[output] prefix = \"../../etc/x\": must be a file-name prefix");
+    free(e);
+    assert_int_equal(run(c, "-s output.prefix=run_a.v2 --summary"), 0);
 }
 
 static void test_cli_summary_and_dry_run(void **state) {
@@ -298,6 +350,8 @@ int main(void) {
         cmocka_unit_test_setup_teardown(test_cli_summary_and_dry_run, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_usage_errors_and_info, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_params_markdown, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_summary_checks_the_fault_file, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_output_prefix_is_a_name, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_parameters_from_stdin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

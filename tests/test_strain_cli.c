@@ -225,6 +225,14 @@ static void test_strain_cli_exports_and_import(void **state) {
     assert_int_equal(run(cmd, out, sizeof out), 1);
     snprintf(path, sizeof path, "%s/never", g_scratch.dir);
     assert_int_not_equal(access(path, F_OK), 0);
+    /* a prefix is a file name, not a path out of the folder; refused before the folder is
+     * made (issue 35, item 8: "../../etc/x" was taken and its folder left behind) */
+    snprintf(cmd, sizeof cmd,
+             "%s export-sspx %s --increments 3-4 --prefix ../../etc/x %s/never 2>&1", g_exe, g_run,
+             g_scratch.dir);
+    assert_int_equal(run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--prefix ../../etc/x: must be a file-name prefix"));
+    assert_int_not_equal(access(path, F_OK), 0);
     const char *d = getenv("CDEM_TEST_DATA");
     snprintf(cmd, sizeof cmd,
              "%s import-cdem2d %s/cdem2d_basic -o %s/imp.h5 && %s compute "
@@ -348,6 +356,12 @@ static void test_strain_cli_errors(void **state) {
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "cdem-strain: unknown quantity 'total-max-sheer'; did you mean "
                                 "'total-max-shear'?"));
+    /* a name without its family: each family's, total first (issue 35, item 15: the nearest by
+     * spelling was cum-max-shear) */
+    snprintf(cmd, sizeof cmd, "%s compute %s --increment last --quantity max-shear", g_exe, g_run);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "unknown quantity 'max-shear'; did you mean 'total-max-shear', "
+                                "'incr-max-shear', 'cum-max-shear'?"));
     snprintf(cmd, sizeof cmd, "%s compute %s --increment 99 --quantity uplift", g_exe, g_run);
     assert_int_equal(run(cmd, out, sizeof out), 1);
     assert_non_null(strstr(out, "increment 99 does not exist"));

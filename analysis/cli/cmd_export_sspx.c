@@ -3,6 +3,7 @@
 
 #include "analysis.h"
 #include "outfile.h"
+#include "params.h"
 #include "sspx.h"
 
 #include <stdio.h>
@@ -13,6 +14,11 @@ static int cmd_export_sspx(const cdem_cmd_options *o) {
                               "export-sspx needs --increments A-B (e.g. 56-282, equil-last)");
     if (!o->dir)
         return cdem_cmd_usage(o->help, "export-sspx needs an output directory");
+    if (o->prefix && !cdem_params_prefix_ok(o->prefix)) { /* before any folder is made */
+        char what[400];
+        snprintf(what, sizeof what, "--prefix %.100s: %s", o->prefix, CDEM_PREFIX_RULE);
+        return cdem_cmd_usage(o->help, what);
+    }
     cdem_analysis *a;
     int rc = cdem_cmd_open_run(o, &a);
     if (rc)
@@ -22,7 +28,12 @@ static int cmd_export_sspx(const cdem_cmd_options *o) {
     const char *prefix = o->prefix ? o->prefix : cdem_analysis_params(a)->prefix;
     if (!prefix[0])
         prefix = "cdem";
-    cdem_status st = cdem_sspx_parse_range(a, o->increments, &first, &last, &err);
+    cdem_status st = cdem_params_prefix_ok(prefix)
+                         ? CDEM_OK
+                         : CDEM_FAIL(&err, CDEM_ERR_FORMAT, "%s: stored output.prefix '%s' %s",
+                                     o->file, prefix, CDEM_PREFIX_RULE);
+    if (st == CDEM_OK)
+        st = cdem_sspx_parse_range(a, o->increments, &first, &last, &err);
     if (st == CDEM_OK) /* after the run file and range are known good: no stray folder */
         st = cdem_outfile_make_dirs(o->dir, &err);
     if (st == CDEM_OK)

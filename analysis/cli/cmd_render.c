@@ -2,6 +2,7 @@
  * an animated GIF. Every frame of a series uses one fixed view box (the union of the first
  * and last increments' boxes) so pictures and animation frames line up. */
 #include "cmd_render.h"
+#include "params.h"
 
 #include "cmd_support.h"
 #include "commands.h"
@@ -139,6 +140,8 @@ static int parse_args(int argc, char **argv, render_args *a) {
         } else if (cdem_cli_option_is(o, "--gif")) {
             a->gif = next;
         } else if (cdem_cli_option_is(o, "--prefix")) {
+            if (!cdem_params_prefix_ok(next))
+                return usage("--prefix: " CDEM_PREFIX_RULE);
             a->prefix = next;
         } else if (cdem_cli_option_is(o, "--format")) {
             if (strcmp(next, "png") && strcmp(next, "pdf") && strcmp(next, "svg"))

@@ -1,6 +1,8 @@
 /* sspx: see sspx.h. */
 #include "sspx.h"
 
+#include "params.h"
+
 #include "outfile.h"
 
 #include <errno.h>
@@ -62,9 +64,9 @@ cdem_status cdem_sspx_export(cdem_analysis *a, size_t first, size_t last, const 
                          "export: increment range %zu..%zu is not within "
                          "0..%zu",
                          first, last, cdem_analysis_count(a) - 1);
-    if (!prefix || strchr(prefix, '/'))
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: prefix '%s' must not contain '/'",
-                         prefix ? prefix : "(null)");
+    if (!cdem_params_prefix_ok(prefix))
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "export: prefix '%s' %s",
+                         prefix ? prefix : "(null)", CDEM_PREFIX_RULE);
     int dirlen = (int)strlen(dir); /* "out/" and "out" name the same directory */
     while (dirlen > 1 && dir[dirlen - 1] == '/')
         dirlen--;

@@ -85,19 +85,36 @@ cdem_status cdem_quantity_find(const char *name, const cdem_quantity **out, cdem
             *out = &t[i];
             return CDEM_OK;
         }
-    size_t best = 0, bestd = (size_t)-1;
-    for (size_t i = 0; i < n; i++) {
-        size_t d = cdem_edit_distance(name, t[i].name);
-        if (d < bestd) {
-            bestd = d;
-            best = i;
-        }
-    }
     char list[CDEM_ERROR_MSG_MAX / 2] = "";
     size_t pos = 0;
     for (size_t i = 0; i < n && pos < sizeof list; i++)
         pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s", i ? ", " : "", t[i].name);
+    /* A name without its family ("max-shear", "e1"): every family that has it, total first,
+     * the one asked for most (issue 35, item 15: the nearest by spelling was cum-max-shear,
+     * the rarest). Else the nearest name by spelling. */
+    static const char *const families[] = {"total-", "incr-", "cum-"};
+    char offer[256] = "";
+    size_t at = 0, found = 0;
+    for (size_t f = 0; f < sizeof families / sizeof families[0]; f++) {
+        char full[128];
+        snprintf(full, sizeof full, "%s%.60s", families[f], name);
+        for (size_t i = 0; i < n; i++)
+            if (strcmp(t[i].name, full) == 0 && at < sizeof offer)
+                at += (size_t)snprintf(offer + at, sizeof offer - at, "%s'%s'", found++ ? ", " : "",
+                                       full);
+    }
+    if (found == 0) {
+        size_t best = 0, bestd = (size_t)-1;
+        for (size_t i = 0; i < n; i++) {
+            size_t d = cdem_edit_distance(name, t[i].name);
+            if (d < bestd) {
+                bestd = d;
+                best = i;
+            }
+        }
+        snprintf(offer, sizeof offer, "'%s'", t[best].name);
+    }
     return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
-                     "unknown quantity '%.60s'; did you mean '%s'? Valid quantities: %s", name,
-                     t[best].name, list);
+                     "unknown quantity '%.60s'; did you mean %s? Valid quantities: %s", name, offer,
+                     list);
 }

@@ -2,11 +2,13 @@
 #include "fault_file.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 void cdem_fault_file_free(cdem_fault_polyline *pl) {
     if (!pl)
@@ -188,16 +190,28 @@ cdem_status cdem_fault_file_read(const char *path, double x0, double tol, cdem_f
                          "fault file %s: x0 = %g m, tol = %g m: need a "
                          "finite x0 and tol > 0",
                          path, x0, tol);
-    FILE *f = fopen(path, "r");
-    if (!f)
+    /* Opened without waiting (a FIFO would block the open until a writer came: --summary and
+     * the run hung, issue 35, item 6), then refused unless it is a regular file (a folder
+     * opens, and then every read fails with a bare "read error"; /dev/zero never ends). */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
         return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: cannot open: %s", path, strerror(errno));
-    struct stat sb; /* a folder opens, and then every read fails with a bare "read error" */
-    if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
-        fclose(f);
+    struct stat sb;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        const int is_dir = S_ISDIR(sb.st_mode);
+        close(fd);
         return CDEM_FAIL(
             err, CDEM_ERR_IO,
             "fault file %s: is %s, not a text file of x y points (boundary.fault_file)", path,
-            S_ISDIR(sb.st_mode) ? "a folder" : "not a regular file");
+            is_dir                 ? "a folder"
+            : S_ISFIFO(sb.st_mode) ? "a pipe (FIFO)"
+            : S_ISCHR(sb.st_mode)  ? "a device"
+                                   : "not a regular file");
+    }
+    FILE *f = fdopen(fd, "r");
+    if (!f) {
+        close(fd);
+        return CDEM_FAIL(err, CDEM_ERR_IO, "fault file %s: cannot open: %s", path, strerror(errno));
     }
     /* A NUL byte would end a line early without notice (fgets): refuse binary files. */
     char chunk[4096];
