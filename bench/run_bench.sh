@@ -19,13 +19,19 @@
 #   5. Threads on a busy machine (bench/contended.sh): 1 and 2 threads, idle and with one
 #      CPU-bound competitor process that the script starts and stops, with cdem-run's own
 #      wait policy and with libgomp's default, in the same run.
+#   6. Scale: every phase per element at ~10^4, ~2.5 x 10^5 and ~10^6 elements (build,
+#      BIG_STEPS time steps on 1 and 2 threads, writing three increments, cdem-strain compute
+#      and render of the total strain) and the peak memory per element (bench/bench_big.c);
+#      about 4 minutes.
 # Usage: sh bench/run_bench.sh [BUILD]   (make bench; about 10 minutes on an idle 2-core box)
 # Environment:
 #   SIZES="10:5:0 10:5:1 40:5:1 100:7.5:1"  width:height:half_radii of the scaling table
 #   LARGE=1     adds 200 x 7.5 half radii (~250,000 elements; ~1.5 more minutes)
 #   REPS=3      timed runs per size and thread count (medians)
 #   ELSTEPS=2e7 element-steps per timed run;  SETTLE=3000 untimed settling steps
-#   PARTS="machine scale full lammps analysis contended"  the parts to run
+#   PARTS="machine scale full lammps analysis contended big"  the parts to run
+#   BIG_SIZES="24:10:1 100:7.5:0.356 100:7.5:0.178" width:height:radius_scale of part 6;
+#   BIG_STEPS=1000
 #   WORK=/tmp/cdem_bench  scratch directory (the default run's file is kept there)
 # OMP_WAIT_POLICY is left as the caller has it. cdem-run and cdem-strain, when it is unset,
 # choose passive themselves (common/threads.h; part 5 measures why); the benchmark programs
@@ -41,7 +47,9 @@ SIZES=${SIZES:-"10:5:0 10:5:1 40:5:1 100:7.5:1"}
 REPS=${REPS:-3}
 ELSTEPS=${ELSTEPS:-2e7}
 SETTLE=${SETTLE:-3000}
-PARTS=${PARTS:-"machine scale full lammps analysis contended"}
+PARTS=${PARTS:-"machine scale full lammps analysis contended big"}
+BIG_SIZES=${BIG_SIZES:-"24:10:1 100:7.5:0.356 100:7.5:0.178"}
+BIG_STEPS=${BIG_STEPS:-1000}
 WORK=${WORK:-/tmp/cdem_bench}
 PKGS="hdf5 gsl"
 CFLAGS="-O2 -g -std=c17 -Wall -Wextra -Werror -fopenmp -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icommon $(for d in solver/*/; do printf " -I%s" "${d%/}"; done)"
@@ -52,6 +60,8 @@ cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_scale" bench/bench_scal
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_io" bench/bench_io.c \
     "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
 cc $CFLAGS -o "$BUILD/bench_machine" bench/bench_machine.c -lm
+cc $CFLAGS $(pkg-config --cflags $PKGS zlib) -o "$BUILD/bench_big" bench/bench_big.c \
+    "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs $PKGS zlib) -lm
 
 has() { case " $PARTS " in *" $1 "*) return 0 ;; esac; return 1; }
 load() { cut -d' ' -f1-3 /proc/loadavg; }
@@ -199,4 +209,25 @@ if has contended; then
     echo "      common/threads.h, and the thread governor, solver/run/governor.h), without the governor"
     echo "      (cdem-fixed), and with libgomp's default spin, idle and with one CPU-bound competitor"
     WAITS="cdem cdem-fixed libgomp" sh bench/contended.sh "$BUILD"
+fi
+
+if has big; then
+    echo
+    echo "== 6. Scale: every phase per element from ~10^4 to ~10^6 elements (bench/bench_big.c; $BIG_STEPS steps,"
+    echo "      half in equilibration, half deforming the planar fault, blocks of 1 and 2 threads alternating)"
+    printf "   %9s %9s %9s %9s %10s %10s %10s %10s %10s %9s\n" elements build_us \
+        ns/el-st1t ns/el-st2t write_us B/el-inc compute_us render_us bytes/el compute_B
+    for spec in $BIG_SIZES; do
+        w=${spec%%:*}; rest=${spec#*:}; h=${rest%%:*}; rs=${rest#*:}
+        line=$("$BUILD/bench_big" "$w" "$h" "$rs" "$BIG_STEPS" "$WORK" "$BUILD/cdem-strain") || {
+            echo "   $spec: bench_big failed"; continue; }
+        echo "$line" | awk '{for (i = 2; i < NF; i += 2) v[$i] = $(i + 1);
+            printf "   %9d %9.2f %10.1f %10.1f %10.2f %10.1f %10.2f %10.2f %10.0f %9.0f\n",
+            v["N"], v["build_us_per_el"], v["ns_per_el_step_1t"], v["ns_per_el_step_2t"],
+            v["write_us_per_el_incr"], v["file_bytes_per_el_incr"], v["compute_us_per_el"],
+            v["render_us_per_el"], v["rss_bytes_per_el"], v["compute_rss_bytes_per_el"]}'
+    done
+    echo "   (per element: build, writing an increment, compute and render in microseconds; a time step in"
+    echo "   nanoseconds; bytes: the file per element and increment, and the peak resident memory of the"
+    echo "   solver process and of cdem-strain compute; load average now $(load))"
 fi

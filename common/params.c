@@ -93,14 +93,16 @@ static const char *const section_names[] = {"assembly", "time",          "physic
 /* clang-format off */
 static const cdem_param_def param_table[] = {
     /* section, key, type, offset, size, unit, default, min, max, min_excl, max_excl, choices, help */
-    {"assembly", "width", CDEM_PTYPE_DOUBLE, P_OFF(width), 0, "units", "10", 10, 100, 0, 0, NULL,
-     "assembly width in model units"},
-    {"assembly", "height", CDEM_PTYPE_DOUBLE, P_OFF(height), 0, "units", "5", 2.5, 7.5, 0, 0, NULL,
-     "assembly height in model units"},
-    {"assembly", "unit_scaling", CDEM_PTYPE_DOUBLE, P_OFF(unit_scaling), 0, "m", "1000", 100, 1000, 0, 0, NULL,
-     "length of one model unit"},
+    {"assembly", "width", CDEM_PTYPE_DOUBLE, P_OFF(width), 0, "units", "10", 0, 1e6, 1, 0, NULL,
+     "assembly width in model units (cdem's box: 10 to 100; beyond it, bounded by the memory the run needs, at least 8 largest diameters)"},
+    {"assembly", "height", CDEM_PTYPE_DOUBLE, P_OFF(height), 0, "units", "5", 0, 1e6, 1, 0, NULL,
+     "assembly height in model units (cdem's box: 2.5 to 7.5; beyond it, bounded by the memory the run needs, at least 8 largest diameters)"},
+    {"assembly", "unit_scaling", CDEM_PTYPE_DOUBLE, P_OFF(unit_scaling), 0, "m", "1000", 1, 1e6, 0, 0, NULL,
+     "length of one model unit (cdem: 100 to 1000; the contact constants scale with the radius below 1000 m, docs/solver.md)"},
     {"assembly", "half_radii", CDEM_PTYPE_BOOL, P_OFF(half_radii), 0, "", "off", 0, 1, 0, 0, NULL,
-     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step)"},
+     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step); radius_scale = 0.5 is the same"},
+    {"assembly", "radius_scale", CDEM_PTYPE_DOUBLE, P_OFF(radius_scale), 0, "", "1", 0.001, 1000, 0, 0, NULL,
+     "the four element radii 0.05, 0.075, 0.1, 0.125 units times this (the paper's distribution kept): 0.5 is cdem's half radii, 0.1 cdem2D's finer assemblies; elements per area grow as 1/radius_scale^2, the time step shrinks with radius_scale"},
     {"assembly", "wall_height_multiplier", CDEM_PTYPE_INT, P_OFF(wall_height_multiplier), 0, "", "1", 1, 4, 0, 0, NULL,
      "lateral wall height as a multiple of the assembly height"},
     {"assembly", "base_spacing", CDEM_PTYPE_DOUBLE, P_OFF(base_spacing), 0, "wall radii", "2", 1, 2, 0, 0, NULL,
@@ -988,6 +990,10 @@ void cdem_rule_add(cdem_rule_log *log, const char *fmt, ...) {
         log->len += (size_t)w < log->cap - log->len ? (size_t)w : log->cap - log->len - 1;
 }
 
+double cdem_params_radius_scale(const cdem_params *p) {
+    return p->radius_scale * (p->half_radii ? 0.5 : 1.0);
+}
+
 int cdem_params_prefix_ok(const char *prefix) {
     if (!prefix || !prefix[0] || prefix[0] == '.' || prefix[0] == '-' || strlen(prefix) > 64)
         return 0;
@@ -1055,6 +1061,27 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
     if (log.count > 0) /* ranges first: the cross rules below assume sane values */
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
 
+    /* the size of the assembly against its elements (issue 33: no longer cdem's box of 10 to
+     * 100 by 2.5 to 7.5 units; the memory a run needs is checked before it starts, with the
+     * machine's own memory, by cdem-run) */
+    if (p->half_radii && p->radius_scale != 1.0) {
+        cdem_params_format_number(p->radius_scale, v1, sizeof v1);
+        cdem_rule_add(&log,
+                      "half_radii = on and radius_scale = %s: choose one (half_radii is "
+                      "radius_scale = 0.5)",
+                      v1);
+    } else {
+        const double scale = cdem_params_radius_scale(p), least = 8.0 * 2.0 * 0.125 * scale;
+        cdem_params_format_number(least, v2, sizeof v2);
+        if (p->width < least || p->height < least) {
+            cdem_params_format_number(p->width < least ? p->width : p->height, v1, sizeof v1);
+            cdem_rule_add(&log,
+                          "%s = %s units: an assembly must be at least 8 of its largest elements "
+                          "(diameter %.6g units) wide and high, i.e. >= %s units: enlarge it or "
+                          "make the elements smaller ([assembly] radius_scale)",
+                          p->width < least ? "width" : "height", v1, 0.25 * scale, v2);
+        }
+    }
     /* a file-name prefix, not a path (issue 35, item 8: "../../etc/x" was accepted) */
     if (!cdem_params_prefix_ok(p->prefix))
         cdem_rule_add(&log, "[output] prefix = \"%.60s\": %s", p->prefix, CDEM_PREFIX_RULE);

@@ -91,6 +91,8 @@ typedef struct {
     double height;              /* assembly height in model units, 2.5-7.5 */
     double unit_scaling;        /* metres per model unit, 100-1000 */
     int half_radii;             /* 0/1: radii 0.025..0.0625 units instead of 0.05..0.125 */
+    double radius_scale;        /* the four radii as a multiple of 0.05..0.125 units (> 0; 1:
+                                   cdem's; half_radii is 0.5); cdem_params_radius_scale */
     int wall_height_multiplier; /* lateral wall height = multiplier * assembly height, 1-4 */
     double base_spacing;        /* centre spacing of the base discs in wall radii, 1-2 */
     long seed;                  /* random seed of the packing (and all other randomness), >= 0 */
@@ -268,5 +270,9 @@ int cdem_params_prefix_ok(const char *prefix);
 #define CDEM_PREFIX_RULE                                                                           \
     "must be a file-name prefix: 1 to 64 letters, digits, '_', '-' or '.', not starting with "     \
     "'.' or '-' (e.g. cdem)"
+
+/* The radii's multiple of 0.05..0.125 units that p asks for: radius_scale, halved by
+ * half_radii (cdem's option; the two together are refused by cdem_params_validate). */
+double cdem_params_radius_scale(const cdem_params *p);
 
 #endif

@@ -479,7 +479,7 @@ int main(int argc, char **argv) {
         goto fail;
     }
     cdem_model m;
-    if (cdem_bc_derive_model(&p, &m, &err) != CDEM_OK)
+    if (cdem_bc_derive_model(&p, &m, &err) != CDEM_OK || cdem_run_check_memory(&p, &err) != CDEM_OK)
         goto fail;
     int running = !a.summary_only && !a.dry_run;
     if (running) {

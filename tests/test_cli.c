@@ -193,6 +193,50 @@ static void test_cli_summary_checks_the_fault_file(void **state) {
     }
 }
 
+/* Any assembly and element size (issue 33): the paper's Fig. 14 set-up (a cdem2D model: 125 m
+ * per unit, 6.25 x 2.8 km, average radius ~10 m) is accepted and builds 46,335 +- 3 % free
+ * elements; a model too large for the machine is refused naming the memory it needs and the
+ * memory there is; sizes are checked against the elements, not cdem's box. */
+static void test_cli_any_size(void **state) {
+    const cli_ctx *c = *state;
+    assert_int_equal(run(c, "-s assembly.unit_scaling=125 -s assembly.width=50 -s "
+                            "assembly.height=22.4 -s material.element_cohesion=6e7 --summary"),
+                     0);
+    char *o = slurp(c, "out.txt");
+    const char *at = strstr(o, "free elements:");
+    assert_non_null(at);
+    const long free_elements = atol(at + strlen("free elements:"));
+    if (free_elements < 44945 || free_elements > 47725) /* 46,335 +- 3 % */
+        fail_msg("Fig. 14 set-up: %ld free elements, the paper 46,335", free_elements);
+    free(o);
+    /* cdem2D's finer elements: a tenth of the radii, 100 times the elements per area */
+    assert_int_equal(run(c, "-s assembly.radius_scale=0.1 -s assembly.width=4 -s "
+                            "assembly.height=2 --summary"),
+                     0);
+    o = slurp(c, "out.txt");
+    assert_has(o, "radii:                       0.005-0.0125 units (0.1 x the full radii)");
+    free(o);
+    /* too large for any machine: refused by its memory, named */
+    assert_int_equal(run(c, "-s assembly.width=100000 -s assembly.height=100000 -s "
+                            "assembly.radius_scale=0.01 --summary"),
+                     1);
+    char *e = slurp(c, "err.txt");
+    assert_has(e, "elements and need about");
+    assert_has(e, "GB of memory");
+    assert_has(e, "but this machine has");
+    free(e);
+    /* smaller than 8 elements across; half radii with a scale */
+    assert_int_equal(run(c, "-s assembly.height=1.5 --summary"), 1);
+    e = slurp(c, "err.txt");
+    assert_has(e, "height = 1.5 units: an assembly must be at least 8 of its largest elements");
+    free(e);
+    assert_int_equal(run(c, "-s assembly.half_radii=on -s assembly.radius_scale=0.25 --summary"),
+                     1);
+    e = slurp(c, "err.txt");
+    assert_has(e, "half_radii = on and radius_scale = 0.25: choose one");
+    free(e);
+}
+
 /* output.prefix names files inside an output folder, never a path (issue 35, item 8). */
 static void test_cli_output_prefix_is_a_name(void **state) {
     const cli_ctx *c = *state;
@@ -352,6 +396,7 @@ int main(void) {
         cmocka_unit_test_setup_teardown(test_cli_params_markdown, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_summary_checks_the_fault_file, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_output_prefix_is_a_name, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_any_size, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_parameters_from_stdin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

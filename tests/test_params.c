@@ -711,8 +711,10 @@ static void test_params_write_round_trip_defaults(void **state) {
     cdem_error err;
     cdem_params_defaults(&p);
     char *text = write_to_string(&p);
-    assert_non_null(strstr(text, "[assembly]\n# assembly width in model units (units; 10 to 100; "
-                                 "default 10)\nwidth = 10\n"));
+    assert_non_null(strstr(text, "[assembly]\n# assembly width in model units (cdem's box: 10 to "
+                                 "100; beyond it, bounded by the memory the run needs, at least 8 "
+                                 "largest diameters) (units; > 0 and <= 1000000; default 10)\n"
+                                 "width = 10\n"));
     assert_non_null(strstr(text, "gravity = 9.81\n"));
     assert_int_equal(parse(&q, "", &err), CDEM_OK);
     memset(&q, 0, sizeof q); /* parse over zeros: every key must be present in the text */

@@ -8,6 +8,7 @@
  * steps is kept unrounded so increments do not drift over long runs. */
 #include "model.h"
 
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -44,7 +45,7 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "cannot derive the model: sea_level_rise = %d",
                          (int)p->sea_level_rise);
 
-    double scale = p->unit_scaling * (p->half_radii ? 0.5 : 1.0);
+    double scale = p->unit_scaling * cdem_params_radius_scale(p);
     double sum = 0.0;
     for (int i = 0; i < CDEM_NUM_RADII; i++) {
         m->radius[i] = base_radius[i] * scale;
@@ -137,7 +138,10 @@ long cdem_model_estimate_elements(const cdem_params *p) {
     if (!p || !(p->width > 0) || !(p->height > 0))
         return 0;
     /* 2121 elements fill the default 10 x 5 unit box at full radii (the paper's count);
-     * half radii pack four times as many per unit area. */
-    double per_unit2 = 2121.0 / 50.0 * (p->half_radii ? 4.0 : 1.0);
-    return lround(per_unit2 * p->width * p->height);
+     * elements per area grow as the inverse square of the radii (half radii: four times). */
+    const double scale = cdem_params_radius_scale(p);
+    if (!(scale > 0))
+        return 0;
+    const double n = 2121.0 / 50.0 / (scale * scale) * p->width * p->height;
+    return n < 9e18 ? lround(n) : LONG_MAX;
 }

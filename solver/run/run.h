@@ -39,6 +39,19 @@ typedef struct {
  * own rules (the growth strata's), all violations in one message (cdem_params_validate). */
 cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err);
 
+/* The memory a run of p needs (bytes): CDEM_RUN_MEMORY_FIXED plus CDEM_RUN_MEMORY_PER_ELEMENT
+ * for each element cdem_model_estimate_elements expects, the peak resident size measured on
+ * cdem-run runs of 2,400 to 1,000,000 elements (docs/performance.md, "Scale"), checkpoints
+ * included. */
+#define CDEM_RUN_MEMORY_FIXED       (32.0 * 1024 * 1024)
+#define CDEM_RUN_MEMORY_PER_ELEMENT 1100.0
+double cdem_run_memory_estimate(const cdem_params *p);
+
+/* A model larger than the machine can hold is refused before anything is built
+ * (CDEM_ERR_NOMEM, naming the elements, the memory needed and the memory available); a
+ * machine whose available memory cannot be read is not refused. */
+cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err);
+
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was
  * requested (the file is valid and says where it stopped), other codes on failure. */
 cdem_status cdem_run(const cdem_params *p, const cdem_run_options *opt, cdem_error *err);

@@ -39,58 +39,43 @@ cdem_status cdem_run_capture(const cdem_run_ctx *r, cdem_snapshot *snap, cdem_er
     return cdem_sediment_snapshot_put(&r->sed, snap, err);
 }
 
-/* The setting lines of a parameter file's text (n bytes), without its comments and blank
- * lines, into a malloc'd string: what a checkpoint's parameter set is compared by. The
- * comments are help text; a build that words them differently runs the same model. */
-static char *settings_of(const char *text, size_t n) {
-    char *out = malloc(n + 1);
-    if (!out)
-        return NULL;
-    size_t o = 0;
-    for (size_t i = 0; i < n;) {
-        size_t end = i;
-        while (end < n && text[end] != '\n')
-            end++;
-        size_t first = i;
-        while (first < end && (text[first] == ' ' || text[first] == '\t'))
-            first++;
-        if (first < end && text[first] != '#') {
-            memcpy(out + o, text + i, end - i);
-            o += end - i;
-            out[o++] = '\n';
-        }
-        i = end + 1;
-    }
-    out[o] = '\0';
-    return out;
-}
-
-/* The checkpoint's parameter set (run.params) has this run's settings. */
-static cdem_status check_params(const cdem_snapshot *snap, const char *expected, cdem_error *err) {
+/* The checkpoint's parameter set (run.params, the effective parameter file of the run that
+ * wrote it) has this run's values: compared by value, parameter by parameter, after parsing
+ * it over the defaults. Not by its text: the help comments are reworded between builds, and
+ * a parameter added since reads as its default, which is the value the earlier build ran
+ * with (the torn-index evidence of issue 35 was written before two such changes). */
+static cdem_status check_params(const cdem_snapshot *snap, const cdem_params *p, cdem_error *err) {
     const cdem_snapshot_array *a = NULL;
     CDEM_TRY(cdem_ckpt_get_array(snap, "run", "params", CDEM_SNAP_U8, SIZE_MAX, &a, err));
-    char *have = settings_of(a->data, a->count), *want = settings_of(expected, strlen(expected));
-    cdem_status st = CDEM_OK;
-    if (!have || !want) {
-        st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory comparing a checkpoint's parameters");
-    } else if (strcmp(have, want) != 0) {
-        size_t k = 0;
-        while (have[k] && have[k] == want[k])
-            k++;
-        size_t b = k;
-        while (b > 0 && want[b - 1] != '\n')
-            b--;
-        size_t end = b;
-        while (want[end] && want[end] != '\n' && end - b < 80)
-            end++;
-        st = CDEM_FAIL(err, CDEM_ERR_CONFLICT,
-                       "checkpoint run.params: the parameter set of the checkpoint differs from "
-                       "this run's (first difference in \"%.*s\")",
-                       (int)(end - b), want + b);
+    char *text = malloc(a->count + 1);
+    if (!text)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory comparing a checkpoint's parameters");
+    memcpy(text, a->data, a->count);
+    text[a->count] = '\0';
+    cdem_params stored;
+    cdem_params_defaults(&stored);
+    cdem_error perr;
+    cdem_error_clear(&perr);
+    cdem_status st = cdem_params_parse_text(&stored, text, "checkpoint run.params", &perr);
+    free(text);
+    if (st != CDEM_OK)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint run.params: its parameter set does not parse with this "
+                         "cdem-run: %.600s",
+                         perr.msg);
+    size_t count = 0;
+    const cdem_param_def *table = cdem_params_table(&count);
+    for (size_t i = 0; i < count; i++) {
+        char want[2 * CDEM_PATH_MAX + 64], have[2 * CDEM_PATH_MAX + 64];
+        cdem_params_format_value(p, &table[i], want, sizeof want);
+        cdem_params_format_value(&stored, &table[i], have, sizeof have);
+        if (strcmp(want, have) != 0)
+            return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                             "checkpoint run.params: the parameter set of the checkpoint differs "
+                             "from this run's ([%s] %s = %.200s in the checkpoint, %.200s here)",
+                             table[i].section, table[i].key, have, want);
     }
-    free(have);
-    free(want);
-    return st;
+    return CDEM_OK;
 }
 
 /* Replaces the state of a set-up run by the checkpoint's. */
@@ -111,7 +96,7 @@ cdem_status run_restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *err) 
                          "resumes bit-identically only with the version that started it",
                          (int)(ver->count > 64 ? 64 : ver->count), (const char *)ver->data,
                          CDEM_VERSION);
-    CDEM_TRY(check_params(snap, r->ckpt.params_eff, err));
+    CDEM_TRY(check_params(snap, r->p, err));
     const long total = r->m.total_steps;
     int64_t step = 0, next_inc = 0, next_inc_step = 0, lws = 0, lci = 0, removed = 0, eroded = 0,
             k_def = 0;

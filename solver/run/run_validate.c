@@ -1,11 +1,18 @@
 /* run_validate: every rule the parameters of a cdem-run run obey, checked before anything is
  * built: the table's ranges and rules (common/params.c) and, in the same message, the
  * solver's own: the boundary mode's (its validate hook and excludes, and whether it inverts:
- * modes/bc_registry.c) and the growth strata's (packing/sediment.c). */
+ * modes/bc_registry.c) and the growth strata's (packing/sediment.c). And the one limit on
+ * the size of a model that is not a rule of its parameters: the memory of the machine it
+ * runs on (cdem_run_check_memory). */
 #include "run.h"
 
 #include "bc.h"
+#include "model.h"
 #include "sediment.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
 
 /* The rules of the solver's modules, after the table's. */
 static void solver_rules(const cdem_params *p, cdem_rule_log *log) {
@@ -15,4 +22,40 @@ static void solver_rules(const cdem_params *p, cdem_rule_log *log) {
 
 cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err) {
     return cdem_params_validate(p, solver_rules, err);
+}
+
+/* Memory available to a new process (bytes): MemAvailable of /proc/meminfo, else the free
+ * physical pages; 0 when neither can be read. */
+static double memory_available(void) {
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f) {
+        char line[256];
+        unsigned long long kb = 0;
+        while (fgets(line, sizeof line, f))
+            if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1)
+                break;
+        fclose(f);
+        if (kb > 0)
+            return (double)kb * 1024.0;
+    }
+    const long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? (double)pages * (double)size : 0.0;
+}
+
+double cdem_run_memory_estimate(const cdem_params *p) {
+    const double n = (double)cdem_model_estimate_elements(p);
+    return CDEM_RUN_MEMORY_FIXED + n * CDEM_RUN_MEMORY_PER_ELEMENT;
+}
+
+cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
+    const double need = cdem_run_memory_estimate(p), have = memory_available();
+    if (have <= 0.0 || need <= have)
+        return CDEM_OK;
+    return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                     "the model would hold about %ld elements and need about %.3g GB of memory "
+                     "(%.0f bytes per element, measured), but this machine has %.3g GB "
+                     "available: use larger elements ([assembly] radius_scale), a smaller "
+                     "assembly, or a machine with more memory",
+                     cdem_model_estimate_elements(p), need / 1e9, CDEM_RUN_MEMORY_PER_ELEMENT,
+                     have / 1e9);
 }

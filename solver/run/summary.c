@@ -80,7 +80,14 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "random seed", "%ld", p->seed);
 
     heading(f, "Element radii and masses");
-    line(f, "radii", "%s", p->half_radii ? "half (0.025-0.0625 units)" : "full (0.05-0.125 units)");
+    const double scale = cdem_params_radius_scale(p);
+    if (scale == 1.0)
+        line(f, "radii", "full (0.05-0.125 units)");
+    else if (scale == 0.5)
+        line(f, "radii", "half (0.025-0.0625 units)");
+    else
+        line(f, "radii", "%.6g-%.6g units (%g x the full radii)", 0.05 * scale, 0.125 * scale,
+             scale);
     for (int i = 0; i < CDEM_NUM_RADII; i++) {
         char label[32];
         snprintf(label, sizeof label, "radius %d", i + 1);
