@@ -47,7 +47,9 @@ def main(argv):
     free0 = int(m.group(1)) if m else None
     boundary = first["elements"] - free0 if free0 is not None else 0
     free_last = last["elements"] - boundary
-    radii = "half" if "radii:                       half" in info["summary"] else "default"
+    m = re.search(r"radii:\s+(full|half|[\d.e+-]+-[\d.e+-]+ units \(([\d.e+-]+) x)", info["summary"])
+    radii = ("default" if not m or m.group(1) == "full" else "half" if m.group(1) == "half"
+             else "%s x the default" % m.group(2))
     out = ["### %s" % name, ""]
     out.append(
         "- run: %s radii, %d free elements at the start, %d at the end; %d increments; "
