@@ -149,6 +149,7 @@ static void test_calib_refuses_with_the_reachable_range(void **state) {
             if (pts[i].x[1] == 5e6)
                 at = i;
         assert_true(at < n);
+        assert_int_equal(s.at, at);
         assert_true(fabs(pts[at].y[0] - below[t][0]) <= 3);
     }
     /* phi above what mu = 1 gives (52.8 deg), C reported only */
@@ -159,6 +160,7 @@ static void test_calib_refuses_with_the_reachable_range(void **state) {
     assert_int_equal(s.pair, 0);
     assert_int_equal(s.above, 1);
     assert_near(s.reach_hi_x, 1, 0);
+    assert_near(pts[s.at].x[0], 1, 0);
     assert_true(s.reach_hi < 60 - 1.5);
     assert_true(n <= 8);
     /* within tolerance at the bound is no refusal: phi 54 +- 1.5 at mu = 1 (52.8 deg) */
@@ -199,6 +201,30 @@ static void test_calib_tolerance_is_inclusive_and_scored(void **state) {
     two[1].y[1] = 6.9;
     assert_int_equal(cdem_calib_next(&p, two, 2, &s, &err), CDEM_OK);
     assert_int_equal(s.best, 1);
+}
+
+/* Replicates: points of one input are averaged, so that a lucky packing at the best point
+ * does not hold its input (a reduced-size calibration kept mu = 0.15 for four series: its
+ * first series there gave phi 30.3 deg, the three after 27.9 to 28.2). */
+static void test_calib_replicates_are_averaged(void **state) {
+    (void)state;
+    cdem_calib_problem p = problem(30, 4.5);
+    p.pair[0].tol = 1.2;
+    p.pair[1].tol = 0.6;
+    const cdem_calib_point pts[5] = {
+        {.x = {0.25, 5e9}, .y = {35.8, 3.372}, .err = {1.5, 0.9}},
+        {.x = {0.15, 5e10}, .y = {30.3, 5.151}, .err = {2.2, 1.2}},
+        {.x = {0.15, 3.353e10}, .y = {28.13, 4.649}, .err = {1.4, 0.7}},
+        {.x = {0.15, 2.663e10}, .y = {27.85, 4.341}, .err = {0.8, 0.4}},
+        {.x = {0.15, 3.019e10}, .y = {28.17, 4.499}, .err = {1.2, 0.6}},
+    };
+    cdem_calib_step s;
+    cdem_error err;
+    assert_int_equal(cdem_calib_next(&p, pts, 5, &s, &err), CDEM_OK);
+    assert_int_equal(s.verdict, CDEM_CALIB_RUN);
+    assert_int_equal(s.best, 1);
+    /* mu at 0.15 averages 28.6 deg, 1.4 below: up by the secant to 0.25 (35.8 deg) */
+    assert_true(s.x[0] > 0.16 && s.x[0] < 0.19);
 }
 
 static void test_calib_reports_monotonicity_violations(void **state) {
@@ -302,6 +328,7 @@ int main(void) {
         cmocka_unit_test(test_calib_converges_with_packing_noise),
         cmocka_unit_test(test_calib_refuses_with_the_reachable_range),
         cmocka_unit_test(test_calib_tolerance_is_inclusive_and_scored),
+        cmocka_unit_test(test_calib_replicates_are_averaged),
         cmocka_unit_test(test_calib_reports_monotonicity_violations),
         cmocka_unit_test(test_calib_budget_stall_and_restart),
         cmocka_unit_test(test_calib_first_point_and_checks),

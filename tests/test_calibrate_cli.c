@@ -140,10 +140,12 @@ static void test_calibrate_refuses_a_target_out_of_reach(void **state) {
     int rc = run(cmd, out, sizeof out);
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, "refused: the target friction angle 70 deg is out of reach"));
-    assert_non_null(strstr(out, "at its upper bound (0.3)"));
-    assert_non_null(strstr(out, "Reachable friction angle found: "));
+    assert_non_null(strstr(out, "With C0 fixed at 5e+09, mu at its upper bound (0.3, series "));
+    assert_non_null(strstr(out, "friction angle can go no higher here"));
+    assert_non_null(strstr(out, "Reachable friction angle found (series with C0 fixed at "
+                                "5e+09): "));
     assert_non_null(strstr(out, "cdem-strain calibrate: refused: the target friction angle 70 "
-                                "deg is out of reach (reachable: "));
+                                "deg is out of reach (reachable with C0 fixed at 5e+09: "));
     assert_non_null(strstr(out, "mu = 0.3, C0 = 5e+09 N"));
     assert_null(strstr(out, "[material]"));
     assert_true(exists("w2", "calibration.png")); /* the nearest series' picture */

@@ -13,6 +13,7 @@
 #include "mohr.h"
 #include "params.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -627,20 +628,30 @@ static int say_refusal(cal_state *c, const cdem_calib_step *step) {
     const char *what = k == 0 ? "friction angle" : c->use_ucs ? "unconfined strength" : "cohesion";
     const char *unit = k == 0 ? "deg" : "MPa", *in = k == 0 ? "mu" : "C0";
     if (step->verdict == CDEM_CALIB_UNREACHABLE) {
-        const double bound = step->above ? c->prob.pair[k].hi : c->prob.pair[k].lo;
+        const int other = 1 - k;
+        const char *oname = other == 0 ? "phi" : c->use_ucs ? "the unconfined strength" : "C";
+        char with[160];
+        if (c->prob.pair[other].fixed)
+            snprintf(with, sizeof with, "with %s fixed at %.4g", other == 0 ? "mu" : "C0",
+                     other == 0 ? c->mu0 : c->c00);
+        else
+            snprintf(with, sizeof with, "with %s on its target (within 2 tolerances)", oname);
+        const double target = k == 0 ? a->phi : c->c_target;
+        const double tol = k == 0 ? a->phi_tol : c->c_tol;
+        const cal_measure *at = &c->meas[step->at];
+        const double y_at = c->pts[step->at].y[k];
         say(&c->rep,
-            "refused: the target %s %g %s is out of reach. Where the other target is met, %s "
-            "goes from %.3g %s (%s = %.4g) to %.3g %s (%s = %.4g) over the series, and %s at "
-            "its %s bound (%.4g) gives %.3g %s, %s the target by more than its tolerance. "
-            "Reachable %s found: %.3g to %.3g %s.\n",
-            what, k == 0 ? a->phi : c->c_target, unit, what, step->reach_lo, unit, in,
-            step->reach_lo_x, step->reach_hi, unit, in, step->reach_hi_x, in,
-            step->above ? "upper" : "lower", bound, step->above ? step->reach_hi : step->reach_lo,
-            unit, step->above ? "below" : "above", what, step->reach_lo, step->reach_hi, unit);
+            "refused: the target %s %g %s is out of reach. %c%s, %s at its %s bound (%.4g, "
+            "series %zu) gives %.3g %s, %s than %g %s %g: %s can go no %s here. Reachable %s "
+            "found (series %s): %.3g to %.3g %s.\n",
+            what, target, unit, toupper((unsigned char)with[0]), with + 1, in,
+            step->above ? "upper" : "lower", k == 0 ? at->mu : at->c0, step->at + 1, y_at, unit,
+            step->above ? "less" : "more", target, step->above ? "-" : "+", tol, what,
+            step->above ? "higher" : "lower", what, with, step->reach_lo, step->reach_hi, unit);
         fprintf(stderr,
-                "cdem-strain calibrate: refused: the target %s %g %s is out of reach (reachable: "
-                "%.3g to %.3g %s with %s in %.4g..%.4g); see %s\n",
-                what, k == 0 ? a->phi : c->c_target, unit, step->reach_lo, step->reach_hi, unit, in,
+                "cdem-strain calibrate: refused: the target %s %g %s is out of reach (reachable "
+                "%s: %.3g to %.3g %s, %s in %.4g..%.4g); see %s\n",
+                what, target, unit, with, step->reach_lo, step->reach_hi, unit, in,
                 c->prob.pair[k].lo, c->prob.pair[k].hi, c->report_path);
     } else if (step->verdict == CDEM_CALIB_NOT_MONOTONE) {
         const cal_measure *p0 = &c->meas[step->bad[0]], *p1 = &c->meas[step->bad[1]];

@@ -159,14 +159,15 @@ static int unreachable(const cdem_calib_problem *p, const cdem_calib_point *pts,
     const cdem_calib_pair *q = &p->pair[k];
     const double t_lo = to_t(q, q->lo), t_hi = to_t(q, q->hi), eps = 1e-9 * (t_hi - t_lo);
     int found = 0, above = 0;
+    size_t at = 0;
     for (size_t i = 0; i < n && !found; i++) {
         if (!others_near(p, &pts[i], k))
             continue;
         const double t = to_t(q, pts[i].x[k]), y = pts[i].y[k];
         if (t <= t_lo + eps && y > q->target + q->tol)
-            found = 1, above = 0;
+            found = 1, above = 0, at = i;
         else if (t >= t_hi - eps && y < q->target - q->tol)
-            found = 1, above = 1;
+            found = 1, above = 1, at = i;
     }
     if (!found)
         return 0;
@@ -182,6 +183,7 @@ static int unreachable(const cdem_calib_problem *p, const cdem_calib_point *pts,
     out->verdict = CDEM_CALIB_UNREACHABLE;
     out->pair = k;
     out->above = above;
+    out->at = at;
     out->reach_lo = pts[lo].y[k];
     out->reach_lo_x = pts[lo].x[k];
     out->reach_hi = pts[hi].y[k];
@@ -330,33 +332,45 @@ cdem_status cdem_calib_next(const cdem_calib_problem *p, const cdem_calib_point 
     }
     /* each searched pair steps on the points where the other outputs are near their
      * targets (the other inputs about where they must end: C depends on mu as much as on
-     * C0), or on all points when fewer than two such points differ in its input */
+     * C0), or on all points when fewer than two such points differ in its input; points of
+     * the same input are replicates, their outputs averaged (a lucky packing must not hold
+     * an input where its neighbours say it is wrong) */
     double t_next[CDEM_CALIB_MAX_PAIRS] = {0};
     double t[MAX_POINTS_1D], y[MAX_POINTS_1D];
+    size_t count[MAX_POINTS_1D];
     for (size_t k = 0; k < p->n_pairs; k++) {
         const cdem_calib_pair *q = &p->pair[k];
         if (q->fixed)
             continue;
+        const double t_best = to_t(q, pts[best].x[k]);
         for (int subset = 1; subset >= 0; subset--) {
-            /* nb: the best point when it is among them, else the one nearest the target */
-            size_t m = 0, nb = 0;
-            int has_best = 0;
-            for (size_t i = 0; i < n && m < MAX_POINTS_1D; i++) {
-                if (subset && !others_near(p, &pts[i], k))
+            size_t m = 0;
+            for (size_t i = 0; i < n; i++) {
+                if (subset && i != best && !others_near(p, &pts[i], k))
                     continue;
-                t[m] = to_t(q, pts[i].x[k]);
-                y[m] = pts[i].y[k];
-                if (i == best)
-                    nb = m, has_best = 1;
-                else if (!has_best && fabs(y[m] - q->target) < fabs(y[nb] - q->target))
-                    nb = m;
-                m++;
+                const double ti = to_t(q, pts[i].x[k]);
+                size_t j = 0;
+                while (j < m && t[j] != ti)
+                    j++;
+                if (j == m) {
+                    if (m == MAX_POINTS_1D)
+                        continue;
+                    t[m] = ti;
+                    y[m] = 0;
+                    count[m++] = 0;
+                }
+                y[j] += pts[i].y[k];
+                count[j]++;
             }
-            size_t distinct = 0;
-            for (size_t i = 1; i < m; i++)
-                distinct += t[i] != t[0];
-            if (subset && (m < 2 || distinct == 0))
+            if (subset && m < 2)
                 continue;
+            /* nb: the best point's input (always among them), its outputs averaged */
+            size_t nb = 0;
+            for (size_t j = 0; j < m; j++) {
+                y[j] /= (double)count[j];
+                if (t[j] == t_best)
+                    nb = j;
+            }
             propose_1d(q, t, y, m, nb, &t_next[k]);
             break;
         }

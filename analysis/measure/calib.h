@@ -10,9 +10,11 @@
  * whole map. But the maps are coupled: in the biaxial test C rises with mu as much as with C0
  * (at 1000 m the damping makes C, and more of it the higher the friction), so a cohesion is
  * reachable at one friction angle and out of reach at another. Hence:
- *   - each pair is searched as a one-dimensional root, on the points where the other
- *     outputs are within 2 tolerances of their targets (the other inputs about where they
- *     must end), or on all points while fewer than two such points differ in its input;
+ *   - each pair is searched as a one-dimensional root, on the best point and the points
+ *     where the other outputs are within 2 tolerances of their targets (the other inputs
+ *     about where they must end), or on all points while these share one input; points of
+ *     the same input are replicates, their outputs averaged (one lucky packing must not hold
+ *     an input where the others say it is wrong);
  *   - a pair whose target is bracketed (a point below, a point above) takes the secant
  *     through the two points nearest the target when it falls in the bracket's inner 80 %,
  *     else false position kept there (so a far end, such as a bound, cannot make it creep);
@@ -91,6 +93,7 @@ typedef struct {
     double reach_lo, reach_hi;      /* UNREACHABLE: the pair's outputs measured, least and most */
     double reach_lo_x, reach_hi_x;  /* ... and the inputs they were measured at */
     int above;                      /* UNREACHABLE: 1 the target is above the range, 0 below */
+    size_t at;                      /* UNREACHABLE: the point at the bound that shows it */
     size_t bad[2];                  /* NOT_MONOTONE: the two points; STALLED: bad[0] */
 } cdem_calib_step;
 
