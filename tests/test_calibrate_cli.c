@@ -3,10 +3,10 @@
  * 20 MPa): the whole loop found in one series with its fresh-seed check, [material] block,
  * report and picture; a second invocation that runs nothing (finished runs are read); a
  * damaged run file run again; a work folder of another model refused; a target out of reach
- * refused with the range found; runs that fail named with their log; a Slurm job array
- * through examples/slurm/sweep.sh under a stand-in sbatch; usage errors. The search itself
- * is test_calib.c; the loop at a larger size and its resumption after a kill are in
- * tests/validate/run_validate.sh. */
+ * refused with the range found; the unconfined strength as the target; runs that fail named with
+ * their log; a Slurm job array through examples/slurm/sweep.sh under a stand-in sbatch; usage
+ * errors. The search itself is test_calib.c; the loop at a larger size and its resumption after a
+ * kill are in tests/validate/run_validate.sh. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -214,6 +214,26 @@ static void test_calibrate_through_slurm(void **state) {
     assert_non_null(strstr(out, "sbatch not found on PATH"));
 }
 
+static void test_calibrate_unconfined_strength(void **state) {
+    (void)state;
+    static char out[65536];
+    char cmd[8192];
+    /* the unconfined strength instead of C (the 0 MPa tests' peak), phi only reported */
+    snprintf(cmd, sizeof cmd,
+             "'%s' calibrate '%s' --ucs 5 --ucs-tol 50 " SHORT " --check-seeds 0 --work w6", g_exe,
+             g_model);
+    int rc = run(cmd, out, sizeof out);
+    if (rc != 0)
+        print_error("%s\n", out);
+    assert_int_equal(rc, 0);
+    assert_non_null(
+        strstr(out, "targets: phi reported (mu = 0.25 fixed), unconfined = 5 +- 50 MPa"));
+    assert_non_null(strstr(out, ", unconfined "));
+    assert_non_null(strstr(out, "found in 1 series"));
+    assert_null(strstr(out, "fresh-seed check"));
+    assert_true(exists("w6", "material.ini"));
+}
+
 static void test_calibrate_usage_errors(void **state) {
     (void)state;
     static char out[16384];
@@ -270,6 +290,7 @@ int main(void) {
         cmocka_unit_test(test_calibrate_refuses_a_target_out_of_reach),
         cmocka_unit_test(test_calibrate_names_a_failed_run),
         cmocka_unit_test(test_calibrate_through_slurm),
+        cmocka_unit_test(test_calibrate_unconfined_strength),
         cmocka_unit_test(test_calibrate_usage_errors),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -193,7 +193,6 @@ static cdem_status run_local(const cdem_calib_runner *r, cdem_calib_run *runs, c
                 st = CDEM_ERR_IO;
             else
                 active++;
-            run->ran = 1;
             next++;
         }
         if (active == 0)
@@ -226,7 +225,6 @@ static cdem_status run_slurm(const cdem_calib_runner *r, cdem_calib_run *runs, c
         for (int k = 0; k < run->n_sets; k++)
             fprintf(f, " -s %s", run->sets[k]);
         fprintf(f, "\n");
-        run->ran = 1;
     }
     if (fclose(f) != 0)
         return CDEM_FAIL(err, CDEM_ERR_IO, "cannot write %s", params);
