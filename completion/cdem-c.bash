@@ -22,7 +22,7 @@ complete -o filenames -F _cdem_run cdem-run
 _cdem_strain() {
     local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"
     if [ "$COMP_CWORD" -eq 1 ]; then
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
         [ ${#COMPREPLY[@]} -eq 0 ] && COMPREPLY=($(compgen -f -- "$cur"))
         return
     fi
@@ -103,6 +103,30 @@ _cdem_strain() {
             --height) return ;;
         esac
         opts="--increment -o --output --width --height -h --help" ;;
+    calibrate)
+        case "$prev" in
+            --phi) return ;;
+            --phi-tol) return ;;
+            --cohesion) return ;;
+            --cohesion-tol) return ;;
+            --ucs) return ;;
+            --ucs-tol) return ;;
+            --mu-range) return ;;
+            --c0-range) return ;;
+            --pressures) return ;;
+            --seeds) return ;;
+            --check-seeds) return ;;
+            --series) return ;;
+            --margin) return ;;
+            --jobs) return ;;
+            --nice) return ;;
+            --slurm) return ;;
+            --work) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+            --cdem-run) return ;;
+            -s|--set) return ;;
+            -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+        esac
+        opts="--phi --phi-tol --cohesion --cohesion-tol --ucs --ucs-tol --mu-range --c0-range --pressures --seeds --check-seeds --series --margin --jobs --nice --slurm --work --cdem-run -s --set -o --output -h --help" ;;
     voids)
         case "$prev" in
             --increment) COMPREPLY=($(compgen -W "last equil first" -- "$cur")); return ;;
@@ -162,7 +186,7 @@ _cdem_strain() {
     quantities)
         opts="-h --help" ;;
     help)
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
         return ;;
     esac
     if [[ "$cur" == -* ]]; then

@@ -40,18 +40,20 @@ static const message_call MESSAGE_CALLS[] = {
     {"H5FAIL", 3},            /* common/h5/h5_internal.h: the run file's errors */
     {"h5i_fail_at", 5},       /* what H5FAIL calls */
     {"cdem_error_prefix", 2}, /* context put before a message on its way up */
-    {"cdem_rule_add", 2},     /* common/params.c and the solver: rules between keys, reported together */
-    {"usage_error", 1},       /* solver/main.c: cdem-run's usage errors */
-    {"cdem_cmd_usage", 2},    /* analysis/cli/cmd_support.c: cdem-strain's usage errors */
-    {"usage", 1},             /* analysis/cli/cmd_render.c: cdem_cmd_usage with render's help */
-    {"fprintf", 2},           /* only fprintf(stderr, ...) */
-    {"say_why", 3},           /* common/h5/h5_layout.c: why a value of a run file is refused */
+    {"cdem_rule_add",
+     2},                /* common/params.c and the solver: rules between keys, reported together */
+    {"usage_error", 1}, /* solver/main.c: cdem-run's usage errors */
+    {"cdem_cmd_usage", 2}, /* analysis/cli/cmd_support.c: cdem-strain's usage errors */
+    {"usage", 1},          /* analysis/cli/cmd_render.c: cdem_cmd_usage with render's help */
+    {"fprintf", 2},        /* only fprintf(stderr, ...) */
+    {"say_why", 3},        /* common/h5/h5_layout.c: why a value of a run file is refused */
 };
 #define N_CALLS (sizeof MESSAGE_CALLS / sizeof MESSAGE_CALLS[0])
 
 /* printf-like functions that print no message of the programs. */
 static const char *NOT_MESSAGES[] = {
     "line", /* common/summary.c: one line of the run summary (cdem-run --summary, stdout) */
+    "say",  /* analysis/cli/cmd_calibrate.c: calibrate's report (stdout and calibration.txt) */
     NULL,
 };
 

@@ -203,5 +203,47 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
     return st == CDEM_OK ? 0 : cdem_cmd_fail(a.cmd, NULL, &err);
 }
 
+/* The peaks of runs given by name (cdem-strain calibrate): sigma3 and q of each, N/m. */
+cdem_status cdem_cmd_mohr_peaks(const char *const *files, size_t n, double *sigma3, double *q,
+                                cdem_error *err) {
+    if (n > CDEM_PLOT_MAX_FILES)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%zu runs: at most %d at once", n,
+                         CDEM_PLOT_MAX_FILES);
+    cdem_plot_args a = {.cmd = "mohr", .help = &help, .n_files = n};
+    for (size_t i = 0; i < n; i++)
+        a.files[i] = files[i];
+    mohr_data d;
+    memset(&d, 0, sizeof d);
+    cdem_status st = mohr_read_runs(&a, &d, err);
+    for (size_t i = 0; st == CDEM_OK && i < n; i++) {
+        sigma3[i] = d.sigma3[i];
+        q[i] = d.q[i];
+    }
+    mohr_data_free(&d);
+    return st;
+}
+
+/* mohr's picture of runs given by name, with the envelope fitted to all of them
+ * (cdem-strain calibrate). */
+cdem_status cdem_cmd_mohr_picture(const char *const *files, size_t n, const char *out,
+                                  cdem_error *err) {
+    if (n > CDEM_PLOT_MAX_FILES)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%zu runs: at most %d at once", n,
+                         CDEM_PLOT_MAX_FILES);
+    cdem_plot_args a = {.cmd = "mohr", .help = &help, .n_files = n, .out = out};
+    for (size_t i = 0; i < n; i++)
+        a.files[i] = files[i];
+    mohr_data d;
+    memset(&d, 0, sizeof d);
+    cdem_mohr_fit fit;
+    cdem_status st = mohr_read_runs(&a, &d, err);
+    if (st == CDEM_OK)
+        st = cdem_mohr_fit_envelope(d.sigma3, d.q, d.n, &fit, err);
+    if (st == CDEM_OK)
+        st = mohr_figure(&a, &d, &fit, err);
+    mohr_data_free(&d);
+    return st;
+}
+
 const cdem_command cdem_command_mohr = {"mohr", "Mohr-Coulomb fit of biaxial tests", &help,
                                         cdem_cmd_plot_mohr};

@@ -18,6 +18,7 @@
     X(plot_series)                                                                                 \
     X(mohr)                                                                                        \
     X(repose)                                                                                      \
+    X(calibrate)                                                                                   \
     X(voids)                                                                                       \
     X(faults)                                                                                      \
     X(wedge)                                                                                       \

@@ -12,6 +12,9 @@
 #  5. biaxial tests of the calibration set-up (examples/calibration/biaxial.ini) at 0 and
 #     20 MPa: the confined differential stress rises, peaks and softens (to <= 0.95 of its
 #     peak), and its peak is above the unconfined one (examples/calibration/results.md);
+#  5b. cdem-strain calibrate's whole loop at reduced size: a target found within 8 series,
+#     killed in its second series and resumed, its fresh-seed check within tolerance; a
+#     target out of reach refused with the range found (tests/validate/check_calibrate.sh);
 #  6. the paper's Figure 11A set-up (30 deg normal fault, static sea level) on the default
 #     assembly runs to the end with growth strata in the final increment;
 #  7. a settled assembly with stress on: sigma_yy within 15 % of rho g depth;
@@ -121,6 +124,7 @@ assert not problems, "; ".join(problems)
 print(f"peaks {peaks[0] / 1e6:.1f} < {peaks[1] / 1e6:.1f} MN/m")
 PYEOF
 
+check calibrate sh tests/validate/check_calibrate.sh "$BUILD" "$TMP"
 check growth-run "$RUN" -q -o "$TMP/growth.h5" -s surface.sedimentation=on \
     -s surface.sea_level_rise=null -s material.first_slip=off
 check growth-strata $PY - "$TMP/growth.h5" <<'PYEOF'
