@@ -138,6 +138,14 @@ static void test_summary_modes_geometry(void **state) {
          "net displacement",
          "563.7 m normal"},
         {{"boundary.inversion=on", NULL}, "net displacement", "0 m"},
+        /* settling steps move nothing: 7 deposits x 2838 steps come off the reverse slip */
+        {{"boundary.inversion=on", "surface.sedimentation=on", NULL},
+         "inversion",
+         "at 50 % of the deformation steps: 563.7 m normal, then 169.2 m reverse (7 deposits "
+         "settle, 2838 steps each, with the boundaries still)"},
+        {{"boundary.inversion=on", "surface.sedimentation=on", NULL},
+         "net displacement",
+         "394.5 m normal"},
         {{"material.material=bonded", "material.wall_breaking_strain=0.05", NULL},
          "element-wall",
          "breaking strain 0.05"},

@@ -134,6 +134,13 @@ long cdem_model_increment_step(const cdem_model *m, int k) {
     return step < m->total_steps ? step : m->total_steps;
 }
 
+long cdem_model_sediment_events(const cdem_params *p, const cdem_model *m) {
+    if (!p->sedimentation || m->sediment_steps < 1)
+        return 0;
+    long last_start = m->total_steps - m->settling_steps - m->equil_steps;
+    return last_start >= m->sediment_steps ? last_start / m->sediment_steps : 0;
+}
+
 long cdem_model_estimate_elements(const cdem_params *p) {
     if (!p || !(p->width > 0) || !(p->height > 0))
         return 0;

@@ -91,6 +91,12 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
 /* Time step at which increment k (0..n_increments_total) is written. */
 long cdem_model_increment_step(const cdem_model *m, int k);
 
+/* Number of sediment deposits the run makes when sedimentation is on (0 when it is off):
+ * one every sediment_steps run steps after the equilibration, each one whose settling ends
+ * by the last step (cdem_sediment_due's schedule; a settling never outlasts the interval,
+ * the parameter rules refuse that). Each takes settling_steps without boundary motion. */
+long cdem_model_sediment_events(const cdem_params *p, const cdem_model *m);
+
 /* Rough element count of the assembly before it is generated (from the packing density
  * of the original program: 2121 for 10 x 5 units), for summaries made without a solver. */
 long cdem_model_estimate_elements(const cdem_params *p);

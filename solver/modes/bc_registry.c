@@ -121,15 +121,30 @@ void cdem_bc_describe_inversion(const cdem_params *p, const cdem_model *m, FILE 
         cdem_summary_line(out, "inversion", "off");
         return;
     }
-    double before = m->total_displacement * p->inversion_percent / 100.0;
-    double after = m->total_displacement - before;
+    /* The mode's step counter turns at inversion_percent of the deformation steps; it does
+     * not advance while a deposit settles, so with sedimentation the slip is what the
+     * steps left after the settling give (docs/solver.md, section 8). */
+    long def_steps = m->total_steps - m->equil_steps;
+    long deposits = cdem_model_sediment_events(p, m);
+    long moving = def_steps - deposits * m->settling_steps;
+    long turn = lround(p->inversion_percent / 100.0 * (double)def_steps);
+    double before = (double)(turn < moving ? turn : moving) * m->displacement_per_step;
+    double after = (double)(moving > turn ? moving - turn : 0) * m->displacement_per_step;
     double net = before - after;
-    cdem_summary_line(out, "inversion", "at %g %% of the displacement: %.4g m %s, then %.4g m %s",
-                      p->inversion_percent, before, sense_word(p->fault_sense), after,
-                      other_sense_word(p->fault_sense));
-    if (fabs(net) <= 1e-9 * m->total_displacement)
+    if (deposits > 0)
+        cdem_summary_line(out, "inversion",
+                          "at %g %% of the deformation steps: %.4g m %s, then %.4g m %s "
+                          "(%ld deposits settle, %ld steps each, with the boundaries still)",
+                          p->inversion_percent, before, sense_word(p->fault_sense), after,
+                          other_sense_word(p->fault_sense), deposits, m->settling_steps);
+    else
+        cdem_summary_line(out, "inversion",
+                          "at %g %% of the displacement: %.4g m %s, then %.4g m %s",
+                          p->inversion_percent, before, sense_word(p->fault_sense), after,
+                          other_sense_word(p->fault_sense));
+    if (fabs(net) <= 1.5 * m->displacement_per_step) /* the turn is a whole step */
         cdem_summary_line(out, "net displacement",
-                          "0 m (the block returns to its starting position)");
+                          "0 m (the block returns to its starting position, within a step)");
     else
         cdem_summary_line(out, "net displacement", "%.4g m %s", fabs(net),
                           net > 0 ? sense_word(p->fault_sense) : other_sense_word(p->fault_sense));
