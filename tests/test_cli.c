@@ -237,6 +237,31 @@ static void test_cli_any_size(void **state) {
     free(e);
 }
 
+/* An assembly still sinking at the end of equilibration is named (the default model settles
+ * in about 200 s: 100 s is too short, cdem's 400 s is enough). */
+static void test_cli_warns_when_still_settling(void **state) {
+    const cli_ctx *c = *state;
+    char args[2048];
+    snprintf(args, sizeof args,
+             "-s time.equilibration=100 -s time.runtime=110 -s time.display_interval=100 -o "
+             "'%s/short.h5'",
+             c->scratch.dir);
+    assert_int_equal(run(c, args), 0);
+    char *e = slurp(c, "err.txt");
+    assert_has(e, "warning: the assembly is still settling at the end of equilibration: its "
+                  "free elements sink at");
+    assert_has(e, "a longer time.equilibration lets it come to rest");
+    free(e);
+    snprintf(args, sizeof args,
+             "-s time.runtime=410 -s time.display_interval=100 -o '%s/default.h5'", c->scratch.dir);
+    assert_int_equal(run(c, args), 0);
+    e = slurp(c, "err.txt");
+    assert_has(e, "end of equilibration at step");
+    if (strstr(e, "still settling"))
+        fail_msg("the default model warned after cdem's 400 s: %s", e);
+    free(e);
+}
+
 /* output.prefix names files inside an output folder, never a path (issue 35, item 8). */
 static void test_cli_output_prefix_is_a_name(void **state) {
     const cli_ctx *c = *state;
@@ -397,6 +422,7 @@ int main(void) {
         cmocka_unit_test_setup_teardown(test_cli_summary_checks_the_fault_file, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_output_prefix_is_a_name, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_any_size, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_cli_warns_when_still_settling, setup, teardown),
         cmocka_unit_test_setup_teardown(test_cli_parameters_from_stdin, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -56,6 +56,35 @@ static void assign_layers(cdem_state *s) {
 /* End of equilibration: the erosion level is erosion_base_level x the height of the
  * equilibrated assembly, measured from the lowest free-element centre to the highest one
  * (the span of the 24 layers): y = lo + level (hi - lo). */
+/* End of equilibration: an assembly still sinking will go on compacting under the faulting,
+ * which then reads as subsidence everywhere. It settles at the speed its damping allows, so
+ * a tall or finely resolved assembly needs longer than cdem's 400 s (examples/inversion: 130
+ * elements tall at 125 m, 2500 s). Warned when the free elements' mean downward speed would
+ * move them by more than an average radius in another equilibration's time (400 s at
+ * least, cdem's default). */
+static void warn_if_still_settling(run_ctx *r) {
+    double sum_vy = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < r->s.n; i++) {
+        if (r->s.flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        sum_vy += r->s.vy[i];
+        n++;
+    }
+    if (n == 0 || !run_logging(r))
+        return;
+    const double sinking = -sum_vy / (double)n;
+    const double horizon = fmax(r->p->equilibration, 400.0); /* cdem's default at least */
+    const double more = sinking * horizon;
+    if (sinking > 0.0 && more > r->m.average_radius)
+        fprintf(r->opt->log,
+                "cdem-run: warning: the assembly is still settling at the end of equilibration: "
+                "its free elements sink at %.3g m/s on average, %.3g m in another %g s (%.3g "
+                "average radii); a longer time.equilibration lets it come to rest before the "
+                "boundaries move (docs/guide.md, section 4, \"Equilibration\")\n",
+                sinking, more, horizon, more / r->m.average_radius);
+}
+
 static void set_erosion_level(run_ctx *r) {
     r->erosion_y = INFINITY;
     if (!r->p->erosion)
@@ -281,6 +310,7 @@ static cdem_status run_loop(run_ctx *r, long until, cdem_error *err) {
                 fprintf(opt->log, "cdem-run: end of equilibration at step %ld: %ld %s created\n",
                         step, made,
                         p->material == CDEM_MATERIAL_BONDED ? "bonds" : "cohesive contacts");
+            warn_if_still_settling(r);
         }
         const long settled = cdem_sediment_after_step(&r->sed, &r->it, &r->s, step);
         if (settled > 0 && run_logging(r)) {
