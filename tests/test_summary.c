@@ -208,6 +208,7 @@ static void test_summary_salt_time_mapping(void **state) {
     t = summary_of(&p, 2121, 200, 0);
     assert_non_null(strstr(t, "\nSalt\n"));
     assert_line(t, "time step dt", "0.0264393 s");
+    assert_line(t, "smallest mass", "1.72788e+07 kg/m (salt)");
     assert_line(t, "layer", "basal, lowest 25 % of the span of element centres = 1250 m");
     assert_line(t, "viscosity", "1e+18 Pa s geological = 4.794e+07 Pa s in the model");
     assert_line(t, "geological rate", "1 mm/yr = 3.169e-11 m/s, shown by the model's 0.660983");

@@ -137,7 +137,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     }
     line(f, "average radius", "%.6g m", m->average_radius);
     line(f, "smallest mass", "%.6g kg/m%s", m->min_mass,
-         m->min_mass < m->mass[0] ? " (light interval)" : "");
+         m->salt.on && m->min_mass == m->salt.mass[0] ? " (salt)"
+         : m->min_mass < m->mass[0]                   ? " (light interval)"
+                                                      : "");
 
     heading(f, "Constants");
     const char *kn_origin = p->unit_scaling >= 1000.0 ? "default constant"
