@@ -3,7 +3,8 @@
  *   salt-1 the pair law's kernels: no shear strength, the repulsion only against a non-salt
  *          element, the central dashpot and its weight, no force for a rigid rotation;
  *   salt-2 the viscous kernel: the grid's stress of an affine simple shear is eta x rate and
- *          the pressure is K (1/J - 1), on a real assembly;
+ *          the pressure is K (1/J - 1), on a real assembly; it is the salt's stress of an
+ *          increment;
  *   salt-3 the grid's forces conserve momentum (their sum is zero) for any velocities and J;
  *   salt-4 the placement: a basal band and an interval of the pre-growth layers, the salt's
  *          mass from its density, and a band holding every element refused;
@@ -96,6 +97,16 @@ static void test_salt_viscous_kernel_simple_shear(void **state) {
         n++;
     }
     assert_true(n > 50);
+    /* the stress the run writes into an increment (physics.calculate_stress): the salt's */
+    for (size_t i = 0; i < c.s.n; i++)
+        c.s.sxx[i] = c.s.syy[i] = c.s.sxy[i] = NAN;
+    cdem_salt_stress(salt, &c.s);
+    for (size_t i = 0; i < c.s.n; i++)
+        if (c.s.flags[i] & CDEM_FLAG_SALT)
+            assert_true(c.s.sxx[i] == salt->sxx[i] && c.s.syy[i] == salt->syy[i] &&
+                        c.s.sxy[i] == salt->sxy[i]);
+        else
+            assert_true(isnan(c.s.sxx[i]));
     const double ratio = sum_sxy / (double)n / (eta * rate);
     printf("salt-2: %ld interior elements, sigma_xy / (eta rate) = %.4f (worst element %.3f "
            "off), pressure %.6g Pa (K (1/J - 1) = %.6g)\n",

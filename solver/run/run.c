@@ -450,6 +450,11 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
                                                           : "failed";
         run_progress_line(r, 1, ending);
         run_end_progress_line(r);
+        if (r->salt.elements > 0)
+            fprintf(r->opt->log,
+                    "cdem-run: salt: area %.6g m^2 at placement; largest change at an increment "
+                    "%.3g %%\n",
+                    r->salt.disc_area / r->salt.phi, 100.0 * r->salt_area_change);
     }
     const int had_writer = r->w != NULL;
     if (r->w) {

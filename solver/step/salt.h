@@ -1,44 +1,17 @@
-/* salt: a viscous (Newtonian) salt made of elements whose stress is carried on a background
- * grid (a material-point continuum, as MPM does), under and beside the frictional-cohesive
- * cover of the pair list. Design and measurements: docs/solver.md, "Salt".
- *
- * Why a grid and not a contact law: elements held apart by their contacts (normal repulsion
- * plus dashpots, no friction) keep the macroscopic friction of a frictionless packing (a shear
- * strength of about 0.12 x the pressure) and a viscosity 4-6 times the set one that falls with
- * the shear rate; under a cover the pressure is a thousand times the salt's viscous stress, so
- * such a salt is a weak frictional layer, not a fluid. Here each salt element carries its area
- * ratio J (state.area_ratio) and its pressure p = K (1/J - 1) (no tension: p >= 0); the
- * viscous stress 2 eta D' comes from the velocity gradient on the grid; a uniform pressure
- * gives no force whatever the elements' arrangement, so there is no frictional yield.
- *
- * One force evaluation (cdem_salt_forces), on the positions of the step and the mid-step
- * velocities (those of the tangential spring), with quadratic B-spline weights N over 3 x 3
- * nodes spaced h (salt.grid_spacing mean radii):
- *   P2G   m_n = sum_k N_kn m_k, (m v)_n = sum_k N_kn m_k v_k over the salt elements, then the
- *         elements that are not salt and whose stencil holds a node with salt mass (the cover,
- *         the base and faults, the lateral walls, each as salt.*_contact = no-slip says): they
- *         lend the salt their velocity (the salt sticks to them) and take their share of its
- *         stress (its traction on them)
- *   grad  L_i = sum_n v_n (x) grad N_in, D'_i the deviator of its symmetric part (salt only)
- *   stress sigma_i = -p_i I + 2 eta D'_i on the material area A_i = J_i pi r_i^2 / phi
- *         (phi: the salt's packing fraction at placement, so the material areas tile the salt)
- *   nodes f_n = -sum_i A_i sigma_i grad N_in;  back  F_k += sum_n N_kn m_k f_n / m_n
- * and, after a time step, J_i <- J_i exp(dt tr L_i) (cdem_salt_update_area).
- * The pairs with a salt element are not in the pair list (cdem_contact_class keeps them out);
- * this module evaluates them with the pair law of salt (common/laws/law_salt.h): between salt
- * and any other element a normal repulsion Kn (R - r) while r < R (between two salt elements
- * none: the grid carries the pressure), no friction and no cohesion (the law's shear force is
- * 0), and for every salt pair within reach x R a weak central dashpot c w(r) (dv.n) n,
- * w = 1 up to R falling linearly to 0 at reach x R, which damps the element motions the grid
- * cannot see (its null space); with physics.damping_mode = contact a touching pair also has
- * the contact dashpot of the cover's contacts. Central dashpots are objective (a rigid
- * rotation gives dv.n = 0).
- * Determinism: every sum runs serially in element or pair order: the same bits for any
- * thread count. Nothing allocates in a force evaluation: the grid, the per-element scratch
- * and the salt's pair list are sized at each list build (cdem_salt_after_build; elements move
- * less than half the skin between builds, the grid keeps three cells of margin).
- * Ownership: cdem_salt owns its scratch; never the state. Units: SI (m, s, kg per metre, N
- * per metre, Pa = N/m over m^2/m). */
+/* salt: a Newtonian salt made of elements whose stress lives on a background grid (a
+ * material-point continuum, MPM), under the frictional-cohesive cover of the pair list. Why
+ * not a contact law: a frictionless packing held apart by its contacts keeps a friction of
+ * about 0.12 x the pressure, a thousand times a basin salt's viscous stress; on the grid a
+ * uniform pressure gives no force, so there is no frictional yield. Each salt element carries
+ * its area ratio J (p = K (1/J - 1), no tension); a force evaluation does P2G (the salt, then
+ * the non-salt elements that share its nodes: the no-slip contacts), the gradient and
+ * sigma = -p I + 2 eta D', the node forces and G2P, and the salt's pairs with the law of
+ * common/laws/law_salt.h; after a step J follows tr L and the salt is projected back onto the
+ * grid (cdem_salt_project). The formulas and measurements: docs/solver.md, section 9.
+ * Determinism: serial sums in element or pair order, the same bits for any thread count.
+ * Lifetime: the grid, the scratch and the pair list are sized at list builds, never in a step.
+ * Ownership: cdem_salt owns its scratch, never the state. Units: SI (m, s, kg per metre, N per
+ * metre, Pa). */
 #ifndef CDEM_SALT_H
 #define CDEM_SALT_H
 
