@@ -219,7 +219,8 @@ static void test_summary_salt_time_mapping(void **state) {
     assert_line(t, "damping", "79317916 N s/m in equilibration and settling; contact dashpots");
     free(t);
     /* ten times slower in nature: S ten times larger, the model's viscosity ten times smaller,
-     * the ratio kept (eta_geological x rate / S is the model's eta V) */
+     * and the ratio eta V / (rho g h H) ten times smaller in the model as in nature (the model
+     * keeps nature's ratio, whatever it is) */
     p.salt_rate = 0.1;
     t = summary_of(&p, 2121, 200, 0);
     assert_line(t, "viscosity", "1e+18 Pa s geological = 4.794e+06 Pa s in the model");
