@@ -140,7 +140,7 @@ test: tests-build
 asan:
 	$(MAKE) BUILD=build-asan OPT="-O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined" test
 
-validate: all $(BUILD)/tests/test_kill_survival
+validate: all $(BUILD)/tests/test_kill_survival $(BUILD)/tests/test_salt
 	@sh tests/validate/run_validate.sh $(BUILD)
 
 .PHONY: check-slurm

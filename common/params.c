@@ -80,15 +80,20 @@ static const char *const walls_words[] = {"right", "both", NULL};
 static const char *const weak_words[] = {"off", "lower", "upper", NULL};
 static const char *const flex_words[] = {"layer-contacts", "weak-layers", NULL};
 static const char *const sea_words[] = {"null", "low", "mid", "high", "very-high", NULL};
+static const char *const damping_words[] = {"absolute", "contact", NULL};
+static const char *const salt_layer_words[] = {"off", "basal", "interval", NULL};
+static const char *const salt_contact_words[] = {"no-slip", "free-slip", NULL};
+/* salt.time_scale's word: the time scale follows from salt.rate */
+static const char *const from_rate_words[] = {"rate", NULL};
 
 /* Boolean spellings: bool_true_words[i] and bool_false_words[i] are a pair. */
 static const char *const bool_true_words[] = {"true", "yes", "on", "1", NULL};
 static const char *const bool_false_words[] = {"false", "no", "off", "0", NULL};
 
 /* Sections in file order. */
-static const char *const section_names[] = {"assembly", "time",          "physics",
-                                            "material", "heterogeneity", "boundary",
-                                            "surface",  "output",        NULL};
+static const char *const section_names[] = {"assembly",      "time",     "physics", "material",
+                                            "heterogeneity", "boundary", "surface", "salt",
+                                            "output",        NULL};
 
 /* clang-format off */
 static const cdem_param_def param_table[] = {
@@ -127,6 +132,10 @@ static const cdem_param_def param_table[] = {
      "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)"},
     {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
      "store per-element stress in every increment"},
+    {"physics", "damping_mode", CDEM_PTYPE_ENUM, P_OFF(damping_mode), 0, "", "absolute", 0, 0, 0, 0, damping_words,
+     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)"},
+    {"physics", "contact_damping", CDEM_PTYPE_DOUBLE, P_OFF(contact_damping), 0, "", "0.2", 0, 1, 0, 0, NULL,
+     "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))"},
 
     {"material", "material", CDEM_PTYPE_ENUM, P_OFF(material), 0, "", "granular", 0, 0, 0, 0, material_words,
      "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)"},
@@ -225,6 +234,37 @@ static const cdem_param_def param_table[] = {
      "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0"},
     {"surface", "growth_sequence1_layers", CDEM_PTYPE_INT, P_OFF(growth_sequence1_layers), 0, "", "10", 1, 1000, 0, 0, NULL,
      "growth layers coloured as growth sequence 1 (the rest are sequence 2)"},
+
+    {"salt", "layer", CDEM_PTYPE_ENUM, P_OFF(salt_layer), 0, "", "off", 0, 0, 0, 0, salt_layer_words,
+     "viscous salt: none (off), the lowest part of the assembly (basal) or an interval of the pre-growth layers (interval), fixed at assembly"},
+    {"salt", "thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_thickness_percent), 0, "%", "25", 0, 100, 1, 1, NULL,
+     "basal: the salt's thickness, % of the span of element centres (it must leave a cover)"},
+    {"salt", "interval_bottom_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_bottom_percent), 0, "%", "20", 0, 100, 0, 0, NULL,
+     "interval: the salt's base, % of the span of element centres above the lowest"},
+    {"salt", "interval_top_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_top_percent), 0, "%", "40", 0, 100, 0, 0, NULL,
+     "interval: the salt's top, % of the span of element centres above the lowest"},
+    {"salt", "viscosity", CDEM_PTYPE_DOUBLE, P_OFF(salt_viscosity), 0, "Pa s", "1e18", 1e15, 1e21, 0, 0, NULL,
+     "the salt's geological (Newtonian) viscosity; the model's is viscosity / time_scale"},
+    {"salt", "salt_density", CDEM_PTYPE_DOUBLE, P_OFF(salt_density), 0, "kg/m^3", "2200", 1000, 3500, 0, 0, NULL,
+     "the salt's density (halite 2160)"},
+    {"salt", "rate", CDEM_PTYPE_DOUBLE, P_OFF(salt_rate), 0, "mm/yr", "1", 0.01, 100, 0, 0, NULL,
+     "the geological speed the boundary speed stands for: time_scale = boundary speed / rate"},
+    {"salt", "time_scale", CDEM_PTYPE_DOUBLE, P_OFF(salt_time_scale), 0, "", "rate", 1, 1e16, 0, 0, from_rate_words,
+     "geological seconds per model second (modes without a moving boundary); rate = from salt.rate"},
+    {"salt", "bulk_modulus", CDEM_PTYPE_DOUBLE, P_OFF(salt_bulk_modulus), 0, "Pa", "1e10", 1e8, 1e12, 0, 0, NULL,
+     "the salt's bulk modulus K: pressure K (1/J - 1) for an area ratio J"},
+    {"salt", "grid_spacing", CDEM_PTYPE_DOUBLE, P_OFF(salt_grid_spacing), 0, "mean radii", "4.5", 3, 8, 0, 0, NULL,
+     "node spacing of the grid that carries the salt's stress"},
+    {"salt", "reach", CDEM_PTYPE_DOUBLE, P_OFF(salt_reach), 0, "", "1.5", 1, 2, 0, 0, NULL,
+     "the salt's pair dashpots act up to reach x (r_i + r_j)"},
+    {"salt", "dashpot_fraction", CDEM_PTYPE_DOUBLE, P_OFF(salt_dashpot_fraction), 0, "", "0.1", 0, 1, 0, 0, NULL,
+     "the salt's pair dashpots (which damp the element motions the grid cannot see), as a fraction of a dashpot network of the salt's viscosity"},
+    {"salt", "cover_contact", CDEM_PTYPE_ENUM, P_OFF(salt_cover_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
+     "no-slip: cover elements next to the salt join its grid (the salt sticks to them); free-slip: only the pair law"},
+    {"salt", "base_contact", CDEM_PTYPE_ENUM, P_OFF(salt_base_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
+     "the same for the base and the fault elements"},
+    {"salt", "wall_contact", CDEM_PTYPE_ENUM, P_OFF(salt_wall_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
+     "the same for the lateral walls"},
 
     {"output", "prefix", CDEM_PTYPE_STRING, P_OFF(prefix), sizeof(((cdem_params *)0)->prefix), "", "cdem", 0, 0, 0, 0, NULL,
      "prefix of per-increment export files (cdem282.txt)"},

@@ -65,6 +65,22 @@ typedef enum {
 typedef enum { CDEM_VERT_CALDERA = 0, CDEM_VERT_PISTON = 1 } cdem_vertical_sense;
 typedef enum { CDEM_WALLS_RIGHT = 0, CDEM_WALLS_BOTH = 1 } cdem_walls_choice;
 typedef enum { CDEM_WEAK_OFF = 0, CDEM_WEAK_LOWER = 1, CDEM_WEAK_UPPER = 2 } cdem_weak_interval;
+/* What damps the elements' motion (docs/solver.md, "Damping"). */
+typedef enum {
+    CDEM_DAMPING_ABSOLUTE = 0, /* the paper's: a drag c v on each free element's velocity */
+    CDEM_DAMPING_CONTACT = 1,  /* a normal dashpot on each contact: relative motion only */
+} cdem_damping_mode;
+/* Where the viscous salt is (salt.layer; solver/step/salt.h). */
+typedef enum {
+    CDEM_SALT_OFF = 0,
+    CDEM_SALT_BASAL = 1,    /* the lowest salt.thickness_percent of the assembly */
+    CDEM_SALT_INTERVAL = 2, /* between salt.interval_bottom_percent and _top_percent */
+} cdem_salt_layer_choice;
+/* How the salt meets a neighbour that is not salt (salt.*_contact). */
+typedef enum {
+    CDEM_SALT_NO_SLIP = 0,   /* the neighbour joins the salt's grid: the salt sticks to it */
+    CDEM_SALT_FREE_SLIP = 1, /* only the pair law (repulsion and a normal dashpot) */
+} cdem_salt_contact;
 /* Which contacts flexural slip makes strengthless. */
 typedef enum {
     CDEM_FLEX_LAYER_CONTACTS = 0, /* every contact between two different pre-growth layers */
@@ -104,11 +120,13 @@ typedef struct {
                                 0.1-1000 */
 
     /* [physics] */
-    double gravity;             /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
-    double density;             /* kg/m^3, 1500-3500 */
-    int keep_constants;         /* 0/1: use the 1000 m constants whatever the unit scaling */
-    double deformation_damping; /* multiplier of the damping on deformation steps, 0-1 */
-    int calculate_stress;       /* 0/1: store per-element stress in every increment */
+    double gravity;                 /* m/s^2, 0.5-25 (ignored, i.e. zero, in the biaxial test) */
+    double density;                 /* kg/m^3, 1500-3500 */
+    int keep_constants;             /* 0/1: use the 1000 m constants whatever the unit scaling */
+    double deformation_damping;     /* multiplier of the damping on deformation steps, 0-1 */
+    int calculate_stress;           /* 0/1: store per-element stress in every increment */
+    cdem_damping_mode damping_mode; /* absolute (the paper's) or contact */
+    double contact_damping;         /* contact: fraction of each contact's critical damping */
 
     /* [material] */
     cdem_material_model material;   /* granular (frictional-cohesive) or bonded */
@@ -154,6 +172,20 @@ typedef struct {
     int sedimentation;                  /* 0/1: syn-tectonic growth strata */
     cdem_sea_level_rise sea_level_rise; /* null, low, mid, high, very-high */
     int growth_sequence1_layers;        /* growth layers in growth sequence 1, >= 1 */
+
+    /* [salt] (docs/solver.md, "Salt") */
+    cdem_salt_layer_choice salt_layer; /* off, basal or interval */
+    double salt_thickness_percent;     /* basal: % of the span of element centres, (0, 100) */
+    double salt_interval_bottom_percent, salt_interval_top_percent; /* interval: % of the span */
+    double salt_viscosity;        /* Pa s, geological (Newtonian) */
+    double salt_density;          /* kg/m^3 */
+    double salt_rate;             /* mm/yr: the geological speed of the model's boundary speed */
+    double salt_time_scale;       /* S, geological s per model s; NaN = from salt_rate ("rate") */
+    double salt_bulk_modulus;     /* Pa: p = K (1/J - 1) */
+    double salt_grid_spacing;     /* node spacing of the salt's grid, in mean radii */
+    double salt_reach;            /* the pair dashpots reach reach x (r_i + r_j) */
+    double salt_dashpot_fraction; /* the pair dashpots' coefficient, x beta x viscosity */
+    cdem_salt_contact salt_cover_contact, salt_base_contact, salt_wall_contact;
 
     /* [output] */
     char prefix[64];         /* prefix for per-increment exports (cdem282.txt) */

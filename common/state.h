@@ -28,6 +28,7 @@ enum {
     CDEM_FLAG_MYLAR = 1u << 7,        /* CD "mylar sheet" element dragging the hanging wall */
     CDEM_FLAG_SURFACE = 1u << 8,      /* top-surface element (overburden acts on it) */
     CDEM_FLAG_BASE = 1u << 9,         /* wall element of the base row (material.base_*) */
+    CDEM_FLAG_SALT = 1u << 10,        /* a viscous salt element (salt.layer; solver/step/salt.h) */
 };
 
 /* Elements that are integrated by Newton's law: neither wall, fault nor footwall display. */
@@ -49,7 +50,11 @@ typedef enum {
  * and of the run file's datasets: append new rows, do not reorder. Columns:
  *   X(name, C type, file type, in_increments, stress)
  *   in_increments  1: a dataset /increments/<name> of the run file; 0: checkpoints only
- *   stress         1: allocated only when has_stress (the three stress components) */
+ *   stress         1: allocated only when has_stress (the three stress components)
+ * area_ratio (J) is 1 for every element but salt, whose material area J pi r^2 / phi it
+ * scales (solver/step/salt.h). It is in checkpoints, not in increments: J stays within 1 % of
+ * 1 (the salt's bulk modulus), the salt's pressure K (1/J - 1) is in the stress datasets and
+ * its area in the series (salt_area), and every file of a run without salt stays as it was. */
 #define CDEM_STATE_FIELDS(X)                                                                       \
     X(id, int32_t, CDEM_FIELD_I32, 1, 0)     /* stable element id, unique within a run */          \
     X(x, double, CDEM_FIELD_F64, 1, 0)       /* centre position, m */                              \
@@ -65,7 +70,8 @@ typedef enum {
     X(born, int32_t, CDEM_FIELD_I32, 1, 0)   /* increment that created it (0 = initial) */         \
     X(sxx, double, CDEM_FIELD_F64, 1, 1)     /* stress, N/m, compression positive */               \
     X(syy, double, CDEM_FIELD_F64, 1, 1)     /* NULL unless has_stress */                          \
-    X(sxy, double, CDEM_FIELD_F64, 1, 1)
+    X(sxy, double, CDEM_FIELD_F64, 1, 1)                                                           \
+    X(area_ratio, double, CDEM_FIELD_F64, 0, 0) /* salt: material area / area at placement (J) */
 
 typedef struct {
     size_t n;        /* number of elements in use */
@@ -73,7 +79,7 @@ typedef struct {
     int has_stress;  /* 1: sxx, syy, sxy are allocated */
     int32_t next_id; /* id for the next added element */
     /* one array per row of CDEM_STATE_FIELDS (meaning and units there): id, x, y, vx, vy,
-     * fx, fy, radius, mass, layer, flags, born, sxx, syy, sxy */
+     * fx, fy, radius, mass, layer, flags, born, sxx, syy, sxy, area_ratio */
 #define CDEM_STATE_MEMBER(name, ctype, ftype, in_increments, stress) ctype *name;
     CDEM_STATE_FIELDS(CDEM_STATE_MEMBER)
 #undef CDEM_STATE_MEMBER

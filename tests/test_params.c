@@ -252,7 +252,7 @@ static void test_params_every_enum_word_and_a_wrong_one(void **state) {
         for (int w = 0; d->choices[w]; w++)
             assert_msg_has(&err, d->choices[w]);
     }
-    assert_int_equal(enums, 12);
+    assert_int_equal(enums, 17);
     assert_int_equal(parse(&p, "[surface]\nsea_level_rise = very-high\n", &err), CDEM_OK);
     assert_int_equal(p.sea_level_rise, CDEM_SEA_VERY_HIGH);
     assert_string_equal(cdem_mode_name(CDEM_MODE_VERTICAL_FAULTS), "vertical-faults");
@@ -581,6 +581,31 @@ static const rule_case rule_cases[] = {
     {"settling",
      {"surface.sedimentation=on", "time.equilibration=1500", NULL},
      "settling > displacement: the settling time 0.2 x equilibration = 0.2 x 1500 s = 300 s"},
+    /* the salt's rules (solver/step/salt_rules.c) */
+    {"salt bonded",
+     {"salt.layer=basal", "physics.damping_mode=contact", "material.material=bonded", NULL},
+     "salt.layer = basal: not supported with material.material = bonded"},
+    {"salt biaxial",
+     {"salt.layer=basal", "physics.damping_mode=contact", "boundary.mode=biaxial", NULL},
+     "salt.layer = basal: not supported with boundary.mode = biaxial"},
+    {"salt absolute damping",
+     {"salt.layer=basal", NULL},
+     "salt.layer = basal with physics.damping_mode = absolute"},
+    {"salt interval order",
+     {"salt.layer=interval", "physics.damping_mode=contact", "salt.interval_bottom_percent=50",
+      "salt.interval_top_percent=30", NULL},
+     "salt.interval_bottom_percent = 50 must be below salt.interval_top_percent = 30"},
+    {"salt weak interval",
+     {"salt.layer=basal", "physics.damping_mode=contact", "heterogeneity.weak_interval=lower",
+      NULL},
+     "salt.layer = basal conflicts with heterogeneity.weak_interval = lower"},
+    {"salt as a cover's law",
+     {"material.granular_law=salt", NULL},
+     "material.granular_law = salt: the salt law is the pair law of salt elements"},
+    {"salt too viscous",
+     {"salt.layer=basal", "physics.damping_mode=contact", "salt.viscosity=1e21", "salt.rate=100",
+      NULL},
+     "too viscous for its grid"},
 };
 
 static void apply_overrides(cdem_params *p, const char *const *ov) {
@@ -621,6 +646,8 @@ static void test_params_validate_allowed_combinations(void **state) {
         {"heterogeneity.layered_friction=on", NULL},
         {"surface.overburden_pressure=1e7", "boundary.mode=detachment", NULL},
         {"boundary.mode=repose", "time.display_interval=10", NULL},
+        {"salt.layer=basal", "physics.damping_mode=contact", "boundary.mode=detachment", NULL},
+        {"salt.layer=interval", "physics.damping_mode=contact", "salt.viscosity=1e19", NULL},
     };
     for (size_t i = 0; i < sizeof ok_sets / sizeof ok_sets[0]; i++) {
         cdem_params p;

@@ -156,6 +156,42 @@ static void test_render_layer_and_flag_colours(void **state) {
     cdem_state_free(&s);
 }
 
+/* Salt elements (CDEM_FLAG_SALT, salt.layer) are drawn as their own material: lilac bands
+ * alternating by pre-growth layer, distinct from the cover's yellow and red. */
+static void test_render_salt_colours(void **state) {
+    (void)state;
+    cdem_state s;
+    cdem_error err;
+    assert_int_equal(cdem_state_init(&s, 4, 0, &err), CDEM_OK);
+    static const struct {
+        double x;
+        int32_t layer;
+        uint32_t flags;
+    } el[] = {{1, 1, CDEM_FLAG_SALT}, {3, 2, CDEM_FLAG_SALT}, {5, 1, 0}, {7, 2, 0}};
+    for (int i = 0; i < 4; i++)
+        assert_int_equal(cdem_state_append(&s, -1, el[i].x, 1, 0.45, 1.0, el[i].layer, el[i].flags,
+                                           0, NULL, &err),
+                         CDEM_OK);
+    cdem_render_options o;
+    make_options(&o);
+    cdem_render_scene sc = {0};
+    sc.state = &s;
+    image im;
+    render_image(&im, &sc, &o, 400, 240);
+    const cdem_rgba *want[4] = {&o.salt[0], &o.salt[1], &o.pregrowth[0], &o.pregrowth[1]};
+    int px[4];
+    for (int i = 0; i < 4; i++) {
+        model_pixel(&im, el[i].x, 1, px);
+        assert_int_equal(px[3], 255);
+        assert_near_colour(px, *want[i], 1);
+    }
+    /* lilac: red and blue above green, unlike every cover colour */
+    assert_true(o.salt[0].b > o.salt[0].g && o.salt[0].r > o.salt[0].g);
+    assert_true(o.salt[1].b > o.salt[1].g && o.salt[0].b != o.salt[1].b);
+    cairo_surface_destroy(im.surf);
+    cdem_state_free(&s);
+}
+
 static void test_render_values_colours_and_undefined(void **state) {
     (void)state;
     cdem_state s;
@@ -803,6 +839,7 @@ const char *__lsan_default_suppressions(void) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_layer_and_flag_colours),
+        cmocka_unit_test(test_render_salt_colours),
         cmocka_unit_test(test_render_values_colours_and_undefined),
         cmocka_unit_test(test_render_signed_colour_bar),
         cmocka_unit_test(test_render_vectors_axes_outline),

@@ -430,6 +430,27 @@ static void test_resume_after_max_steps_is_bit_identical(void **state) {
     compare_checkpoints(ps, pe);
 }
 
+/* A run with salt (the salt's area ratio J in the checkpoint, its module's grid and pairs
+ * rebuilt from the restored list, contact damping) stopped by --max-steps in its deformation
+ * phase and resumed: the uninterrupted run's file and newest checkpoint, bit for bit. */
+static void test_resume_salt_is_bit_identical(void **state) {
+    const rs_ctx *c = *state;
+#define SALT                                                                                       \
+    SMALL " -s salt.layer=basal -s physics.damping_mode=contact -s boundary.mode=detachment"
+    assert_int_equal(run(c, KEEP, "-q -o salt_straight.h5 -s output.checkpoint_interval=3 " SALT),
+                     0);
+    assert_int_equal(
+        run(c, KEEP, "-q -o salt_early.h5 --max-steps 4700 -s output.checkpoint_interval=3 " SALT),
+        0);
+#undef SALT
+    char pe[1200], ps[1200];
+    path_of(c, "salt_early.h5", pe, sizeof pe);
+    path_of(c, "salt_straight.h5", ps, sizeof ps);
+    assert_int_equal(run(c, KEEP, "-q --resume salt_early.h5"), 0);
+    compare_files(ps, pe);
+    compare_checkpoints(ps, pe);
+}
+
 static void test_resume_refusals(void **state) {
     const rs_ctx *c = *state;
     /* a completed run */
@@ -716,6 +737,7 @@ int main(void) {
         cmocka_unit_test(test_resume_determinism_threads_1_2_3),
         cmocka_unit_test(test_resume_after_sigkill_is_bit_identical),
         cmocka_unit_test(test_resume_after_max_steps_is_bit_identical),
+        cmocka_unit_test(test_resume_salt_is_bit_identical),
         cmocka_unit_test(test_resume_refusals),
         cmocka_unit_test(test_resume_after_file_size_limit_is_bit_identical),
         cmocka_unit_test(test_resume_refuses_a_damaged_kept_increment),

@@ -233,12 +233,12 @@ static void test_state_id_map_finds_slots(void **state) {
  * so a field the loops forgot would show). */
 static void test_state_field_table_drives_every_field(void **state) {
     (void)state;
-    assert_int_equal(cdem_state_field_count, 15);
+    assert_int_equal(cdem_state_field_count, 16);
     size_t members = 0;
     for (size_t k = 0; k < cdem_state_field_count; k++) {
         const cdem_state_field *f = &cdem_state_fields[k];
         assert_true(f->offset >= offsetof(cdem_state, id) &&
-                    f->offset <= offsetof(cdem_state, sxy));
+                    f->offset <= offsetof(cdem_state, area_ratio));
         assert_int_equal(f->offset, offsetof(cdem_state, id) + k * sizeof(void *));
         members++;
     }

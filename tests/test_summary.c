@@ -199,12 +199,52 @@ static void test_summary_rejects_null(void **state) {
     assert_int_equal(cdem_summary_text(&p, &m, 1, 1, 0, NULL, &err), CDEM_ERR_INVALID);
 }
 
+/* The salt's section (docs/solver.md, section 9.4): the time mapping and the ratio it keeps.
+ * The default model with basal salt: dt 0.0264393 s (the salt's smallest mass), boundary
+ * speed 0.660983 m/s, 1 mm/yr: S = 0.660983 / 3.16881e-11 = 2.086e10, 10^18 / S =
+ * 4.794e7 Pa s; without salt no section. */
+static void test_summary_salt_time_mapping(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    char *t = summary_of(&p, 2121, 200, 0);
+    assert_null(strstr(t, "\nSalt\n"));
+    free(t);
+    p.salt_layer = CDEM_SALT_BASAL;
+    p.damping_mode = CDEM_DAMPING_CONTACT;
+    p.mode = CDEM_MODE_DETACHMENT;
+    t = summary_of(&p, 2121, 200, 0);
+    assert_non_null(strstr(t, "\nSalt\n"));
+    assert_line(t, "time step dt", "0.0264393 s");
+    assert_line(t, "smallest mass", "1.72788e+07 kg/m (salt)");
+    assert_line(t, "layer", "basal, lowest 25 % of the span of element centres = 1250 m");
+    assert_line(t, "viscosity", "1e+18 Pa s geological = 4.794e+07 Pa s in the model");
+    assert_line(t, "geological rate", "1 mm/yr = 3.169e-11 m/s, shown by the model's 0.660983");
+    assert_line(t, "time scale S", "2.086e+10 (1 model s = 661 yr");
+    assert_line(t, "deformation phase", "1600 s of model time = 1.058 Myr");
+    assert_line(t, "eta V / (rho g h H)", "0.000276 (salt 1250 m, cover 3750 m)");
+    assert_line(t, "Reynolds number", "0.0379");
+    assert_line(t, "damping", "79317916 N s/m in equilibration and settling; contact dashpots");
+    free(t);
+    /* ten times slower in nature: S ten times larger, the model's viscosity ten times smaller,
+     * and the ratio eta V / (rho g h H) ten times smaller in the model as in nature (the model
+     * keeps nature's ratio, whatever it is) */
+    p.salt_rate = 0.1;
+    t = summary_of(&p, 2121, 200, 0);
+    assert_line(t, "viscosity", "1e+18 Pa s geological = 4.794e+06 Pa s in the model");
+    assert_line(t, "time scale S", "2.086e+11");
+    assert_line(t, "eta V / (rho g h H)", "2.76e-05");
+    assert_line(t, "deformation phase", "1600 s of model time = 10.58 Myr");
+    free(t);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_summary_default_model_key_lines),
         cmocka_unit_test(test_summary_estimated_counts_say_so),
         cmocka_unit_test(test_summary_modes_geometry),
         cmocka_unit_test(test_summary_rejects_null),
+        cmocka_unit_test(test_summary_salt_time_mapping),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

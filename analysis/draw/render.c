@@ -32,6 +32,8 @@ enum {
     SLOT_G1_1,      /* */
     SLOT_G2_0,      /* growth sequence 2 band colours 0, 1 */
     SLOT_G2_1,      /* */
+    SLOT_SALT0,     /* salt band colours 0, 1 */
+    SLOT_SALT1,     /* */
     SLOT_MAP,       /* first of the colour-map bins */
     MAP_BINS = 257, /* colour-map bins, odd so that t = 0.5 (white, green) is a bin */
     SLOT_FIXED_N = SLOT_MAP + MAP_BINS, /* slots of one opacity variant */
@@ -153,11 +155,11 @@ static cdem_status validate(const cdem_render_scene *sc, const cdem_render_optio
                          "render: outline_width = %g, line_width = %g, font_size = %g: widths "
                          "must be > 0 and the font size < 1000 (<= 0 = automatic)",
                          o->outline_width, o->line_width, o->font_size);
-    const cdem_rgba *cols[] = {&o->background, &o->wall,         &o->pregrowth[0], &o->pregrowth[1],
-                               &o->growth1[0], &o->growth1[1],   &o->growth2[0],   &o->growth2[1],
-                               &o->highlight,  &o->biaxial_edge, &o->footwall,     &o->undefined,
-                               &o->outline,    &o->vector,       &o->axis[0],      &o->axis[1],
-                               &o->text};
+    const cdem_rgba *cols[] = {&o->background, &o->wall,       &o->pregrowth[0], &o->pregrowth[1],
+                               &o->growth1[0], &o->growth1[1], &o->growth2[0],   &o->growth2[1],
+                               &o->salt[0],    &o->salt[1],    &o->highlight,    &o->biaxial_edge,
+                               &o->footwall,   &o->undefined,  &o->outline,      &o->vector,
+                               &o->axis[0],    &o->axis[1],    &o->text};
     for (size_t k = 0; k < sizeof cols / sizeof cols[0]; k++)
         if (!colour_ok(cols[k]))
             return CDEM_FAIL(err, CDEM_ERR_RANGE,
@@ -302,7 +304,11 @@ static int element_slot(const cdem_render_scene *sc, const cdem_render_options *
             return SLOT_MAP + (int)floor(t * (MAP_BINS - 1) + 0.5);
         }
     }
-    return layer_slot(o, s->layer ? s->layer[i] : 0);
+    const int32_t layer = s->layer ? s->layer[i] : 0;
+    const int slot = layer_slot(o, layer);
+    if ((f & CDEM_FLAG_SALT) && slot != SLOT_HIGHLIGHT)
+        return SLOT_SALT0 + (layer >= 1 ? ((layer - 1) / o->band_layers) % 2 : 0);
+    return slot;
 }
 
 static void slot_colours(const cdem_render_scene *sc, const cdem_render_options *o,
@@ -318,6 +324,8 @@ static void slot_colours(const cdem_render_scene *sc, const cdem_render_options 
     pal[SLOT_G1_1] = o->growth1[1];
     pal[SLOT_G2_0] = o->growth2[0];
     pal[SLOT_G2_1] = o->growth2[1];
+    pal[SLOT_SALT0] = o->salt[0];
+    pal[SLOT_SALT1] = o->salt[1];
     for (int k = 0; k < MAP_BINS; k++)
         pal[SLOT_MAP + k] = cdem_colormap_eval(sc->kind, (double)k / (MAP_BINS - 1));
     for (int k = 0; k < SLOT_FIXED_N; k++) {

@@ -91,6 +91,9 @@ typedef struct {
     cdem_rgba pregrowth[2]; /* alternating pre-growth bands: yellow, red */
     cdem_rgba growth1[2];   /* alternating growth sequence 1 bands: pale yellow, magenta */
     cdem_rgba growth2[2];   /* alternating growth sequence 2 bands: pale cyan, blue */
+    cdem_rgba salt[2];      /* salt elements (salt.layer), alternating by pre-growth layer:
+                               lilac, a darker lilac (a quantity's colours win, as for any
+                               element) */
     cdem_rgba highlight;    /* highlighted layers */
     cdem_rgba biaxial_edge; /* biaxial edge elements: green */
     cdem_rgba footwall;     /* fixed footwall display elements: light grey */

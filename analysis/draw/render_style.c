@@ -43,6 +43,8 @@ void cdem_render_options_default(cdem_render_options *o) {
     o->growth1[1] = rgb(0.85, 0.0, 0.85);  /* #d900d9 magenta */
     o->growth2[0] = rgb(0.75, 0.95, 1.0);  /* #bff2ff pale cyan */
     o->growth2[1] = rgb(0.1, 0.35, 0.85);  /* #1a59d9 blue */
+    o->salt[0] = rgb(0.784, 0.635, 0.910); /* #c8a2e8 lilac */
+    o->salt[1] = rgb(0.655, 0.498, 0.820); /* #a77fd1 darker lilac */
     o->highlight = rgb(0.2, 0.2, 0.2);     /* #333333 dark grey */
     o->biaxial_edge = rgb(0.0, 0.7, 0.0);  /* #00b300 green */
     o->footwall = rgb(0.8, 0.8, 0.8);      /* #cccccc light grey */
@@ -70,14 +72,15 @@ void cdem_render_format_colour(const cdem_rgba *c, char buf[10]) {
 
 void cdem_render_options_view(const cdem_render_options *o, FILE *f) {
     static const char *const colour_names[] = {
-        "background", "wall",      "pregrowth_0", "pregrowth_1",  "growth1_0", "growth1_1",
-        "growth2_0",  "growth2_1", "highlight",   "biaxial_edge", "footwall",  "undefined",
-        "outline",    "vector",    "axis_0",      "axis_1",       "text"};
-    const cdem_rgba *cols[] = {&o->background, &o->wall,         &o->pregrowth[0], &o->pregrowth[1],
-                               &o->growth1[0], &o->growth1[1],   &o->growth2[0],   &o->growth2[1],
-                               &o->highlight,  &o->biaxial_edge, &o->footwall,     &o->undefined,
-                               &o->outline,    &o->vector,       &o->axis[0],      &o->axis[1],
-                               &o->text};
+        "background", "wall",         "pregrowth_0", "pregrowth_1", "growth1_0",
+        "growth1_1",  "growth2_0",    "growth2_1",   "salt_0",      "salt_1",
+        "highlight",  "biaxial_edge", "footwall",    "undefined",   "outline",
+        "vector",     "axis_0",       "axis_1",      "text"};
+    const cdem_rgba *cols[] = {&o->background, &o->wall,       &o->pregrowth[0], &o->pregrowth[1],
+                               &o->growth1[0], &o->growth1[1], &o->growth2[0],   &o->growth2[1],
+                               &o->salt[0],    &o->salt[1],    &o->highlight,    &o->biaxial_edge,
+                               &o->footwall,   &o->undefined,  &o->outline,      &o->vector,
+                               &o->axis[0],    &o->axis[1],    &o->text};
     fprintf(f, "render.width = %d\n", o->width);
     fprintf(f, "render.height = %d%s\n", o->height, o->height == 0 ? " (automatic)" : "");
     if (o->has_zoom)

@@ -157,6 +157,13 @@ cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_
     return CDEM_OK;
 }
 
+/* 1 for a field added to the state after checkpoints first shipped, when the checkpoint
+ * (written by an older cdem-run) lacks it: the field then takes its value of an element that
+ * never changed it (area_ratio: 1, no salt existed then). */
+static int added_later_and_absent(const cdem_state_field *f, const cdem_snapshot *s) {
+    return strcmp(f->name, "area_ratio") == 0 && !cdem_snapshot_get(s, "state.area_ratio");
+}
+
 cdem_status cdem_ckpt_state_get(cdem_state *st, const cdem_snapshot *s, cdem_error *err) {
     int64_t n = 0, next_id = 0, has_stress = 0;
     CDEM_TRY(cdem_ckpt_get_range(s, "state", "n", 0, INT32_MAX, &n, err));
@@ -165,7 +172,7 @@ cdem_status cdem_ckpt_state_get(cdem_state *st, const cdem_snapshot *s, cdem_err
     /* check every array before touching st */
     for (size_t k = 0; k < cdem_state_field_count; k++) {
         const cdem_state_field *f = &cdem_state_fields[k];
-        if (f->stress && !has_stress)
+        if ((f->stress && !has_stress) || added_later_and_absent(f, s))
             continue;
         const cdem_snapshot_array *a = NULL;
         CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, snap_type(f->type), (size_t)n, &a, err));
@@ -177,6 +184,11 @@ cdem_status cdem_ckpt_state_get(cdem_state *st, const cdem_snapshot *s, cdem_err
         const cdem_state_field *f = &cdem_state_fields[k];
         if (f->stress && !has_stress)
             continue;
+        if (added_later_and_absent(f, s)) {
+            for (int64_t i = 0; i < n; i++)
+                st->area_ratio[i] = 1.0;
+            continue;
+        }
         const cdem_snapshot_array *a = NULL;
         CDEM_TRY(cdem_ckpt_get_array(s, "state", f->name, snap_type(f->type), (size_t)n, &a, err));
         if (n > 0)

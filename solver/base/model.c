@@ -60,6 +60,21 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         if (light > 0 && light < m->min_mass)
             m->min_mass = light;
     }
+    cdem_salt_model *salt = &m->salt;
+    if (p->salt_layer != CDEM_SALT_OFF) {
+        if (!(p->salt_density > 0.0) || !isfinite(p->salt_density))
+            return CDEM_FAIL(
+                err, CDEM_ERR_RANGE,
+                "cannot derive the model: salt.salt_density = %g kg/m^3 must be positive",
+                p->salt_density);
+        salt->on = 1;
+        salt->density = p->salt_density;
+        for (int i = 0; i < CDEM_NUM_RADII; i++)
+            salt->mass[i] = p->salt_density * M_PI * m->radius[i] * m->radius[i];
+        if (salt->mass[0] < m->min_mass) /* a lighter salt sets the time step, as a light
+                                            interval does */
+            m->min_mass = salt->mass[0];
+    }
 
     if (p->keep_constants || p->unit_scaling >= 1000.0) {
         m->kn = kn_default;
@@ -71,6 +86,9 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         m->damping = m->average_radius * damping_per_radius;
     }
     m->ks = m->kn;
+    if (p->damping_mode == CDEM_DAMPING_CONTACT) /* dashpots on the contacts: deformation
+                                                    steps have no absolute damping (run.c) */
+        m->contact_damping = p->contact_damping;
     m->boundary_speed = CDEM_BOUNDARY_ACCEL * m->dt;
     m->displacement_per_step = m->boundary_speed * m->dt;
     m->gravity = m->mode.gravity_off ? 0.0 : p->gravity;
@@ -120,6 +138,22 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
     m->sediment_steps = lround(m->sediment_interval / m->displacement_per_step);
     m->settling_steps = lround(0.2 * p->equilibration / m->dt);
     m->sea_level_factor = sea_factor[p->sea_level_rise];
+    if (salt->on) {
+        salt->viscosity_geological = p->salt_viscosity;
+        salt->rate = p->salt_rate * 1e-3 / CDEM_SECONDS_PER_YEAR;
+        salt->time_scale =
+            isnan(p->salt_time_scale) ? m->boundary_speed / salt->rate : p->salt_time_scale;
+        salt->viscosity = p->salt_viscosity / salt->time_scale;
+        salt->bulk_modulus = p->salt_bulk_modulus;
+        salt->grid_spacing = p->salt_grid_spacing * m->average_radius;
+        salt->reach = p->salt_reach;
+        salt->dashpot_fraction = p->salt_dashpot_fraction;
+        if (!(salt->viscosity > 0.0) || !isfinite(salt->viscosity))
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "cannot derive the model: salt.viscosity = %g Pa s over the time "
+                             "scale %g gives a model viscosity of %g Pa s",
+                             p->salt_viscosity, salt->time_scale, salt->viscosity);
+    }
     return CDEM_OK;
 }
 

@@ -55,6 +55,28 @@ static inline cdem_model_mode cdem_model_mode_default(void) {
     return (cdem_model_mode){NULL, 1, NULL, 0.0, 0.0, 0.0, NULL, NULL};
 }
 
+/* The salt's constants (salt.*; docs/solver.md, "Salt"), all 0 when salt.layer = off. The
+ * model runs at natural lengths, densities and gravity but with time compressed by
+ * time_scale S = boundary speed / geological rate; the salt's model viscosity is the
+ * geological one / S, which keeps the ratio of viscous to gravitational and frictional
+ * stresses (eta V / (rho g h H)) of nature. */
+typedef struct {
+    int on;                      /* 1: salt.layer is basal or interval */
+    double density;              /* kg/m^3 */
+    double mass[CDEM_NUM_RADII]; /* kg per metre, density * pi r^2 of each radius class */
+    double viscosity_geological; /* Pa s, salt.viscosity */
+    double rate;                 /* m/s, salt.rate in SI */
+    double time_scale;           /* S: geological seconds per model second */
+    double viscosity;            /* Pa s, the model's: viscosity_geological / S */
+    double bulk_modulus;         /* Pa */
+    double grid_spacing;         /* m, salt.grid_spacing x the average radius */
+    double reach;                /* the pair dashpots' reach / (r_i + r_j) */
+    double dashpot_fraction;     /* alpha of the pair dashpots */
+} cdem_salt_model;
+
+/* Seconds in a (Julian) year: salt.rate is in mm per year. */
+#define CDEM_SECONDS_PER_YEAR (365.25 * 86400.0)
+
 typedef struct {
     double radius[CDEM_NUM_RADII]; /* m, ascending */
     double mass[CDEM_NUM_RADII];   /* kg per metre of thickness, density * pi r^2 */
@@ -62,7 +84,11 @@ typedef struct {
     double average_radius;         /* m, mean of the four radii */
     double max_radius;             /* m */
     double kn, ks;                 /* N/m, normal and shear spring stiffness */
-    double damping;                /* N s/m, viscous force = -damping * velocity */
+    double damping;                /* N s/m, viscous force = -damping * velocity (absolute
+                                      damping; with physics.damping_mode = contact only on the
+                                      steps of equilibration and sediment settling) */
+    double contact_damping;        /* contact dashpots as a fraction of critical (0 with
+                                      damping_mode = absolute) */
     double dt;                     /* s, 0.25 sqrt(min_mass / kn) */
     double boundary_speed;         /* m/s, CDEM_BOUNDARY_ACCEL * dt */
     double displacement_per_step;  /* m, boundary_speed * dt */
@@ -79,6 +105,7 @@ typedef struct {
     long settling_steps;           /* steps of settling after each sediment event */
     double sea_level_factor;       /* 0, 0.25, 0.5, 0.75, 1.0 */
     cdem_model_mode mode;          /* what the boundary mode decided (its derive hook) */
+    cdem_salt_model salt;          /* the salt's constants (all 0 without salt) */
 } cdem_model;
 
 /* Computes every derived quantity from the parameters and the mode's part `mode` (its derive

@@ -24,7 +24,8 @@ const char *cdem_contact_class_name(int cls) {
 }
 
 int cdem_contact_class(uint32_t flags_i, uint32_t flags_j) {
-    if ((flags_i | flags_j) & CDEM_FLAG_FOOTWALL)
+    /* a salt pair is the salt module's (solver/step/salt.h), never the pair list's */
+    if ((flags_i | flags_j) & (CDEM_FLAG_FOOTWALL | CDEM_FLAG_SALT))
         return -1;
     if ((flags_i & CDEM_FLAGS_BOUNDARY) && (flags_j & CDEM_FLAGS_BOUNDARY))
         return -1;

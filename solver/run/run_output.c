@@ -1,9 +1,11 @@
 /* run_output: what a run writes into its file besides checkpoints (run_ctx.h): the
- * increments (after the erosion due before them, with the stress when asked), the time-series
- * samples (kinetic energy, contacts, bonds, boundary and base forces, the mode's measures) and
- * the summary text. */
+ * increments (after the erosion due before them, with the stress when asked: the salt's
+ * elements their continuum stress; the salt's area change tracked for the final log), the
+ * time-series samples (kinetic energy, contacts, bonds, boundary and base forces, the mode's
+ * measures) and the summary text. */
 #include "run_ctx.h"
 
+#include "salt.h"
 #include "stress.h"
 #include "summary.h"
 
@@ -31,8 +33,19 @@ static cdem_status erode(run_ctx *r, cdem_error *err) {
 
 cdem_status run_write_increment(run_ctx *r, cdem_error *err) {
     CDEM_TRY(erode(r, err));
-    if (r->p->calculate_stress)
+    if (r->p->calculate_stress) {
         CDEM_TRY(cdem_stress_compute(&r->it.nb, &r->s, err));
+        /* salt elements: their continuum stress (no pair of the list carries theirs) */
+        cdem_salt_stress(&r->it.viscous.salt, &r->s);
+    }
+    if (r->salt.elements > 0 && r->salt.phi > 0.0) {
+        double area, top;
+        long count;
+        cdem_salt_measures(&r->s, r->salt.phi, &area, &top, &count);
+        const double change = fabs(area / (r->salt.disc_area / r->salt.phi) - 1.0);
+        if (change > r->salt_area_change)
+            r->salt_area_change = change;
+    }
     cdem_increment_info inf;
     memset(&inf, 0, sizeof inf);
     inf.number = r->next_inc;

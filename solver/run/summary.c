@@ -10,6 +10,7 @@
 #include "summary.h"
 
 #include "bc.h"
+#include "salt.h"
 #include "summary_line.h"
 
 #include <math.h>
@@ -41,6 +42,54 @@ static void contact_line(FILE *f, const char *label, const cdem_params *p,
     else
         line(f, label, "breaking strain %g (bond breaks when r - R >= %g R)", c->breaking_strain,
              c->breaking_strain);
+}
+
+/* The salt's section (docs/solver.md, section 9): where it is, its material and how the
+ * model's clock maps onto geological time, with the ratio that mapping keeps. */
+static void salt_lines(FILE *f, const cdem_params *p, const cdem_model *m) {
+    const cdem_salt_model *sm = &m->salt;
+    cdem_salt_time t;
+    cdem_salt_time_map(p, m, &t);
+    heading(f, "Salt");
+    if (p->salt_layer == CDEM_SALT_BASAL)
+        line(f, "layer",
+             "basal, lowest %g %% of the span of element centres = %.6g m (fixed at "
+             "assembly)",
+             p->salt_thickness_percent, t.salt_thickness);
+    else
+        line(f, "layer",
+             "interval from %g to %g %% of the span of element centres = %.6g m "
+             "(fixed at assembly)",
+             p->salt_interval_bottom_percent, p->salt_interval_top_percent, t.salt_thickness);
+    line(f, "cover above", "%.6g m", t.cover_thickness);
+    line(f, "salt density", "%g kg/m^3 (smallest salt mass %.6g kg/m)", sm->density, sm->mass[0]);
+    line(f, "viscosity", "%g Pa s geological = %.4g Pa s in the model (/ time scale)",
+         sm->viscosity_geological, sm->viscosity);
+    line(f, "geological rate", "%g mm/yr = %.4g m/s, shown by the model's %.6g m/s", p->salt_rate,
+         sm->rate, m->boundary_speed);
+    line(f, "time scale S", "%.4g (1 model s = %.4g yr%s)", sm->time_scale,
+         sm->time_scale / CDEM_SECONDS_PER_YEAR,
+         isnan(p->salt_time_scale) ? "; boundary speed / geological rate" : "; salt.time_scale");
+    line(f, "deformation phase", "%g s of model time = %.4g Myr", p->runtime - p->equilibration,
+         t.deformation_yr / 1e6);
+    if (isnan(t.pi_ratio))
+        line(f, "eta V / (rho g h H)", "none (gravity off)");
+    else
+        line(f, "eta V / (rho g h H)",
+             "%.3g (salt %.6g m, cover %.6g m): the same in model and nature", t.pi_ratio,
+             t.salt_thickness, t.cover_thickness);
+    line(f, "Reynolds number", "%.3g (rho_s V h / eta in the model; %s)", t.reynolds,
+         t.reynolds < 0.1 ? "viscous" : "WARNING: above 0.1, inertia is not negligible");
+    line(f, "grid", "%.6g m (%g mean radii), bulk modulus %g Pa", sm->grid_spacing,
+         p->salt_grid_spacing, sm->bulk_modulus);
+    line(f, "time-step limits", "grid viscosity %.3g s, grid pressure %.3g s (time step %.6g s)",
+         t.dt_viscous, t.dt_pressure, m->dt);
+    line(f, "damping", "%s (absolute damping would give D = %.3g)",
+         p->damping_mode == CDEM_DAMPING_CONTACT ? "contact" : "absolute", t.damping_number);
+    line(f, "contacts", "cover %s, base %s, walls %s; salt pairs: no friction, no cohesion",
+         p->salt_cover_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip",
+         p->salt_base_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip",
+         p->salt_wall_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip");
 }
 
 cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
@@ -95,7 +144,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     }
     line(f, "average radius", "%.6g m", m->average_radius);
     line(f, "smallest mass", "%.6g kg/m%s", m->min_mass,
-         m->min_mass < m->mass[0] ? " (light interval)" : "");
+         m->salt.on && m->min_mass == m->salt.mass[0] ? " (salt)"
+         : m->min_mass < m->mass[0]                   ? " (light interval)"
+                                                      : "");
 
     heading(f, "Constants");
     const char *kn_origin = p->unit_scaling >= 1000.0 ? "default constant"
@@ -103,7 +154,12 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
                                                       : "scaled with the average radius";
     line(f, "normal stiffness Kn", "%.10g N/m (%s)", m->kn, kn_origin);
     line(f, "shear stiffness Ks", "%.10g N/m", m->ks);
-    if (p->deformation_damping == 1.0)
+    if (p->damping_mode == CDEM_DAMPING_CONTACT)
+        line(f, "damping",
+             "%.8g N s/m in equilibration and settling; contact dashpots of %g "
+             "of critical on deformation steps (physics.damping_mode = contact)",
+             m->damping, p->contact_damping);
+    else if (p->deformation_damping == 1.0)
         line(f, "damping", "%.8g N s/m", m->damping);
     else
         line(f, "damping", "%.8g N s/m; x %g on deformation steps (physics.deformation_damping)",
@@ -204,6 +260,9 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     else
         line(f, "layered friction", "off");
     line(f, "pre-growth layers", "%d of equal thickness", CDEM_PREGROWTH_LAYERS);
+
+    if (m->salt.on)
+        salt_lines(f, p, m);
 
     heading(f, "Surface processes");
     if (p->overburden_pressure > 0)

@@ -50,6 +50,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
     CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
                                  RESORT_EVERY, err));
+    cdem_viscous_init(&it->viscous, m);
     return CDEM_OK;
 }
 
@@ -60,6 +61,7 @@ void cdem_integrator_free(cdem_integrator *it) {
     cdem_force_free(&it->force);
     cdem_loads_free(&it->loads);
     cdem_removal_free(&it->removal);
+    cdem_viscous_free(&it->viscous);
     free(it->kick.drift);
     free(it->kick.finish);
     memset(it, 0, sizeof *it);
@@ -121,6 +123,7 @@ static cdem_status build_list(cdem_integrator *it, cdem_state *s, const unsigned
     CDEM_TRY(cdem_neighbour_build(&it->nb, s, keep, 0, err));
     CDEM_TRY(cdem_force_reserve(&it->force, &it->nb, s->n, err));
     CDEM_TRY(reserve_kick(&it->kick, s->n, err));
+    CDEM_TRY(cdem_viscous_after_build(&it->viscous, &it->nb, s, err));
     cdem_integrator_classify(it, s);
     return cdem_loads_after_build(&it->loads, s, err);
 }
@@ -211,6 +214,29 @@ static int forces_and_kick(cdem_integrator *it, cdem_state *s, unsigned what, cd
     return 0;
 }
 
+/* The viscous forces (viscous.h) of a configuration's first forces (prime, removals): added
+ * to the forces, no kick. */
+static void viscous_without_kick(cdem_integrator *it, cdem_state *s) {
+    if (!cdem_viscous_active(&it->viscous))
+        return;
+    cdem_viscous_forces(&it->viscous, &it->nb, s);
+    cdem_viscous_finish(&it->viscous, s, 0, 0.0, 0.0);
+}
+
+/* The rest of a step with viscous forces (viscous.h), after the drift and the mode: the list
+ * brought up to date first (their forces and the pass must see the same element order), their
+ * forces at the mid-step velocities, the force pass, and their share of the second kick. */
+static cdem_status step_with_viscous(cdem_integrator *it, cdem_state *s, cdem_error *err) {
+    if (cdem_neighbour_needs_rebuild(&it->nb, s)) {
+        CDEM_TRY(check_finite(it, s, err));
+        CDEM_TRY(rebuild(it, s, err));
+    }
+    cdem_viscous_forces(&it->viscous, &it->nb, s);
+    forces_and_kick(it, s, PASS_KICK, NULL, NULL);
+    cdem_viscous_finish(&it->viscous, s, 1, it->dt, cdem_integrator_damping(it));
+    return CDEM_OK;
+}
+
 cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error *err) {
     for (size_t i = 0; i < s->n; i++)
         if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) && !(s->mass[i] > 0.0))
@@ -220,6 +246,7 @@ cdem_status cdem_integrator_prime(cdem_integrator *it, cdem_state *s, cdem_error
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
     forces_and_kick(it, s, PASS_NO_INCREMENT, NULL, NULL);
+    viscous_without_kick(it, s);
     return CDEM_OK;
 }
 
@@ -253,7 +280,9 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(cdem_integrator_prime(it, s, err));
     /* the drift in the force pass's region when the mode commutes with it (top of file) */
     const int list_current = it->nb.n == s->n;
-    const int drift_in_pass = list_current && (!bc || cdem_bc_apply_is_boundary_only(bc, k));
+    const int viscous = cdem_viscous_active(&it->viscous); /* mid-step velocities wanted */
+    const int drift_in_pass =
+        list_current && !viscous && (!bc || cdem_bc_apply_is_boundary_only(bc, k));
     if (!drift_in_pass)
         drift(it, s);
     it->step++;
@@ -264,6 +293,8 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         CDEM_TRY(cdem_bc_step_begin(bc, k, du, it->dt, err));
     else if (bc)
         CDEM_TRY(cdem_bc_apply(bc, s, k, du, it->dt, err));
+    if (viscous)
+        return step_with_viscous(it, s, err);
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
     if (list_current &&
         forces_and_kick(it, s, PASS_KICK | PASS_CHECK_MOVED | (drift_in_pass ? PASS_DRIFT : 0u),
@@ -284,6 +315,7 @@ static cdem_status remove_marked(cdem_integrator *it, cdem_state *s, size_t nrem
     it->removal.n_removed_last = nrem;
     CDEM_TRY(build_list(it, s, it->removal.keep, err));
     forces_and_kick(it, s, PASS_NO_INCREMENT, NULL, NULL);
+    viscous_without_kick(it, s);
     return CDEM_OK;
 }
 
@@ -426,6 +458,7 @@ cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapsho
     CDEM_TRY(cdem_ckpt_get_f64(snap, P, "confining_factor", &cf, err));
     CDEM_TRY(cdem_ckpt_get_f64(snap, P, "edge_x_mid", &exmid, err));
     CDEM_TRY(cdem_neighbour_snapshot_get(&it->nb, snap, s, err));
+    CDEM_TRY(cdem_viscous_after_build(&it->viscous, &it->nb, s, err));
     CDEM_TRY(cdem_removal_reserve(rm, s->n, err));
     CDEM_TRY(cdem_force_reserve(&it->force, &it->nb, s->n, err));
     CDEM_TRY(reserve_kick(&it->kick, s->n, err));
