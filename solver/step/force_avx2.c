@@ -205,7 +205,7 @@ pairs_of_law(const cdem_force_pairs *a, long p0, long p1, int32_t below, law_lan
     return pairs_with_law(a, p0, p1, below, lanes);
 }
 
-AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+AVX2 static inline long pairs_by_law(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
     switch (a->law->granular) { /* one case per row of laws.def */
 #define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
     case CDEM_LAW_##ID:                                                                            \
@@ -219,6 +219,17 @@ AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int
     }
 }
 
+/* Both functions called from the baseline code end with the upper halves of the vector
+ * registers zero (vzeroupper; GCC 12 inserts none in these target("avx2") functions): else
+ * every SSE instruction after them (the element loops of the pass, the list builds, the
+ * output) runs with the upper halves in use, up to 4 times slower on an AMD EPYC (Zen 5;
+ * docs/performance.md, "Speed on every CPU"). */
+AVX2 long cdem_force_pairs_avx2(const cdem_force_pairs *a, long p0, long p1, int32_t below) {
+    const long left = pairs_by_law(a, p0, p1, below);
+    _mm256_zeroupper();
+    return left;
+}
+
 AVX2 void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, double *acc) {
     const int32_t *restrict pi = a->pi, *restrict pj = a->pj;
     const double *restrict pfx = a->pfx, *restrict pfy = a->pfy;
@@ -229,6 +240,7 @@ AVX2 void cdem_force_scatter_avx2(const cdem_force_pairs *a, long p0, long p1, d
         _mm_storeu_pd(sj, _mm_sub_pd(_mm_loadu_pd(sj), u));
         _mm_storeu_pd(si, _mm_add_pd(_mm_loadu_pd(si), u));
     }
+    _mm256_zeroupper();
 }
 
 #else
