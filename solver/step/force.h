@@ -22,11 +22,13 @@
 
 #include <stdatomic.h>
 
-/* Paths: how the pair forces are evaluated. Both give the same bits (force_pairs.h says
- * how); the vector one is faster where the CPU has AVX2. */
+/* Paths: how the pair forces and the element loops of the pass are evaluated. Both give the
+ * same bits (force_pairs.h says how); the vector one is faster where the CPU has AVX2. It
+ * reads the elements of a pair from a packed copy (x, y, vx, vy of an element in 32 bytes)
+ * rather than gathering them, and runs the element loops (drift, finish) in lanes too. */
 typedef enum {
-    CDEM_FORCE_PATH_AUTO = 0, /* not chosen yet: the first pass calls cdem_force_path_choose
-                                 with the environment's CDEM_SIMD */
+    CDEM_FORCE_PATH_AUTO = 0, /* not chosen yet: the first need (reserve or pass) calls
+                                 cdem_force_path_choose with the environment's CDEM_SIMD */
     CDEM_FORCE_PATH_SCALAR,   /* one pair at a time (any CPU) */
     CDEM_FORCE_PATH_AVX2,     /* four pairs at a time in AVX2 lanes, blocks of pairs evaluated
                                  then scattered */
@@ -70,9 +72,11 @@ typedef struct {
     double chunk_time[CDEM_MAX_CHUNKS];  /* s per pass, running mean (0: none yet) */
     double *acc;          /* the vector path's per-element contact-force sums, x and y
                              interleaved (acc[2e], acc[2e+1]): one 128-bit add per pair end */
-    size_t acccap;        /* elements acc holds */
-    cdem_force_path path; /* the pair evaluation (AUTO until the first pass; a caller may set
-                             SCALAR, or AVX2 when cdem_force_path_choose(NULL) gives it) */
+    double *pos4;         /* the vector path's packed elements (force_pairs.h: x, y, vx, vy of
+                             element e at pos4[4e]), 32-byte aligned */
+    size_t acccap;        /* elements acc and pos4 hold */
+    cdem_force_path path; /* the pass's path (AUTO until the first need; a caller may set
+                             any path cdem_force_path_usable accepts) */
 } cdem_force;
 
 /* The loads the element finish adds to the contact-force sum of a free element. */
@@ -116,6 +120,9 @@ void cdem_force_free(cdem_force *f);
  * build and the CPU have it, else scalar). CDEM_SIMD=scalar in the environment forces the
  * scalar path (tests, comparisons). */
 cdem_force_path cdem_force_path_choose(const char *request);
+
+/* 1 when this build and this CPU run path (SCALAR always; AVX2), else 0. */
+int cdem_force_path_usable(cdem_force_path path);
 
 /* "auto", "scalar" or "avx2". */
 const char *cdem_force_path_name(cdem_force_path path);
