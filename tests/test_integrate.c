@@ -238,6 +238,8 @@ static void run_box_with(int threads, int nsteps, cdem_state *out, box_material 
     it.par_min = 0; /* thread every loop, whatever its size */
     assert_true(cdem_force_path_usable(path));
     it.force.path = path;
+    /* the list build's distance test follows the path (scalar, or vector where usable) */
+    it.nb.simd = path == CDEM_FORCE_PATH_SCALAR || !cdem_neighbour_avx2_usable() ? 1 : 2;
     if (!mat.bonded && mat.rule == CDEM_COHESIVE_INITIAL)
         cdem_integrator_mark_initial(&it, out);
     for (int k = 0; k < nsteps; k++) {
