@@ -236,10 +236,12 @@ static void run_box_with(int threads, int nsteps, cdem_state *out, box_material 
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
     cdem_integrator_enable_escape(&it);
     it.par_min = 0; /* thread every loop, whatever its size */
-    assert_true(cdem_force_path_usable(path));
-    it.force.path = path;
-    /* the list build's distance test follows the path (scalar, or vector where usable) */
-    it.nb.simd = path == CDEM_FORCE_PATH_SCALAR || !cdem_neighbour_avx2_usable() ? 1 : 2;
+    if (path != CDEM_FORCE_PATH_AUTO) {
+        assert_true(cdem_force_path_usable(path));
+        it.force.path = path;
+        /* the list build's distance test follows the path (scalar, or vector where usable) */
+        it.nb.simd = path == CDEM_FORCE_PATH_SCALAR || !cdem_neighbour_avx2_usable() ? 1 : 2;
+    }
     if (!mat.bonded && mat.rule == CDEM_COHESIVE_INITIAL)
         cdem_integrator_mark_initial(&it, out);
     for (int k = 0; k < nsteps; k++) {
@@ -254,7 +256,13 @@ static void run_box_with(int threads, int nsteps, cdem_state *out, box_material 
     }
     assert_true(it.nb.np > 2048);
     assert_true(it.nb.n_builds > 1);
-    assert_int_equal(it.force.path, path);
+    if (path != CDEM_FORCE_PATH_AUTO) {
+        assert_int_equal(it.force.path, path);
+    } else { /* chosen (and measured where there was a choice) by now */
+        assert_true(it.force.path != CDEM_FORCE_PATH_AUTO);
+        assert_true(cdem_force_path_usable(it.force.path));
+        assert_int_equal(it.force.measure_left, 0);
+    }
     cdem_integrator_free(&it);
 }
 
@@ -276,8 +284,8 @@ static void assert_same_state(const cdem_state *a, const cdem_state *b) {
 /* The vector paths this CPU runs (force.h, "Paths") into paths; returns how many. */
 static int vector_paths(cdem_force_path paths[3]) {
     int n = 0;
-    static const cdem_force_path all[1] = {CDEM_FORCE_PATH_AVX2};
-    for (int k = 0; k < 1; k++) {
+    static const cdem_force_path all[2] = {CDEM_FORCE_PATH_AVX2, CDEM_FORCE_PATH_AVX512};
+    for (int k = 0; k < 2; k++) {
         if (cdem_force_path_usable(all[k]))
             paths[n++] = all[k];
         else
@@ -346,6 +354,23 @@ static void test_integrate_threads_change_mid_run(void **st) {
         cdem_state_free(&a);
         cdem_state_free(&b);
     }
+    omp_set_num_threads(1);
+}
+
+/* A path left to the pass (AUTO): the environment's CDEM_SIMD, or, without one on a CPU with
+ * AVX2 and AVX-512, the first passes alternating between the two and timing themselves
+ * (force.h). Whatever it chose and while it measured, the bits are the scalar path's, on 1 and
+ * 2 threads. */
+static void test_integrate_measured_path(void **st) {
+    (void)st;
+    cdem_state a, b;
+    run_box_with(1, 120, &a, box_default, CDEM_FORCE_PATH_SCALAR);
+    for (int threads = 1; threads <= 2; threads++) {
+        run_box_with(threads, 120, &b, box_default, CDEM_FORCE_PATH_AUTO);
+        assert_same_state(&a, &b);
+        cdem_state_free(&b);
+    }
+    cdem_state_free(&a);
     omp_set_num_threads(1);
 }
 
@@ -430,8 +455,8 @@ static void test_integrate_vector_paths_leave_upper_clean(void **st) {
                                      .flags = s.flags,
                                      .dt = dt,
                                      .pos4 = it.force.pos4};
-    const cdem_force_kernels *ks[1] = {cdem_force_kernels_avx2()};
-    for (int k = 0; k < 1; k++) {
+    const cdem_force_kernels *ks[2] = {cdem_force_kernels_avx2(), cdem_force_kernels_avx512()};
+    for (int k = 0; k < 2; k++) {
         if (!ks[k])
             continue;
         ks[k]->pack(s.x, s.y, s.vx, s.vy, 0, n, it.force.pos4);
@@ -638,6 +663,7 @@ int main(void) {
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
         cmocka_unit_test(test_integrate_simd_paths),
+        cmocka_unit_test(test_integrate_measured_path),
         cmocka_unit_test(test_integrate_vector_paths_leave_upper_clean),
         cmocka_unit_test(test_integrate_threads_change_mid_run),
         cmocka_unit_test(test_integrate_unstable_guard),

@@ -34,14 +34,24 @@ void cdem_force_free(cdem_force *f) {
 /* The path of f's passes: chosen at the first need (reserve or pass) from the environment's
  * CDEM_SIMD (force.h), unless a caller set it. */
 static cdem_force_path path_of(cdem_force *f) {
-    if (f->path == CDEM_FORCE_PATH_AUTO)
-        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    if (f->path == CDEM_FORCE_PATH_AUTO) {
+        const char *req = getenv("CDEM_SIMD");
+        f->path = cdem_force_path_choose(req);
+        /* no request and two vector paths: the first passes measure which is faster here */
+        if ((!req || !*req || strcmp(req, "auto") == 0) && f->path == CDEM_FORCE_PATH_AVX2 &&
+            cdem_force_path_usable(CDEM_FORCE_PATH_AVX512)) {
+            f->measure_left = 2 * CDEM_FORCE_MEASURE_PASSES;
+            f->measure_time[0] = f->measure_time[1] = 0.0;
+        }
+    }
     return f->path;
 }
 
 /* The vector kernels of a path, or NULL (the scalar path). */
 static const cdem_force_kernels *kernels_of(cdem_force_path path) {
-    return path == CDEM_FORCE_PATH_AVX2 ? cdem_force_kernels_avx2() : NULL;
+    return path == CDEM_FORCE_PATH_AVX2     ? cdem_force_kernels_avx2()
+           : path == CDEM_FORCE_PATH_AVX512 ? cdem_force_kernels_avx512()
+                                            : NULL;
 }
 
 cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n, cdem_error *err) {
@@ -437,18 +447,22 @@ static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t 
 }
 
 int cdem_force_path_usable(cdem_force_path path) {
-    return path == CDEM_FORCE_PATH_SCALAR || (path == CDEM_FORCE_PATH_AVX2 && kernels_of(path));
+    return path == CDEM_FORCE_PATH_SCALAR ||
+           ((path == CDEM_FORCE_PATH_AVX2 || path == CDEM_FORCE_PATH_AVX512) && kernels_of(path));
 }
 
 cdem_force_path cdem_force_path_choose(const char *request) {
     if (request && strcmp(request, "scalar") == 0)
         return CDEM_FORCE_PATH_SCALAR;
+    if (request && strcmp(request, "avx512") == 0 && cdem_force_path_usable(CDEM_FORCE_PATH_AVX512))
+        return CDEM_FORCE_PATH_AVX512;
     return cdem_force_path_usable(CDEM_FORCE_PATH_AVX2) ? CDEM_FORCE_PATH_AVX2
                                                         : CDEM_FORCE_PATH_SCALAR;
 }
 
 const char *cdem_force_path_name(cdem_force_path path) {
     return path == CDEM_FORCE_PATH_AVX2     ? "avx2"
+           : path == CDEM_FORCE_PATH_AVX512 ? "avx512"
            : path == CDEM_FORCE_PATH_SCALAR ? "scalar"
                                             : "auto";
 }
@@ -508,9 +522,10 @@ static int pass_drift(const force_pass *fp, cdem_state *s, const cdem_force_step
     return fp->vec->drift(&d, lo, hi);
 }
 
-/* The pass (force.h): the parallel driver of chunk_pass; see the top of this file. */
-int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
-                    long *unstable) {
+/* The pass (force.h) with the vector kernels vec (NULL: the scalar path): the parallel driver
+ * of chunk_pass; see the top of this file. */
+static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
+                     long *unstable, const cdem_force_kernels *vec) {
     cdem_contact_law lawc; /* the law of this step, a local copy: provably not aliased by stores */
     cdem_contact_law_phase(in->law, in->equilibrating, &lawc);
     const int kick = in->kick, check_moved = in->check_moved;
@@ -549,7 +564,7 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     };
     /* (a pass before the first cdem_force_reserve for this size takes the scalar path: the
      * same bits) */
-    fp.vec = f->acc && f->acccap >= (size_t)n ? kernels_of(path_of(f)) : NULL;
+    fp.vec = f->acc && f->acccap >= (size_t)n ? vec : NULL;
     fp.packed = fp.vec && in->drift;
     fp.acc = f->acc;
     fp.pairs = (cdem_force_pairs){.law = &lawc,
@@ -647,4 +662,29 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
             break;
         }
     return 0;
+}
+
+/* The pass (force.h). While the path is being measured (path_of), the passes alternate
+ * between the AVX2 and the AVX-512 kernels (the same bits) and time themselves by the wall
+ * clock; after CDEM_FORCE_MEASURE_PASSES complete passes each, the one with the shorter
+ * fastest pass is the path (the fastest rather than the sum: a pass the machine's other work
+ * interrupted says nothing of the kernel). */
+int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
+                    long *unstable) {
+    const cdem_force_path path = path_of(f);
+    if (f->measure_left <= 0)
+        return pass_with(f, nb, s, in, unstable, kernels_of(path));
+    const int k = f->measure_left & 1;
+    const double t0 = omp_get_wtime();
+    const int r = pass_with(f, nb, s, in, unstable,
+                            kernels_of(k ? CDEM_FORCE_PATH_AVX512 : CDEM_FORCE_PATH_AVX2));
+    if (r == 0) {
+        const double t = omp_get_wtime() - t0;
+        if (f->measure_time[k] == 0.0 || t < f->measure_time[k])
+            f->measure_time[k] = t;
+        if (--f->measure_left == 0)
+            f->path = f->measure_time[1] < f->measure_time[0] ? CDEM_FORCE_PATH_AVX512
+                                                              : CDEM_FORCE_PATH_AVX2;
+    }
+    return r;
 }

@@ -188,5 +188,7 @@ typedef struct {
 
 /* The AVX2 kernels (force_avx2.c), or NULL when this build or this CPU has none. */
 const cdem_force_kernels *cdem_force_kernels_avx2(void);
+/* The AVX-512 pair kernel with the AVX2 element loops (force_avx512.c), or NULL. */
+const cdem_force_kernels *cdem_force_kernels_avx512(void);
 
 #endif
