@@ -68,7 +68,9 @@ peak_mb() { awk -F: '/Maximum resident set size/ {printf "%.0f", $2/1024}' "$1";
 relerr() { awk -v a="$1" -v b="$2" 'BEGIN {d=a-b; if (d<0) d=-d; m=(b<0?-b:b); print (m>0? d/m : d)}'; }
 
 echo "lammps_bench: $(lmp -h | grep -m1 '^Large-scale' || true) $(lmp -h | grep -m1 'LAMMPS (' || true)"
-echo "lammps_bench: machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+# the CPU model, printed with every figure (run_bench.sh passes its own)
+CPU=${CDEM_BENCH_CPU:-$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')}
+echo "lammps_bench: machine: $CPU, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
 failed=""
 for size in $SIZES; do
     width=$(echo "$size" | cut -d: -f1)
@@ -143,19 +145,19 @@ for size in $SIZES; do
         "$dir/lmp1.log" | tail -n "$REPS" | median)
     rate() { awk -v n="$n" -v s="$ntime" -v t="$1" 'BEGIN {printf "%.3g", n * s / t}'; }
     ratio() { awk -v a="$1" -v b="$2" 'BEGIN {printf "%.2f", b / a}'; }
-    echo "   timing (median of $REPS x $ntime steps; element-steps/s counting all $n elements):"
-    echo "     cdem   1 thread : $c1 s  $(rate "$c1") el-steps/s  (list builds in the $REPS runs: $cb)"
-    echo "     cdem   2 threads: $c2 s  $(rate "$c2") el-steps/s"
-    echo "     LAMMPS 1 rank   : $l1 s  $(rate "$l1") el-steps/s  (list builds in the $REPS runs: $nb)"
-    echo "     LAMMPS 2 ranks  : $l2m s  $(rate "$l2m") el-steps/s"
+    echo "   timing on $CPU (median of $REPS x $ntime steps; element-steps/s counting all $n elements):"
+    echo "     cdem   1 thread : $c1 s  $(rate "$c1") el-steps/s  (list builds in the $REPS runs: $cb)  [$CPU]"
+    echo "     cdem   2 threads: $c2 s  $(rate "$c2") el-steps/s  [$CPU]"
+    echo "     LAMMPS 1 rank   : $l1 s  $(rate "$l1") el-steps/s  (list builds in the $REPS runs: $nb)  [$CPU]"
+    echo "     LAMMPS 2 ranks  : $l2m s  $(rate "$l2m") el-steps/s  [$CPU]"
     if [ "$omp_ok" = 1 ]; then
         echo "     LAMMPS 2 threads: $l2o s  $(rate "$l2o") el-steps/s  (-sf omp -pk omp 2)"
     else
         echo "     LAMMPS 2 threads: not available ($(grep -m1 ERROR "$dir/lmpomp.log" || echo 'lmp -sf omp failed'))"
     fi
-    echo "     per CPU-second, 1 core: cdem $u1 s $(rate "$u1") el-steps/s, LAMMPS $v1 s $(rate "$v1") el-steps/s"
-    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x (against LAMMPS' faster: $l2how)"
-    echo "     speed-up 1 -> 2 cores: cdem $(ratio "$c2" "$c1")x, LAMMPS $(ratio "$l2" "$l1")x"
+    echo "     per CPU-second, 1 core: cdem $u1 s $(rate "$u1") el-steps/s, LAMMPS $v1 s $(rate "$v1") el-steps/s  [$CPU]"
+    echo "     ratio cdem/LAMMPS: 1 core $(ratio "$c1" "$l1")x (per CPU-second $(ratio "$u1" "$v1")x), 2 cores $(ratio "$c2" "$l2")x (against LAMMPS' faster: $l2how)  [$CPU]"
+    echo "     speed-up 1 -> 2 cores: cdem $(ratio "$c2" "$c1")x, LAMMPS $(ratio "$l2" "$l1")x  [$CPU]"
     # further rounds of the 1-core pair, the order swapped every round (see the top)
     rounds="$(ratio "$c1" "$l1")"
     r=2
@@ -174,7 +176,7 @@ for size in $SIZES; do
         rounds="$rounds $(ratio "$rc1" "$rl1")"
         r=$((r + 1))
     done
-    echo "     ratio cdem/LAMMPS on 1 core in $ROUNDS rounds (the first above; then the order swapped each round): $rounds; median $(echo "$rounds" | tr ' ' '\n' | median)x"
+    echo "     ratio cdem/LAMMPS on 1 core in $ROUNDS rounds (the first above; then the order swapped each round): $rounds; median $(echo "$rounds" | tr ' ' '\n' | median)x  [$CPU]"
     echo "     load average after the size: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
     echo "   peak memory: cdem $(peak_mb "$dir/cdem.time") MB (whole process incl. equilibration)," \
         "LAMMPS 1 rank $(peak_mb "$dir/lmp1.time") MB, 2 ranks $(peak_mb "$dir/lmp2.time") MB (mpirun: largest single process)," \

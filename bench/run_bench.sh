@@ -58,11 +58,18 @@ mkdir -p "$WORK"
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_scale" bench/bench_scale.c \
     "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
 cc $CFLAGS $(pkg-config --cflags $PKGS) -o "$BUILD/bench_io" bench/bench_io.c \
-    "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lm
+    "$BUILD/libcdem.a" $(pkg-config --libs $PKGS) -lz -lm
 cc $CFLAGS -o "$BUILD/bench_machine" bench/bench_machine.c -lm
 cc $CFLAGS $(pkg-config --cflags $PKGS zlib) -o "$BUILD/bench_big" bench/bench_big.c \
     "$BUILD/libcdemsolver.a" "$BUILD/libcdem.a" $(pkg-config --libs $PKGS zlib) -lm
 
+# the CPU model, printed with every figure (docs/performance.md keeps a table per CPU family)
+CPU=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+CDEM_BENCH_CPU=${CPU:-unknown CPU}
+CPU=$CDEM_BENCH_CPU
+export CDEM_BENCH_CPU
+# appends the CPU model to every non-empty line of its input (the piped parts' figures)
+tag_cpu() { awk -v c="$CPU" 'NF {print $0 "  [" c "]"; next} {print}'; }
 has() { case " $PARTS " in *" $1 "*) return 0 ;; esac; return 1; }
 load() { cut -d' ' -f1-3 /proc/loadavg; }
 now() { date +%s.%N; }
@@ -81,7 +88,7 @@ if has machine; then
     echo "== 0. The machine now (bench/bench_machine.c): what 2 threads can gain over 1, compute-bound and streaming"
     "$BUILD/bench_machine" | awk '
         / compute / {printf "   compute (square roots, divisions; no memory): 2 threads %.2fx 1 thread\n", $8}
-        / triad /   {printf "   triad over %4s MB: %5.1f GB/s on 1 thread, %5.1f on 2: %.2fx\n", $4, $6, $8, $10}'
+        / triad /   {printf "   triad over %4s MB: %5.1f GB/s on 1 thread, %5.1f on 2: %.2fx\n", $4, $6, $8, $10}' | tag_cpu
     echo "   (on a shared virtual machine the streaming ratios vary from run to run; the solver's 2-thread speed-up"
     echo "   at ~35,000 elements and above follows the 6 and 24 MB ones)"
 fi
@@ -90,8 +97,8 @@ if has scale; then
     echo
     echo "== 1. Solver scaling (deformation of the default planar normal fault after $SETTLE settling steps;"
     echo "      N = all elements incl. walls; median of $REPS runs of ~$ELSTEPS element-steps; 1 and 2 threads interleaved)"
-    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s %7s %8s | %s\n' size N pairs builds \
-        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "twins" "2t/twins" "load during"
+    printf '%-16s %8s %8s %6s | %9s %9s %9s | %9s %9s %9s | %7s %7s %8s | %-11s | %s\n' size N pairs builds \
+        "ns/el 1t" "cpu 1t" "ns/cont" "ns/el 2t" "cpu 2t" "el-st/s" "2t/1t" "twins" "2t/twins" "load during" "CPU"
     for size in $SIZES; do
         w=$(echo "$size" | cut -d: -f1)
         h=$(echo "$size" | cut -d: -f2)
@@ -118,8 +125,8 @@ if has scale; then
         cp=$(field ceiling "BENCH_TWINS" "$out.twins" | median)
         ef=$(field efficiency "BENCH_TWINS" "$out.twins" | median)
         ld=$(field load "" "$out" | sort -g | awk 'NR==1 {lo=$1} {hi=$1} END {print lo "-" hi}')
-        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %6.2fx %8.2f | %s\n' \
-            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ef" "$ld"
+        printf '%-16s %8s %8s %6s | %9.1f %9.1f %9.1f | %9.1f %9.1f %9.3g | %6.2fx %6.2fx %8.2f | %-11s | %s\n' \
+            "${w}x${h} half=$hr" "$n" "$np" "$nb" "$w1" "$c1" "$k1" "$w2" "$c2" "$r2" "$sp" "$cp" "$ef" "$ld" "$CPU"
     done
     echo "   ns/el = wall-clock ns per element-step (linear scaling = the same figure at every size);"
     echo "   cpu = process CPU ns per element-step (2t: both threads, so cpu 2t ~ cpu 1t when the threads do no extra work);"
@@ -135,9 +142,9 @@ if has full; then
     echo "== 2. Long run: the default model's whole schedule on 1 thread (bench_scale full 10 5 0), element-steps/s per tenth"
     out="$WORK/full.out"
     OMP_NUM_THREADS=1 "$BUILD/bench_scale" full 10 5 0 >"$out"
-    awk '/^BENCH_FULL/ {for (i=1;i<NF;i++) {if ($i=="tenth") t=$(i+1); if ($i=="phase") ph=$(i+1);
+    awk -v cpu="$CPU" '/^BENCH_FULL/ {for (i=1;i<NF;i++) {if ($i=="tenth") t=$(i+1); if ($i=="phase") ph=$(i+1);
          if ($i=="el_steps_per_s") r=$(i+1); if ($i=="cpu_el_steps_per_s") c=$(i+1); if ($i=="builds") b=$(i+1); if ($i=="N") n=$(i+1)}
-         printf "   tenth %2d  %-13s N %5d  builds %4d  %.3g el-steps/s (per CPU-second %.3g)\n", t, ph, n, b, r, c}' "$out"
+         printf "   tenth %2d  %-13s N %5d  builds %4d  %.3g el-steps/s (per CPU-second %.3g) on %s\n", t, ph, n, b, r, c, cpu}' "$out"
     f=$(field el_steps_per_s "tenth 1 " "$out")
     l=$(field el_steps_per_s "tenth 10 " "$out")
     fc=$(field cpu_el_steps_per_s "tenth 1 " "$out")
@@ -148,7 +155,7 @@ if has full; then
     echo "   last tenth / first tenth: $(awk -v a="$f" -v b="$l" 'BEGIN {printf "%.2f", b/a}') by the wall clock," \
         "$(awk -v a="$fc" -v b="$lc" 'BEGIN {printf "%.2f", b/a}') per CPU-second (1.00 = no degradation; the first tenth is"
     echo "   equilibration, with more list rebuilds); last tenth / first deformation tenth ($d):" \
-        "$(awk -v a="$df" -v b="$lc" 'BEGIN {printf "%.2f", b/a}') per CPU-second; load average now $(load)"
+        "$(awk -v a="$df" -v b="$lc" 'BEGIN {printf "%.2f", b/a}') per CPU-second; load average now $(load); $CPU"
 fi
 
 if has lammps; then
@@ -164,13 +171,13 @@ if has analysis; then
     t0=$(now)
     OMP_NUM_THREADS=1 "$BUILD/cdem-run" -q --force -o "$h5"  # the benchmark's own scratch file
     t1=$(now)
-    echo "   default run (cdem-run, 1 thread, writes every increment): $(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.1f", b-a}') s, load $(load)"
+    echo "   default run (cdem-run, 1 thread, writes every increment): $(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.1f", b-a}') s, load $(load)  [$CPU]"
     "$BUILD/bench_io" "$h5" 3 >"$WORK/io.out"
     awk '{for (i=1;i<NF;i++) v[$i]=$(i+1)}
          END {printf "   file: %.2f MB for %d increments x %d elements = %.1f bytes per element-increment;" \
                      " the original program: 10.1 MB for its default run (ratio %.2f)\n", v["file_MB"], v["increments"], v["mean_elements"], v["bytes_per_element_increment"], v["file_MB"]/10.1;
               printf "   reading (cdem_h5_reader_load_increment, every increment, median of 3): %.2f ms per increment" \
-                     " (%.2f ms CPU), %.0f ns per element\n", v["load_ms_per_increment"], v["cpu_ms_per_increment"], v["ns_per_element"]}' "$WORK/io.out"
+                     " (%.2f ms CPU), %.0f ns per element\n", v["load_ms_per_increment"], v["cpu_ms_per_increment"], v["ns_per_element"]}' "$WORK/io.out" | tag_cpu
     for t in 1 2; do
         t0=$(now)
         OMP_NUM_THREADS=$t "$BUILD/cdem-strain" compute "$h5" --increment last --quantity total-max-shear \
@@ -181,7 +188,7 @@ if has analysis; then
         t2=$(now)
         echo "   cdem-strain compute, $t thread(s): total max. shear of the last increment (whole process incl. reading," \
             "CSV) $(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.2f", b-a}') s; incremental max. shear of all" \
-            "increments (HDF5 out) $(awk -v a="$t1" -v b="$t2" 'BEGIN {printf "%.2f", b-a}') s"
+            "increments (HDF5 out) $(awk -v a="$t1" -v b="$t2" 'BEGIN {printf "%.2f", b-a}') s  [$CPU]"
     done
     t0=$(now)
     OMP_NUM_THREADS=1 "$BUILD/cdem-strain" render "$h5" --increment last -o "$WORK/last.png" >/dev/null
@@ -191,15 +198,15 @@ if has analysis; then
     t2=$(now)
     echo "   cdem-strain render, last increment to PNG (whole process): layer colours" \
         "$(awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.2f", b-a}') s, coloured by total max. shear" \
-        "$(awk -v a="$t1" -v b="$t2" 'BEGIN {printf "%.2f", b-a}') s; load $(load)"
+        "$(awk -v a="$t1" -v b="$t2" 'BEGIN {printf "%.2f", b-a}') s; load $(load)  [$CPU]"
     echo "   -- synthetic strain benchmark beside the numpy/scipy baseline (bench/bench_strain.sh):"
-    sh bench/bench_strain.sh "$BUILD" | sed 's/^/   /'
+    sh bench/bench_strain.sh "$BUILD" | sed 's/^/   /' | tag_cpu
     echo "   -- renderer on synthetic states (bench/bench_render.c, best of 3 draws):"
     make -s "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a"
     cc -O2 -std=c17 -D_DEFAULT_SOURCE -Icommon -Ianalysis/measure -Ianalysis/input -Ianalysis/draw $(pkg-config --cflags cairo) \
         bench/bench_render.c "$BUILD/libcdemanalysis.a" "$BUILD/libcdem.a" \
         $(pkg-config --libs cairo) -lgif -lm -fopenmp -o "$BUILD/bench_render"
-    "$BUILD/bench_render" "$WORK" render | sed 's/^/   /'
+    "$BUILD/bench_render" "$WORK" render | sed 's/^/   /' | tag_cpu
     echo "   load average now $(load)"
 fi
 
@@ -208,7 +215,7 @@ if has contended; then
     echo "== 5. Threads on a busy machine (bench/contended.sh): cdem-run as it comes (passive wait policy,"
     echo "      common/threads.h, and the thread governor, solver/run/governor.h), without the governor"
     echo "      (cdem-fixed), and with libgomp's default spin, idle and with one CPU-bound competitor"
-    WAITS="cdem cdem-fixed libgomp" sh bench/contended.sh "$BUILD"
+    WAITS="cdem cdem-fixed libgomp" sh bench/contended.sh "$BUILD" | tag_cpu
 fi
 
 if has big; then

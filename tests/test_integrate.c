@@ -8,6 +8,7 @@
 
 #include <cmocka.h>
 
+#include "force_pairs.h" /* the vector kernels, called one by one (upper_clean below) */
 #include "integrate.h"
 
 #include <math.h>
@@ -213,12 +214,11 @@ static const box_material box_default = {0, CDEM_LAW_NORMAL_COHESION, CDEM_COHES
 static const box_material box_bonded = {1, CDEM_LAW_NORMAL_COHESION, CDEM_COHESIVE_EQUILIBRATED, 1};
 
 /* make_box(1234) stepped `nsteps` times on `threads` threads with every loop threaded, the
- * pair forces by `path`, the touching pairs made cohesive half way; threads = 0: a count
- * that changes at every step (1, 2, 3, 2, 1, ...; the run loop's thread governor may change
- * it at any step). Returns the path used (CDEM_FORCE_PATH_AVX2 is given SCALAR where the CPU
- * has no AVX2). */
-static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, box_material mat,
-                                    cdem_force_path path) {
+ * pair forces by `path` (one this CPU runs), the touching pairs made cohesive half way;
+ * threads = 0: a count that changes at every step (1, 2, 3, 2, 1, ...; the run loop's thread
+ * governor may change it at any step). */
+static void run_box_with(int threads, int nsteps, cdem_state *out, box_material mat,
+                         cdem_force_path path) {
     static const int changing[4] = {1, 2, 3, 2};
     omp_set_num_threads(threads > 0 ? threads : 1);
     const double dt = 0.028;
@@ -236,9 +236,12 @@ static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, bo
     assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
     cdem_integrator_enable_escape(&it);
     it.par_min = 0; /* thread every loop, whatever its size */
-    if (path == CDEM_FORCE_PATH_AVX2 && cdem_force_path_choose(NULL) != CDEM_FORCE_PATH_AVX2)
-        path = CDEM_FORCE_PATH_SCALAR;
-    it.force.path = path;
+    if (path != CDEM_FORCE_PATH_AUTO) {
+        assert_true(cdem_force_path_usable(path));
+        it.force.path = path;
+        /* the list build's distance test follows the path (scalar, or vector where usable) */
+        it.nb.simd = path == CDEM_FORCE_PATH_SCALAR || !cdem_neighbour_avx2_usable() ? 1 : 2;
+    }
     if (!mat.bonded && mat.rule == CDEM_COHESIVE_INITIAL)
         cdem_integrator_mark_initial(&it, out);
     for (int k = 0; k < nsteps; k++) {
@@ -253,9 +256,14 @@ static cdem_force_path run_box_with(int threads, int nsteps, cdem_state *out, bo
     }
     assert_true(it.nb.np > 2048);
     assert_true(it.nb.n_builds > 1);
-    assert_int_equal(it.force.path, path);
+    if (path != CDEM_FORCE_PATH_AUTO) {
+        assert_int_equal(it.force.path, path);
+    } else { /* chosen (and measured where there was a choice) by now */
+        assert_true(it.force.path != CDEM_FORCE_PATH_AUTO);
+        assert_true(cdem_force_path_usable(it.force.path));
+        assert_int_equal(it.force.measure_left, 0);
+    }
     cdem_integrator_free(&it);
-    return path;
 }
 
 static void run_box(int threads, int nsteps, cdem_state *out) {
@@ -273,15 +281,33 @@ static void assert_same_state(const cdem_state *a, const cdem_state *b) {
     assert_memory_equal(a->fy, b->fy, a->n * sizeof *a->fy);
 }
 
-/* The scalar and the AVX2 force paths of material `mat` give the same bits, on 1, 2 and 3
- * threads (the scalar path on 1 thread is the reference). */
+/* The vector paths this CPU runs (force.h, "Paths") into paths; returns how many. */
+static int vector_paths(cdem_force_path paths[3]) {
+    int n = 0;
+    static const cdem_force_path all[2] = {CDEM_FORCE_PATH_AVX2, CDEM_FORCE_PATH_AVX512};
+    for (int k = 0; k < 2; k++) {
+        if (cdem_force_path_usable(all[k]))
+            paths[n++] = all[k];
+        else
+            fprintf(stderr, "test_integrate: no %s path on this CPU: not compared\n",
+                    cdem_force_path_name(all[k]));
+    }
+    return n;
+}
+
+/* Every force path of material `mat` gives the same bits, on 1, 2 and 3 threads (the scalar
+ * path on 1 thread is the reference). */
 static void assert_paths_agree(box_material mat) {
     cdem_state a, b;
+    cdem_force_path paths[3];
+    const int npaths = vector_paths(paths);
     run_box_with(1, 120, &a, mat, CDEM_FORCE_PATH_SCALAR);
     for (int threads = 1; threads <= 3; threads++) {
-        run_box_with(threads, 120, &b, mat, CDEM_FORCE_PATH_AVX2);
-        assert_same_state(&a, &b);
-        cdem_state_free(&b);
+        for (int k = 0; k < npaths; k++) {
+            run_box_with(threads, 120, &b, mat, paths[k]);
+            assert_same_state(&a, &b);
+            cdem_state_free(&b);
+        }
         if (threads > 1) {
             run_box_with(threads, 120, &b, mat, CDEM_FORCE_PATH_SCALAR);
             assert_same_state(&a, &b);
@@ -291,15 +317,13 @@ static void assert_paths_agree(box_material mat) {
     cdem_state_free(&a);
 }
 
-/* The scalar and the AVX2 force paths (force.h) give the same bits, on 1, 2 and 3 threads,
- * for every registered granular law (common/laws/laws.def, the tests' fixtures included: a
- * law without an AVX2 kernel takes its scalar kernel on the vector path) under every
- * cohesion rule, and for the bonded model. A vector kernel that misses a case of its
- * scalar kernel fails here, naming the law. */
+/* The scalar and the vector force paths (force.h) give the same bits, on 1, 2 and 3 threads, for
+ * every registered granular law (common/laws/laws.def, the tests' fixtures included: a law without
+ * an AVX2 kernel takes its scalar kernel on the vector paths) under every cohesion rule, and for
+ * the bonded model. A vector kernel that misses a case of its scalar kernel fails here, naming the
+ * law. */
 static void test_integrate_simd_paths(void **st) {
     (void)st;
-    if (cdem_force_path_choose(NULL) != CDEM_FORCE_PATH_AVX2)
-        fprintf(stderr, "test_integrate_simd_paths: no AVX2 here, scalar path only\n");
     assert_int_equal(cdem_force_path_choose("scalar"), CDEM_FORCE_PATH_SCALAR);
     for (int law = 0; law < CDEM_LAW_COUNT; law++)
         for (int rule = 0; rule < 3; rule++) {
@@ -310,17 +334,21 @@ static void test_integrate_simd_paths(void **st) {
 }
 
 /* The thread count changing from step to step (the run loop's governor, solver/run/governor.h)
- * gives the same bits as one thread throughout, on both force paths and for the bonded
+ * gives the same bits as one thread throughout, on every force path and for the bonded
  * model. */
 static void test_integrate_threads_change_mid_run(void **st) {
     (void)st;
     const box_material materials[2] = {box_default, box_bonded};
+    cdem_force_path paths[3];
+    const int npaths = vector_paths(paths);
     for (int k = 0; k < 2; k++) {
         cdem_state a, b;
         run_box_with(1, 120, &a, materials[k], CDEM_FORCE_PATH_SCALAR);
-        run_box_with(0, 120, &b, materials[k], CDEM_FORCE_PATH_AVX2);
-        assert_same_state(&a, &b);
-        cdem_state_free(&b);
+        for (int q = 0; q < npaths; q++) {
+            run_box_with(0, 120, &b, materials[k], paths[q]);
+            assert_same_state(&a, &b);
+            cdem_state_free(&b);
+        }
         run_box_with(0, 120, &b, materials[k], CDEM_FORCE_PATH_SCALAR);
         assert_same_state(&a, &b);
         cdem_state_free(&a);
@@ -328,6 +356,128 @@ static void test_integrate_threads_change_mid_run(void **st) {
     }
     omp_set_num_threads(1);
 }
+
+/* A path left to the pass (AUTO): the environment's CDEM_SIMD, or, without one on a CPU with
+ * AVX2 and AVX-512, the first passes alternating between the two and timing themselves
+ * (force.h). Whatever it chose and while it measured, the bits are the scalar path's, on 1 and
+ * 2 threads. */
+static void test_integrate_measured_path(void **st) {
+    (void)st;
+    cdem_state a, b;
+    run_box_with(1, 120, &a, box_default, CDEM_FORCE_PATH_SCALAR);
+    for (int threads = 1; threads <= 2; threads++) {
+        run_box_with(threads, 120, &b, box_default, CDEM_FORCE_PATH_AUTO);
+        assert_same_state(&a, &b);
+        cdem_state_free(&b);
+    }
+    cdem_state_free(&a);
+    omp_set_num_threads(1);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <cpuid.h>
+
+/* The processor's XINUSE bits (XGETBV with ECX = 1): bit 2 the upper halves of YMM0-15, bit
+ * 6 the upper halves of ZMM0-15 in use. 0 when the processor cannot say. */
+static int xinuse(uint64_t *bits) {
+    unsigned a, b, c, d;
+    if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & (1u << 27))) /* OSXSAVE */
+        return 0;
+    if (!__get_cpuid_count(0xD, 1, &a, &b, &c, &d) || !(a & (1u << 2))) /* XGETBV ECX = 1 */
+        return 0;
+    uint32_t lo, hi;
+    __asm__ volatile("xgetbv" : "=a"(lo), "=d"(hi) : "c"(1));
+    *bits = ((uint64_t)hi << 32) | lo;
+    return 1;
+}
+
+/* Every kernel of the vector paths (force_pairs.h) returns with the upper halves of the
+ * vector registers zero (vzeroupper): else every SSE instruction of the baseline code after
+ * it (the rest of the step, the list builds, the output) pays a penalty, up to 4 times its
+ * time on the AMD EPYC measured (docs/performance.md, "Speed on every CPU"). Each kernel is
+ * called on a stepped box and the processor asked right after (XINUSE); skipped where it
+ * cannot say, or where it reports the registers in use even after a vzeroupper. */
+static void test_integrate_vector_paths_leave_upper_clean(void **st) {
+    (void)st;
+    uint64_t bits;
+    const uint64_t upper = (1u << 2) | (1u << 6);
+    if (!cdem_force_path_usable(CDEM_FORCE_PATH_AVX2) || !xinuse(&bits)) {
+        fprintf(stderr, "test_integrate: no AVX2 or no XINUSE here: not checked\n");
+        return;
+    }
+    __asm__ volatile("vzeroupper");
+    if (!xinuse(&bits) || (bits & upper)) {
+        fprintf(stderr, "test_integrate: XINUSE reports the upper halves in use: not checked\n");
+        return;
+    }
+    /* a box stepped on the AVX2 path: its list, state and packed elements */
+    const double dt = 0.028;
+    cdem_model m = hand_model(dt, dt * 3.0e9, 9.81);
+    cdem_params p = hand_params(CDEM_MATERIAL_GRANULAR);
+    cdem_integrator it;
+    cdem_state s;
+    cdem_error err;
+    make_box(&s, 20, 20, 7);
+    assert_int_equal(cdem_integrator_init(&it, &p, &m, &err), CDEM_OK);
+    it.force.path = CDEM_FORCE_PATH_AVX2;
+    for (int k = 0; k < 20; k++)
+        assert_int_equal(cdem_integrator_step(&it, &s, NULL, 0, 0.0, &err), CDEM_OK);
+    const long n = (long)s.n, np = (long)it.nb.np;
+    const cdem_force_pairs a = {.law = &it.law,
+                                .dt = dt,
+                                .x = s.x,
+                                .y = s.y,
+                                .vx = s.vx,
+                                .vy = s.vy,
+                                .pi = it.nb.pi,
+                                .pj = it.nb.pj,
+                                .R = it.nb.R,
+                                .cls = it.nb.cls,
+                                .hist = it.nb.hist,
+                                .xs = it.nb.xs,
+                                .pfx = it.nb.pfx,
+                                .pfy = it.nb.pfy,
+                                .pos4 = it.force.pos4};
+    const cdem_force_elements e = {.kick = 1,
+                                   .hdt = 0.5 * dt,
+                                   .mass = s.mass,
+                                   .x = s.x,
+                                   .flags = s.flags,
+                                   .radius = s.radius,
+                                   .dt2 = dt * dt};
+    const cdem_force_drift_args d = {.x = s.x,
+                                     .y = s.y,
+                                     .vx = s.vx,
+                                     .vy = s.vy,
+                                     .fx = s.fx,
+                                     .fy = s.fy,
+                                     .mass = s.mass,
+                                     .flags = s.flags,
+                                     .dt = dt,
+                                     .pos4 = it.force.pos4};
+    const cdem_force_kernels *ks[2] = {cdem_force_kernels_avx2(), cdem_force_kernels_avx512()};
+    for (int k = 0; k < 2; k++) {
+        if (!ks[k])
+            continue;
+        ks[k]->pack(s.x, s.y, s.vx, s.vy, 0, n, it.force.pos4);
+        assert_true(xinuse(&bits) && !(bits & upper));
+        ks[k]->pairs(&a, 0, np, (int32_t)n);
+        assert_true(xinuse(&bits) && !(bits & upper));
+        ks[k]->scatter(&a, 0, np, it.force.acc);
+        assert_true(xinuse(&bits) && !(bits & upper));
+        ks[k]->finish(&e, it.force.acc, s.vx, s.vy, s.fx, s.fy, 0, n);
+        assert_true(xinuse(&bits) && !(bits & upper));
+        ks[k]->drift(&d, 0, n);
+        assert_true(xinuse(&bits) && !(bits & upper));
+    }
+    cdem_integrator_free(&it);
+    cdem_state_free(&s);
+}
+#else
+static void test_integrate_vector_paths_leave_upper_clean(void **st) {
+    (void)st;
+}
+#endif
 
 /* A settled-looking box stepper for the threaded tests: make_box(seed), granular law, dt
  * 0.028 s, every loop threaded (par_min 0), `steps` steps taken. */
@@ -513,6 +663,8 @@ int main(void) {
         cmocka_unit_test(test_integrate_energy_conservation),
         cmocka_unit_test(test_integrate_deterministic_threads),
         cmocka_unit_test(test_integrate_simd_paths),
+        cmocka_unit_test(test_integrate_measured_path),
+        cmocka_unit_test(test_integrate_vector_paths_leave_upper_clean),
         cmocka_unit_test(test_integrate_threads_change_mid_run),
         cmocka_unit_test(test_integrate_unstable_guard),
         cmocka_unit_test(test_integrate_rebuild_test_in_force_pass),

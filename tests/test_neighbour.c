@@ -337,6 +337,58 @@ static void test_neighbour_threaded_build_same_list(void **st) {
     }
 }
 
+/* The vector distance test of the build (neighbour_avx2.c) gives the scalar test's list, slot
+ * for slot with the same R bits, serial and on 2 threads, on a first build and on one after
+ * every element moved (no re-sort: the cell order then differs from the index order), and the
+ * list of brute force. Elements exactly at the reach of their neighbours are included. */
+static void test_neighbour_vector_test_same_list(void **st) {
+    (void)st;
+    if (!cdem_neighbour_avx2_usable()) {
+        fprintf(stderr, "test_neighbour: no AVX2 on this CPU: vector test not compared\n");
+        return;
+    }
+    const int saved = omp_get_max_threads();
+    enum { RUNS = 4 };
+    cdem_state s[RUNS];
+    cdem_neighbour nb[RUNS];
+    cdem_error err;
+    for (int t = 0; t < RUNS; t++) {
+        make_cloud(&s[t], 3000, 12000.0, 777);
+        /* a few pairs exactly at the reach (R + skin apart in x) */
+        for (size_t k = 0; k + 1 < 40; k += 2) {
+            s[t].x[k + 1] = s[t].x[k] + s[t].radius[k] + s[t].radius[k + 1] + 12.5;
+            s[t].y[k + 1] = s[t].y[k];
+        }
+        assert_int_equal(cdem_neighbour_init(&nb[t], 12.5, 1.0, 1000, &err), CDEM_OK);
+        nb[t].simd = t % 2 == 0 ? 1 : 2; /* scalar, vector */
+        nb[t].par_min = t < 2 ? 1000000 : 0;
+        omp_set_num_threads(t < 2 ? 1 : 2);
+        assert_int_equal(cdem_neighbour_build(&nb[t], &s[t], NULL, 1, &err), CDEM_OK);
+    }
+    uint64_t *bk = NULL;
+    const size_t nbk = brute_pairs(&s[0], nb[0].reach_factor, nb[0].skin, &bk);
+    assert_int_equal(nb[0].np, nbk);
+    for (int t = 1; t < RUNS; t++)
+        assert_same_list(&nb[t], &s[t], &nb[0], &s[0]);
+    for (int t = 0; t < RUNS; t++) {
+        for (size_t i = 0; i < s[t].n; i++) {
+            s[t].x[i] += 40.0 * sin((double)s[t].id[i]);
+            s[t].y[i] += 40.0 * cos((double)s[t].id[i]);
+        }
+        omp_set_num_threads(t < 2 ? 1 : 2);
+        assert_int_equal(cdem_neighbour_build(&nb[t], &s[t], NULL, -1, &err), CDEM_OK);
+        assert_int_equal(nb[t].simd, t % 2 == 0 ? 1 : 2);
+    }
+    omp_set_num_threads(saved);
+    for (int t = 1; t < RUNS; t++)
+        assert_same_list(&nb[t], &s[t], &nb[0], &s[0]);
+    free(bk);
+    for (int t = 0; t < RUNS; t++) {
+        cdem_neighbour_free(&nb[t]);
+        cdem_state_free(&s[t]);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_neighbour_matches_brute_force),
@@ -344,6 +396,7 @@ int main(void) {
         cmocka_unit_test(test_neighbour_order_along_short_side),
         cmocka_unit_test(test_neighbour_rejects_bad_input),
         cmocka_unit_test(test_neighbour_threaded_build_same_list),
+        cmocka_unit_test(test_neighbour_vector_test_same_list),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

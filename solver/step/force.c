@@ -1,7 +1,8 @@
 /* force: see force.h. One pass: the drift (optional), the rebuild test (optional), then the
  * pair loop (chunk_pass)
  * computes each pair force once into its slot and scatters it to its two elements, then the
- * elements are finished (second half kick, loads, instability test).
+ * elements are finished (second half kick, loads, instability test). The scalar path does it
+ * here; the vector path with the kernels of force_avx2.c (force_pairs.h).
  * Threads: the elements are cut into one chunk per thread, by estimated work and then by
  * measured thread times (make_chunks, update_shares); a pair is evaluated by the chunk of
  * its second element, so a pair whose two elements lie in different chunks (a cross pair)
@@ -26,15 +27,31 @@ void cdem_force_free(cdem_force *f) {
     free(f->cross);
     free(f->elem_work);
     free(f->acc);
+    free(f->pos4);
     memset(f, 0, sizeof *f);
 }
 
 /* The path of f's passes: chosen at the first need (reserve or pass) from the environment's
  * CDEM_SIMD (force.h), unless a caller set it. */
 static cdem_force_path path_of(cdem_force *f) {
-    if (f->path == CDEM_FORCE_PATH_AUTO)
-        f->path = cdem_force_path_choose(getenv("CDEM_SIMD"));
+    if (f->path == CDEM_FORCE_PATH_AUTO) {
+        const char *req = getenv("CDEM_SIMD");
+        f->path = cdem_force_path_choose(req);
+        /* no request and two vector paths: the first passes measure which is faster here */
+        if ((!req || !*req || strcmp(req, "auto") == 0) && f->path == CDEM_FORCE_PATH_AVX2 &&
+            cdem_force_path_usable(CDEM_FORCE_PATH_AVX512)) {
+            f->measure_left = 2 * CDEM_FORCE_MEASURE_PASSES;
+            f->measure_time[0] = f->measure_time[1] = 0.0;
+        }
+    }
     return f->path;
+}
+
+/* The vector kernels of a path, or NULL (the scalar path). */
+static const cdem_force_kernels *kernels_of(cdem_force_path path) {
+    return path == CDEM_FORCE_PATH_AVX2     ? cdem_force_kernels_avx2()
+           : path == CDEM_FORCE_PATH_AVX512 ? cdem_force_kernels_avx512()
+                                            : NULL;
 }
 
 cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n, cdem_error *err) {
@@ -54,72 +71,39 @@ cdem_status cdem_force_reserve(cdem_force *f, const cdem_neighbour *nb, size_t n
         f->elem_work = w;
         f->workcap = c;
     }
-    /* only the vector path's buffer: the scalar path's memory stays as it was */
-    if (path_of(f) == CDEM_FORCE_PATH_AVX2 && f->acccap < n) {
+    /* only the vector paths' buffers: the scalar path's memory stays as it was */
+    if (path_of(f) != CDEM_FORCE_PATH_SCALAR && f->acccap < n) {
         const size_t c = n + n / 2 + 16;
         double *a = realloc(f->acc, 2 * c * sizeof *a);
         if (!a)
             return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
         f->acc = a;
+        free(f->pos4);
+        f->pos4 = aligned_alloc(32, 4 * c * sizeof *f->pos4); /* a multiple of 32 bytes */
+        if (!f->pos4) {
+            f->acccap = 0;
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "integrator: out of memory (%zu elements)", c);
+        }
         f->acccap = c;
     }
     return CDEM_OK;
-}
-
-/* What an element's finish reads besides its contact-force sum: the kick, the loads
- * (cdem_force_loads) and the element arrays of the pass. */
-typedef struct {
-    int kick;                  /* 1: the damped second half kick */
-    double hdt, c;             /* s, dt / 2; N s/m, the damping of the step */
-    cdem_force_loads loads;    /* gravity, surface and edge loads */
-    const double *mass, *x;    /* kg per metre; m (the edge load's side) */
-    const double *kick_finish; /* 1 / (m + c dt/2) per element (the stepper's), or NULL */
-    const uint32_t *flags;
-} element_finish;
-
-/* Finishes element i from its contact-force sum (sx, sy): gravity and the other loads, the
- * damped second half kick (when e->kick) of its velocity (vx, vy), and the total force
- * stored in fx, fy. Boundary elements keep the sum. The written arrays are restrict
- * parameters rather than members of e: so the compiler knows the stores do not touch what
- * the loop reads next (docs/performance.md, "Choices in the force pass"). */
-static inline void finish_element(const element_finish *e, long i, double sx, double sy,
-                                  double *restrict vx, double *restrict vy, double *restrict fx,
-                                  double *restrict fy) {
-    const uint32_t fl = e->flags[i];
-    if (fl & CDEM_FLAGS_BOUNDARY) {
-        fx[i] = sx;
-        fy[i] = sy;
-        return;
-    }
-    const double m = e->mass[i];
-    sy -= m * e->loads.gravity + ((fl & CDEM_FLAG_SURFACE) ? e->loads.surface_force : 0.0);
-    if (fl & CDEM_FLAG_BIAXIAL_EDGE)
-        sx += e->x[i] < e->loads.edge_x_mid ? e->loads.edge_force : -e->loads.edge_force;
-    if (e->kick) {
-        /* v = (v_half + hdt/m F) / (1 + c hdt/m), with 1 / (m + c hdt) from kick_finish */
-        const double inv = e->kick_finish ? e->kick_finish[i] : 1.0 / (m + e->c * e->hdt);
-        vx[i] = (m * vx[i] + e->hdt * sx) * inv;
-        vy[i] = (m * vy[i] + e->hdt * sy) * inv;
-    }
-    fx[i] = sx - e->c * vx[i];
-    fy[i] = sy - e->c * vy[i];
 }
 
 /* Everything the force pass reads or writes, gathered once per step. */
 typedef struct {
     const cdem_contact_law *law;
     double dt;
-    element_finish fin; /* the elements' finish */
+    cdem_force_elements fin; /* the elements' finish */
     const double *x, *y, *Rp;
     const int32_t *pi, *pj, *istart;
     const uint8_t *cls;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
-    const double *radius; /* element radii (the unstable-motion guard), NULL: guard off */
-    int nchunk;           /* chunks of this pass */
+    int nchunk;                                      /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
-    int avx2;                        /* 1: the AVX2 block evaluation (force.h, "Paths") */
+    const cdem_force_kernels *vec;   /* the vector path's kernels (force.h, "Paths"), or NULL */
+    int packed;                      /* 1: the pass's drift packed the elements (pairs.pos4) */
     double *acc;                     /* its interleaved sums (cdem_force acc) */
     cdem_force_pairs pairs;          /* the same arrays, for the block evaluation */
     long unstable[CDEM_MAX_CHUNKS];  /* per chunk: lowest unstable element index, or -1 */
@@ -184,37 +168,12 @@ static void cross_eval(const force_pass *fp, int c) {
 /* The run loop's guard (integrate.h) over the chunk's elements, while the velocities are in
  * cache: the lowest index whose element moves more than its radius in a step, or -1. */
 static long unstable_in(const force_pass *fp, long lo, long hi) {
-    if (!fp->radius)
+    if (!fp->fin.radius)
         return -1;
-    const double *restrict rad = fp->radius;
-    const double *restrict vx = fp->vx, *restrict vy = fp->vy;
-    const double dt2 = fp->dt * fp->dt;
-    for (long i = lo; i < hi; i++) {
-        const double d2 = (vx[i] * vx[i] + vy[i] * vy[i]) * dt2;
-        if (d2 > rad[i] * rad[i])
+    for (long i = lo; i < hi; i++)
+        if (cdem_force_unstable_one(&fp->fin, i, fp->vx, fp->vy))
             return i;
-    }
     return -1;
-}
-
-/* The vector path's finish of the chunk's elements lo..hi-1 from their sums in the
- * interleaved buffer acc, and unstable_in's guard in the same loop, while the velocities are
- * in registers: returns the lowest index whose element moves more than its radius in a
- * step, or -1 (also when the guard is off). */
-static long finish_chunk(force_pass *fp, const double *acc, long lo, long hi) {
-    const double *restrict rad = fp->radius;
-    const double dt2 = fp->dt * fp->dt;
-    long unstable = -1;
-    for (long i = lo; i < hi; i++) {
-        finish_element(&fp->fin, i, acc[2 * i], acc[2 * i + 1], fp->vx, fp->vy, fp->fx, fp->fy);
-        if (rad && unstable < 0) {
-            const double vxi = fp->vx[i], vyi = fp->vy[i];
-            const double d2 = (vxi * vxi + vyi * vyi) * dt2;
-            if (d2 > rad[i] * rad[i])
-                unstable = i;
-        }
-    }
-    return unstable;
 }
 
 /* The force pass over the elements lo..hi-1 and their pi ranges (pairs istart[lo] ..
@@ -268,7 +227,7 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);
     for (long i = lo; i < hi; i++)
-        finish_element(&fp->fin, i, fx[i], fy[i], vx, vy, fx, fy);
+        cdem_force_finish_one(&fp->fin, i, fx[i], fy[i], vx, vy, fx, fy);
     fp->unstable[chunk] = unstable_in(fp, lo, hi);
 }
 
@@ -277,7 +236,7 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
 static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long be, long hi,
                                          int32_t safe, int cross) {
     if (!cross) {
-        cdem_force_scatter_avx2(&fp->pairs, b, be, fp->acc);
+        fp->vec->scatter(&fp->pairs, b, be, fp->acc);
         return safe;
     }
     const int32_t *restrict pi = fp->pi, *restrict pj = fp->pj;
@@ -296,11 +255,12 @@ static CDEM_INLINE int32_t scatter_block(force_pass *fp, int chunk, long b, long
     return safe;
 }
 
-/* chunk_pass_scalar's work on the vector path: the sums in the interleaved buffer acc (zeroed,
- * the incoming cross pairs subtracted), then blocks of PAIR_BLOCK pairs evaluated into their
- * slots four at a time (force_avx2.c) and scattered in slot order, then the finish. Each
- * element's sum has the same additions in the same order as on the scalar path. */
-static void chunk_pass_avx2(force_pass *fp, int chunk) {
+/* chunk_pass_scalar's work on a vector path: the sums in the interleaved buffer acc (zeroed,
+ * the incoming cross pairs subtracted), the chunk's elements packed (unless the pass's drift
+ * did it), then blocks of PAIR_BLOCK pairs evaluated into their slots by the path's kernel
+ * and scattered in slot order, then the finish. Each element's sum has the same additions in
+ * the same order as on the scalar path. */
+static void chunk_pass_vec(force_pass *fp, int chunk) {
     const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
     const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
     const long p0 = fp->istart[lo], pe = fp->istart[hi];
@@ -311,20 +271,23 @@ static void chunk_pass_avx2(force_pass *fp, int chunk) {
         acc[2 * j] -= fp->pfx[p];
         acc[2 * j + 1] -= fp->pfy[p];
     }
+    /* a chunk's own pairs join two of its elements: only its elements need packing */
+    if (!fp->packed)
+        fp->vec->pack(fp->x, fp->y, fp->vx, fp->vy, lo, hi, (double *)fp->pairs.pos4);
     int32_t safe = chunk + 1 >= fp->nchunk ? INT32_MAX : 0;
     for (long b = p0; b < pe; b += PAIR_BLOCK) {
         const long be = pe - b > PAIR_BLOCK ? b + PAIR_BLOCK : pe;
-        const long cross = cdem_force_pairs_avx2(&fp->pairs, b, be, (int32_t)hi);
+        const long cross = fp->vec->pairs(&fp->pairs, b, be, (int32_t)hi);
         safe = scatter_block(fp, chunk, b, be, hi, safe, cross > 0);
     }
     if (pe > safe)
         wait_cross(fp, chunk, (int32_t)pe);
-    fp->unstable[chunk] = finish_chunk(fp, acc, lo, hi);
+    fp->unstable[chunk] = fp->vec->finish(&fp->fin, acc, fp->vx, fp->vy, fp->fx, fp->fy, lo, hi);
 }
 
 static void chunk_pass(force_pass *fp, int chunk) {
-    if (fp->avx2)
-        chunk_pass_avx2(fp, chunk);
+    if (fp->vec)
+        chunk_pass_vec(fp, chunk);
     else
         chunk_pass_scalar(fp, chunk);
 }
@@ -483,14 +446,23 @@ static void make_chunks(cdem_force *f, const cdem_neighbour *nb, const uint32_t 
     }
 }
 
+int cdem_force_path_usable(cdem_force_path path) {
+    return path == CDEM_FORCE_PATH_SCALAR ||
+           ((path == CDEM_FORCE_PATH_AVX2 || path == CDEM_FORCE_PATH_AVX512) && kernels_of(path));
+}
+
 cdem_force_path cdem_force_path_choose(const char *request) {
     if (request && strcmp(request, "scalar") == 0)
         return CDEM_FORCE_PATH_SCALAR;
-    return cdem_force_avx2_usable() ? CDEM_FORCE_PATH_AVX2 : CDEM_FORCE_PATH_SCALAR;
+    if (request && strcmp(request, "avx512") == 0 && cdem_force_path_usable(CDEM_FORCE_PATH_AVX512))
+        return CDEM_FORCE_PATH_AVX512;
+    return cdem_force_path_usable(CDEM_FORCE_PATH_AVX2) ? CDEM_FORCE_PATH_AVX2
+                                                        : CDEM_FORCE_PATH_SCALAR;
 }
 
 const char *cdem_force_path_name(cdem_force_path path) {
     return path == CDEM_FORCE_PATH_AVX2     ? "avx2"
+           : path == CDEM_FORCE_PATH_AVX512 ? "avx512"
            : path == CDEM_FORCE_PATH_SCALAR ? "scalar"
                                             : "auto";
 }
@@ -508,39 +480,52 @@ const int32_t *cdem_force_current_cut(const cdem_force *f, const cdem_neighbour 
     return current ? f->chunk_elem : NULL;
 }
 
+/* The arguments of the drift of the state s (cdem_force_drift_one), with the rebuild test
+ * when nb is given, and the packed elements written when pos4 is. */
+static cdem_force_drift_args drift_args(cdem_state *s, double dt, const double *drift_factor,
+                                        const cdem_neighbour *nb, double *pos4) {
+    return (cdem_force_drift_args){.x = s->x,
+                                   .y = s->y,
+                                   .vx = s->vx,
+                                   .vy = s->vy,
+                                   .fx = s->fx,
+                                   .fy = s->fy,
+                                   .mass = s->mass,
+                                   .flags = s->flags,
+                                   .factor = drift_factor,
+                                   .dt = dt,
+                                   .x0 = nb ? nb->x0 : NULL,
+                                   .y0 = nb ? nb->y0 : NULL,
+                                   .lim2 = nb ? cdem_neighbour_moved_limit2(nb) : 0.0,
+                                   .pos4 = pos4};
+}
+
 /* The drift (force.h), with the rebuild test in the same loop when nb is given, while each
  * position is in a register. */
 int cdem_force_drift(cdem_state *s, double dt, const double *drift_factor, const cdem_neighbour *nb,
                      long lo, long hi) {
-    const double hdt = 0.5 * dt;
-    double *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy;
-    const double *restrict fx = s->fx, *restrict fy = s->fy, *restrict mass = s->mass;
-    const uint32_t *restrict flags = s->flags;
-    const double *restrict kd = drift_factor;
-    const double *restrict x0 = nb ? nb->x0 : NULL, *restrict y0 = nb ? nb->y0 : NULL;
-    const double lim2 = nb ? cdem_neighbour_moved_limit2(nb) : 0.0;
+    const cdem_force_drift_args d = drift_args(s, dt, drift_factor, nb, NULL);
     int moved = 0;
-    for (long i = lo; i < hi; i++) {
-        double xi = x[i], yi = y[i];
-        if (!(flags[i] & CDEM_FLAGS_BOUNDARY)) {
-            const double a = kd ? kd[i] : hdt / mass[i]; /* the same bits */
-            const double hvx = vx[i] + a * fx[i], hvy = vy[i] + a * fy[i];
-            vx[i] = hvx;
-            vy[i] = hvy;
-            xi += dt * hvx;
-            yi += dt * hvy;
-            x[i] = xi;
-            y[i] = yi;
-        }
-        if (nb)
-            moved |= cdem_neighbour_moved_one(xi, yi, x0[i], y0[i], lim2);
-    }
+    for (long i = lo; i < hi; i++)
+        moved |= cdem_force_drift_one(&d, i);
     return moved;
 }
 
-/* The pass (force.h): the parallel driver of chunk_pass; see the top of this file. */
-int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
-                    long *unstable) {
+/* The pass's drift of the elements lo..hi-1 (cdem_force_drift), by the vector path's kernel
+ * when it has one, which then also packs them for its pairs. */
+static int pass_drift(const force_pass *fp, cdem_state *s, const cdem_force_step *in,
+                      const cdem_neighbour *nb, long lo, long hi) {
+    if (!fp->vec)
+        return cdem_force_drift(s, in->dt, in->drift_factor, nb, lo, hi);
+    const cdem_force_drift_args d =
+        drift_args(s, in->dt, in->drift_factor, nb, (double *)fp->pairs.pos4);
+    return fp->vec->drift(&d, lo, hi);
+}
+
+/* The pass (force.h) with the vector kernels vec (NULL: the scalar path): the parallel driver
+ * of chunk_pass; see the top of this file. */
+static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
+                     long *unstable, const cdem_force_kernels *vec) {
     cdem_contact_law lawc; /* the law of this step, a local copy: provably not aliased by stores */
     cdem_contact_law_phase(in->law, in->equilibrating, &lawc);
     const int kick = in->kick, check_moved = in->check_moved;
@@ -551,11 +536,16 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
         .fin = {.kick = kick,
                 .hdt = 0.5 * in->dt,
                 .c = in->damping,
-                .loads = in->loads,
+                .gravity = in->loads.gravity,
+                .surface_force = in->loads.surface_force,
+                .edge_force = in->loads.edge_force,
+                .edge_x_mid = in->loads.edge_x_mid,
                 .mass = s->mass,
                 .x = s->x,
                 .kick_finish = in->kick_finish,
-                .flags = s->flags},
+                .flags = s->flags,
+                .radius = in->unstable_test ? s->radius : NULL,
+                .dt2 = in->dt * in->dt},
         .x = s->x,
         .y = s->y,
         .Rp = nb->R,
@@ -574,7 +564,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     };
     /* (a pass before the first cdem_force_reserve for this size takes the scalar path: the
      * same bits) */
-    fp.avx2 = path_of(f) == CDEM_FORCE_PATH_AVX2 && f->acc && f->acccap >= (size_t)n;
+    fp.vec = f->acc && f->acccap >= (size_t)n ? vec : NULL;
+    fp.packed = fp.vec && in->drift;
     fp.acc = f->acc;
     fp.pairs = (cdem_force_pairs){.law = &lawc,
                                   .dt = in->dt,
@@ -589,7 +580,8 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
                                   .hist = nb->hist,
                                   .xs = nb->xs,
                                   .pfx = nb->pfx,
-                                  .pfy = nb->pfy};
+                                  .pfy = nb->pfy,
+                                  .pos4 = f->pos4};
     const int nch = cdem_force_chunks_wanted(nb, in->par_min, n);
     if (f->nchunk != nch || f->chunk_build != nb->n_builds || f->chunk_n != (size_t)n)
         make_chunks(f, nb, s->flags, (size_t)n, nch, in->par_min);
@@ -599,11 +591,10 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
     fp.cross_start = f->cross_start;
     fp.cross = f->cross;
     fp.f = f;
-    fp.radius = in->unstable_test ? s->radius : NULL;
     if (nchunk == 1) {
         if (in->drift && in->boundary_move)
             in->boundary_move(in->boundary_ctx, s, 0, n);
-        if (in->drift ? cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL, 0, n)
+        if (in->drift ? pass_drift(&fp, s, in, check_moved ? nb : NULL, 0, n)
                       : check_moved && cdem_neighbour_moved(nb, s, 0, (size_t)n))
             return 1;
         chunk_pass(&fp, 0);
@@ -625,8 +616,7 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
                 if (in->drift && in->boundary_move)
                     in->boundary_move(in->boundary_ctx, s, lo, hi);
                 if (in->drift)
-                    mine |= cdem_force_drift(s, in->dt, in->drift_factor, check_moved ? nb : NULL,
-                                             lo, hi);
+                    mine |= pass_drift(&fp, s, in, check_moved ? nb : NULL, lo, hi);
                 else if (check_moved)
                     mine |= cdem_neighbour_moved(nb, s, (size_t)lo, (size_t)hi);
             }
@@ -672,4 +662,29 @@ int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem
             break;
         }
     return 0;
+}
+
+/* The pass (force.h). While the path is being measured (path_of), the passes alternate
+ * between the AVX2 and the AVX-512 kernels (the same bits) and time themselves by the wall
+ * clock; after CDEM_FORCE_MEASURE_PASSES complete passes each, the one with the shorter
+ * fastest pass is the path (the fastest rather than the sum: a pass the machine's other work
+ * interrupted says nothing of the kernel). */
+int cdem_force_pass(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cdem_force_step *in,
+                    long *unstable) {
+    const cdem_force_path path = path_of(f);
+    if (f->measure_left <= 0)
+        return pass_with(f, nb, s, in, unstable, kernels_of(path));
+    const int k = f->measure_left & 1;
+    const double t0 = omp_get_wtime();
+    const int r = pass_with(f, nb, s, in, unstable,
+                            kernels_of(k ? CDEM_FORCE_PATH_AVX512 : CDEM_FORCE_PATH_AVX2));
+    if (r == 0) {
+        const double t = omp_get_wtime() - t0;
+        if (f->measure_time[k] == 0.0 || t < f->measure_time[k])
+            f->measure_time[k] = t;
+        if (--f->measure_left == 0)
+            f->path = f->measure_time[1] < f->measure_time[0] ? CDEM_FORCE_PATH_AVX512
+                                                              : CDEM_FORCE_PATH_AVX2;
+    }
+    return r;
 }

@@ -22,14 +22,20 @@
 
 #include <stdatomic.h>
 
-/* Paths: how the pair forces are evaluated. Both give the same bits (force_pairs.h says
- * how); the vector one is faster where the CPU has AVX2. */
+/* Paths: how the pair forces and the element loops of the pass are evaluated. Both give the
+ * same bits (force_pairs.h says how); the vector one is faster where the CPU has AVX2. It
+ * reads the elements of a pair from a packed copy (x, y, vx, vy of an element in 32 bytes)
+ * rather than gathering them, and runs the element loops (drift, finish) in lanes too. */
+/* Complete passes each vector path is timed for, when the faster is chosen by measuring. */
+#define CDEM_FORCE_MEASURE_PASSES 48
+
 typedef enum {
-    CDEM_FORCE_PATH_AUTO = 0, /* not chosen yet: the first pass calls cdem_force_path_choose
-                                 with the environment's CDEM_SIMD */
+    CDEM_FORCE_PATH_AUTO = 0, /* not chosen yet: the first need (reserve or pass) calls
+                                 cdem_force_path_choose with the environment's CDEM_SIMD */
     CDEM_FORCE_PATH_SCALAR,   /* one pair at a time (any CPU) */
     CDEM_FORCE_PATH_AVX2,     /* four pairs at a time in AVX2 lanes, blocks of pairs evaluated
                                  then scattered */
+    CDEM_FORCE_PATH_AVX512,   /* the pairs eight at a time in AVX-512 lanes, the rest as AVX2 */
 } cdem_force_path;
 
 /* Largest number of element chunks (threads) of the force pass. */
@@ -68,11 +74,17 @@ typedef struct {
     int share_n;                         /* nchunk the shares are for (0: none yet) */
     double chunk_share[CDEM_MAX_CHUNKS]; /* fractions of the work, sum 1 */
     double chunk_time[CDEM_MAX_CHUNKS];  /* s per pass, running mean (0: none yet) */
-    double *acc;          /* the vector path's per-element contact-force sums, x and y
-                             interleaved (acc[2e], acc[2e+1]): one 128-bit add per pair end */
-    size_t acccap;        /* elements acc holds */
-    cdem_force_path path; /* the pair evaluation (AUTO until the first pass; a caller may set
-                             SCALAR, or AVX2 when cdem_force_path_choose(NULL) gives it) */
+    double *acc;            /* the vector path's per-element contact-force sums, x and y
+                               interleaved (acc[2e], acc[2e+1]): one 128-bit add per pair end */
+    double *pos4;           /* the vector path's packed elements (force_pairs.h: x, y, vx, vy of
+                               element e at pos4[4e]), 32-byte aligned */
+    size_t acccap;          /* elements acc and pos4 hold */
+    cdem_force_path path;   /* the pass's path (AUTO until the first need; a caller may set
+                               any path cdem_force_path_usable accepts) */
+    int measure_left;       /* passes left of the measured choice between the AVX2 and the
+                               AVX-512 kernels (cdem_force_pass), 0: none */
+    double measure_time[2]; /* s: their fastest pass so far by the wall clock (AVX2, AVX-512;
+                               0: none yet) */
 } cdem_force;
 
 /* The loads the element finish adds to the contact-force sum of a free element. */
@@ -112,10 +124,15 @@ typedef struct {
 
 void cdem_force_free(cdem_force *f);
 
-/* The path for a request ("scalar": the scalar path; anything else or NULL: AVX2 when this
- * build and the CPU have it, else scalar). CDEM_SIMD=scalar in the environment forces the
- * scalar path (tests, comparisons). */
+/* The path for a request ("scalar": the scalar path; "avx512": the AVX-512 pair kernel when
+ * this build and the CPU have it; anything else or NULL: AVX2 when this build and the CPU
+ * have it, else scalar). CDEM_SIMD in the environment is the request of a pass whose path is
+ * AUTO; without one (or "auto"), on a CPU with both vector paths, the pass measures them
+ * (cdem_force_pass) and keeps the faster, which the run's log names. */
 cdem_force_path cdem_force_path_choose(const char *request);
+
+/* 1 when this build and this CPU run path (SCALAR always; AVX2), else 0. */
+int cdem_force_path_usable(cdem_force_path path);
 
 /* "auto", "scalar" or "avx2". */
 const char *cdem_force_path_name(cdem_force_path path);

@@ -72,6 +72,9 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->scratch);
     free(nb->cell_start);
     free(nb->cell_items);
+    free(nb->cell_x);
+    free(nb->cell_y);
+    free(nb->cell_r);
     free(nb->carry);
     free(nb->oldmap);
     for (int t = 0; t < CDEM_NB_MAX_THREADS; t++) {
@@ -115,6 +118,9 @@ static cdem_status reserve_elements(cdem_neighbour *nb, size_t n, cdem_error *er
     CDEM_TRY(grow((void **)&nb->oldmap, sizeof(size_t), c, err));
     CDEM_TRY(grow((void **)&nb->scratch, 8, c, err));
     CDEM_TRY(grow((void **)&nb->cell_items, sizeof(int32_t), c, err));
+    CDEM_TRY(grow((void **)&nb->cell_x, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->cell_y, sizeof(double), c, err));
+    CDEM_TRY(grow((void **)&nb->cell_r, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->istart, sizeof(int32_t), c + 1, err));
     CDEM_TRY(grow((void **)&nb->jstart, sizeof(int32_t), c + 1, err));
     nb->ncap = c;
@@ -280,6 +286,83 @@ static int buf_grow(cdem_pair_buf *b, size_t want) {
     return 0;
 }
 
+/* Appends the pair (i, j) of radii sum R and class cls to the list (buf NULL) or to buf,
+ * whose count the caller keeps in *bn (enumerate says why). */
+static CDEM_INLINE cdem_status add_pair(cdem_neighbour *nb, cdem_pair_buf *buf, size_t *bn,
+                                        int32_t i, int32_t j, double R, int cls, cdem_error *err) {
+    if (buf) {
+        if (*bn == buf->cap && buf_grow(buf, *bn + 1) != 0) {
+            buf->n = *bn;
+            buf->failed = 1;
+            return CDEM_ERR_NOMEM;
+        }
+        const size_t p = (*bn)++;
+        buf->pi[p] = i;
+        buf->pj[p] = j;
+        buf->R[p] = R;
+        buf->cls[p] = (uint8_t)cls;
+        return CDEM_OK;
+    }
+    if (nb->np == nb->pcap)
+        CDEM_TRY(reserve_pairs(nb, nb->np + 1, err));
+    const size_t p = nb->np++;
+    nb->pi[p] = i;
+    nb->pj[p] = j;
+    nb->R[p] = R;
+    nb->cls[p] = (uint8_t)cls;
+    nb->hist[p] = 0;
+    nb->xs[p] = 0.0;
+    nb->pfx[p] = 0.0;
+    nb->pfy[p] = 0.0;
+    return CDEM_OK;
+}
+
+/* enumerate with the vector distance test (cdem_neighbour_near_avx2): the candidates of each
+ * row of cells in segments of NEAR_SEGMENT, from the cell-ordered copies; the same pairs in
+ * the same order with the same R as the scalar loop. */
+#define NEAR_SEGMENT 256
+static cdem_status enumerate_vec(cdem_neighbour *nb, const cdem_state *s, const cdem_grid *g,
+                                 size_t lo, size_t hi, cdem_pair_buf *buf, cdem_error *err) {
+    const double *restrict x = s->x, *restrict y = s->y, *restrict rad = s->radius;
+    const uint32_t *restrict fl = s->flags;
+    const int32_t *restrict cell_start = nb->cell_start, *restrict cell_items = nb->cell_items;
+    const cdem_neighbour_cells cells = {.x = nb->cell_x,
+                                        .y = nb->cell_y,
+                                        .r = nb->cell_r,
+                                        .item = cell_items,
+                                        .reach_factor = nb->reach_factor,
+                                        .skin = nb->skin};
+    const size_t nx = g->nx;
+    size_t bn = buf ? buf->n : 0;
+    int32_t near_k[NEAR_SEGMENT];
+    double near_R[NEAR_SEGMENT];
+    for (size_t i = lo; i < hi; i++) {
+        if (fl[i] & CDEM_FLAG_FOOTWALL)
+            continue;
+        const cdem_grid_box b = cdem_grid_around(g, (size_t)nb->cell_of[i]);
+        const double xi = x[i], yi = y[i], ri = rad[i];
+        const uint32_t fi = fl[i];
+        for (size_t yy = b.y_lo; yy <= b.y_hi; yy++) {
+            const int32_t k0 = cell_start[yy * nx + b.x_lo], k1 = cell_start[yy * nx + b.x_hi + 1];
+            for (int32_t ks = k0; ks < k1; ks += NEAR_SEGMENT) {
+                const int32_t ke = k1 - ks > NEAR_SEGMENT ? ks + NEAR_SEGMENT : k1;
+                const size_t m = cdem_neighbour_near_avx2(&cells, (int32_t)i, xi, yi, ri, ks, ke,
+                                                          near_k, near_R);
+                for (size_t q = 0; q < m; q++) {
+                    const int32_t j = cell_items[near_k[q]];
+                    const int cls = cdem_contact_class(fi, fl[j]);
+                    if (cls < 0)
+                        continue;
+                    CDEM_TRY(add_pair(nb, buf, &bn, (int32_t)i, j, near_R[q], cls, err));
+                }
+            }
+        }
+    }
+    if (buf)
+        buf->n = bn;
+    return CDEM_OK;
+}
+
 /* Enumerates the pairs (i, j > i) of the elements lo..hi-1 in index order: into the list
  * (buf NULL; serial) or into buf (one thread's share; err unused, buf->failed on NOMEM). The
  * buffer's count is kept in a local and stored once at the end: the threads' buffer
@@ -293,6 +376,8 @@ static cdem_status enumerate(cdem_neighbour *nb, const cdem_state *s, const cdem
     const double rf = nb->reach_factor, skin = nb->skin;
     const size_t nx = g->nx;
     size_t bn = buf ? buf->n : 0; /* buf->n, in a register (see above) */
+    if (nb->simd == 2)
+        return enumerate_vec(nb, s, g, lo, hi, buf, err);
     for (size_t i = lo; i < hi; i++) {
         if (fl[i] & CDEM_FLAG_FOOTWALL)
             continue;
@@ -470,6 +555,22 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     }
     /* counting sort by cell: cell_items lists each cell's elements in ascending index */
     cdem_grid_sort(nb->cell_of, n, ncells, nb->cell_start, nb->cell_items);
+    if (nb->simd == 0) {
+        const char *req = getenv("CDEM_SIMD");
+        nb->simd = (req && strcmp(req, "scalar") == 0) || !cdem_neighbour_avx2_usable() ? 1 : 2;
+    }
+    if (nb->simd == 2) {
+        /* the vector test's cell-ordered copies */
+        const int32_t *restrict items = nb->cell_items;
+        double *restrict cx = nb->cell_x, *restrict cy = nb->cell_y, *restrict cr = nb->cell_r;
+#pragma omp parallel for schedule(static) if ((long)n > nb->par_min)
+        for (long k = 0; k < (long)n; k++) {
+            const int32_t e = items[k];
+            cx[k] = px[e];
+            cy[k] = py[e];
+            cr[k] = prad[e];
+        }
+    }
 
     /* enumerate pairs: element i in index order, j > i in the 3 x 3 cells around it */
     nb->np = 0;

@@ -78,9 +78,13 @@ typedef struct {
     void *scratch;    /* permutation scratch, ncap * 8 bytes */
 
     /* cell grid */
-    size_t ccap;         /* capacity of cell_start */
-    int32_t *cell_start; /* ncells + 1 */
-    int32_t *cell_items; /* element indices sorted by cell (ncap) */
+    size_t ccap;                      /* capacity of cell_start */
+    int32_t *cell_start;              /* ncells + 1 */
+    int32_t *cell_items;              /* element indices sorted by cell (ncap) */
+    double *cell_x, *cell_y, *cell_r; /* m: x, y, radius of cell_items[k] at k (ncap; the
+                                         vector distance test reads them without gathers) */
+    int simd; /* the build's distance test: 0 until the first build (then CDEM_SIMD as the
+                 force pass: "scalar", else AVX2 where the CPU has it), 1 scalar, 2 AVX2 */
 
     /* carried histories */
     size_t ncarry, carrycap;
@@ -93,6 +97,23 @@ typedef struct {
     long n_builds; /* builds so far */
     long n_sorts;  /* re-sorts so far */
 } cdem_neighbour;
+
+/* The cell-ordered candidates of a build, for cdem_neighbour_near_avx2. */
+typedef struct {
+    const double *x, *y, *r; /* cell_x, cell_y, cell_r */
+    const int32_t *item;     /* cell_items */
+    double reach_factor, skin;
+} cdem_neighbour_cells;
+
+/* 1 when this build and CPU have cdem_neighbour_near_avx2. */
+int cdem_neighbour_avx2_usable(void);
+
+/* The list build's distance test of element i (at xi, yi, radius ri) against the candidates
+ * k0..k1-1 in cell order (neighbour_avx2.c): writes the positions k of those with item > i
+ * within reach, ascending, and their R = ri + r, into out_k, out_R (room for k1 - k0);
+ * returns how many. The bits and order of the scalar test. Only when usable. */
+size_t cdem_neighbour_near_avx2(const cdem_neighbour_cells *c, int32_t i, double xi, double yi,
+                                double ri, int32_t k0, int32_t k1, int32_t *out_k, double *out_R);
 
 /* Sets up an empty list. skin > 0 (m); reach_factor >= 1. */
 cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_factor,
