@@ -432,10 +432,11 @@ static inline void to_grid(double *gm, double *gmx, double *gmy, const cdem_stat
     }
 }
 
-/* 1 when a node is a velocity (Dirichlet) node of the prescribed-velocity elements (base,
- * faults, walls, plates that join the grid): their mass on it outweighs the salt's and the
- * cover's, or it lies within half a cell of one's surface (near: flag 4 of gsalt). It moves
- * with them, and its whole force is their reaction (docs/solver.md, section 9.5). */
+/* 1 when a node belongs to the non-salt elements that join the grid (the cover, base, faults,
+ * walls, plates): their mass on it outweighs the salt's, or it lies within half a cell of one's
+ * surface (near: flag 4 of gsalt). It moves with them (a velocity node of the salt: the salt
+ * sticks to them), and its whole force goes to them, the reaction on a prescribed-velocity
+ * element, the salt's traction on a cover element (docs/solver.md, section 9.5). */
 static inline int owned(double m_free, double m_bound, int near) {
     return m_bound > 0.0 && (m_bound >= m_free || near);
 }
@@ -473,26 +474,23 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
             touches = st.node[k] >= 0 && st.w[k] > 0.0 && (salt->gsalt[st.node[k]] & 1);
         if (!touches)
             continue;
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY) {
-            to_grid(salt->gbm, salt->gbx, salt->gby, s, i, &st);
-            /* its nodes nearer than half a cell to its surface (or inside it) */
-            const double reach = s->radius[i] + 0.5 * salt->h;
-            for (int k = 0; k < 9; k++) {
-                const long g = st.node[k];
-                if (g < 0)
-                    continue;
-                const double dx = (double)(salt->gx0 + g % (long)salt->gnx) * salt->h - s->x[i];
-                const double dy = (double)(salt->gy0 + g / (long)salt->gnx) * salt->h - s->y[i];
-                if (dx * dx + dy * dy <= reach * reach)
-                    salt->gsalt[g] |= 4;
-            }
-        } else
-            to_grid(salt->gm, salt->gmx, salt->gmy, s, i, &st);
+        to_grid(salt->gbm, salt->gbx, salt->gby, s, i, &st);
+        /* its nodes nearer than half a cell to its surface (or inside it) */
+        const double reach = s->radius[i] + 0.5 * salt->h;
+        for (int k = 0; k < 9; k++) {
+            const long g = st.node[k];
+            if (g < 0)
+                continue;
+            const double dx = (double)(salt->gx0 + g % (long)salt->gnx) * salt->h - s->x[i];
+            const double dy = (double)(salt->gy0 + g / (long)salt->gnx) * salt->h - s->y[i];
+            if (dx * dx + dy * dy <= reach * reach)
+                salt->gsalt[g] |= 4;
+        }
         salt->members[nm++] = (int32_t)i;
     }
     salt->n_members = nm;
     /* each node's velocity (into gmx, gmy) and the divisors of its force's shares: the
-     * boundary's mass on a node it owns (gbm), else the salt's and the cover's (gm) */
+     * non-salt elements' mass on a node they own (gbm), else the salt's (gm) */
     for (size_t g = 0; g < nodes; g++) {
         if (owned(salt->gm[g], salt->gbm[g], (salt->gsalt[g] & 4) != 0)) {
             salt->gmx[g] = salt->gbx[g] / salt->gbm[g];
@@ -544,7 +542,7 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
     /* back to the elements, each its mass share of the forces of the nodes of its body */
     for (size_t q = 0; q < nm; q++) {
         const size_t i = (size_t)salt->members[q];
-        const double *div = (s->flags[i] & CDEM_FLAGS_BOUNDARY) ? salt->gbm : salt->gm;
+        const double *div = (s->flags[i] & CDEM_FLAG_SALT) ? salt->gm : salt->gbm;
         stencil_of(salt, s->x[i], s->y[i], &st);
         double fx = 0.0, fy = 0.0;
         for (int k = 0; k < 9; k++) {
