@@ -4,14 +4,14 @@
  *
  * Simple shear (Couette). The assembly of an 8 x 2 km box (default radii) with every free
  * element salt, a top plate of wall elements (base class: salt.base_contact) laid on the
- * packing, gravity off. The plate moves at U to the right; the lateral walls are hinged: each
- * of their elements moves at U (y - y_b) / H, so the box is a simple-shear box whose side walls
- * follow the affine profile (cdem-c has no periodic boundaries). The salt starts with the
- * affine velocity profile and is sheared to `strain`; over the second half the shear stress
- * is measured (a) on the plate, tau = -sum fx / L, and (b) as the mean continuum shear stress
- * of the salt elements of the middle half of the box (x from W/4 to 3W/4); the rate as U / H
- * (nominal) and as the slope of the mean velocity profile over the middle 60 % of the gap
- * (bulk). eta = tau / rate, against the model's set viscosity.
+ * packing, gravity off, the lateral walls free slip (salt.wall_contact). The plate moves at U to
+ * the right; the lateral walls are hinged: each of their elements moves at U (y - y_b) / H, so the
+ * box is a simple-shear box whose side walls follow the affine profile (cdem-c has no periodic
+ * boundaries). The salt starts with the affine velocity profile and is sheared to `strain`; over
+ * the second half the shear stress is measured (a) on the plate, tau = -sum fx / L, and (b) as the
+ * mean continuum shear stress of the salt elements of the middle half of the box (x from W/4 to
+ * 3W/4); the rate as U / H (nominal) and as the slope of the mean velocity profile over the middle
+ * 60 % of the gap (bulk). eta = tau / rate, against the model's set viscosity.
  *
  * Gravity current (Huppert 1982). A block of salt (the lower part of an assembly, the rest
  * removed) against the left wall (free slip: salt.wall_contact = free-slip) on the no-slip
@@ -126,6 +126,8 @@ typedef struct {
 
 /* Sorts the elements of the shear cell's walls: 1 plate, 2 hinged lateral wall, 0 other. */
 static int couette_wall_kind(const cdem_state *s, size_t i, double gap) {
+    if (!(s->flags[i] & (CDEM_FLAGS_BOUNDARY | CDEM_FLAG_SALT)))
+        return 1; /* a plate of cover elements */
     if (!(s->flags[i] & CDEM_FLAG_WALL))
         return 0;
     if (s->flags[i] & CDEM_FLAG_MOVING)
@@ -134,15 +136,21 @@ static int couette_wall_kind(const cdem_state *s, size_t i, double gap) {
 }
 
 /* Simple shear at plate speed U to `strain` (see the top). J starts at 1 / (1 + P / K) for a
- * confining pressure P. Returns 0 with err set when the set-up or a step fails. */
+ * confining pressure P. cover_plate: the plate's elements are free (cover) elements whose motion
+ * the cell imposes each step, so that the salt module couples them as cover, not as a
+ * prescribed-velocity boundary. Returns 0 with err set when the set-up or a step fails. */
 __attribute__((unused)) static int couette_run(double U, double strain, double confining,
-                                               int threads, couette_result *out, cdem_error *err) {
+                                               int cover_plate, couette_result *out,
+                                               cdem_error *err) {
     memset(out, 0, sizeof *out);
     cdem_params p = salt_cell_params(8.0, 2.0, 0);
     if (getenv("SALT_GRID"))
         p.salt_grid_spacing = atof(getenv("SALT_GRID"));
     if (getenv("SALT_HALF"))
         p.half_radii = 1;
+    /* the hinged walls keep the salt in the box (their pairs' repulsion); on the grid they
+     * would own a slanted band of nodes that the shear sweeps across (docs/solver.md 9.5) */
+    p.salt_wall_contact = CDEM_SALT_FREE_SLIP;
     salt_cell c;
     cdem_model m0;
     if (cdem_model_derive(&p, NULL, &m0, err) != CDEM_OK)
@@ -173,7 +181,8 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     const double x_lo = -rw - strain * H - 4.0 * rw, x_hi = W + rw;
     for (double x = x_lo; x <= x_hi; x += rw) /* smooth: the grid alone holds the salt */
         cdem_state_append(&c.s, -1, x, H + rw, rw, c.m.mass[0], 0,
-                          CDEM_FLAG_WALL | CDEM_FLAG_BASE | CDEM_FLAG_MOVING, 0, NULL, err);
+                          cover_plate ? 0u : CDEM_FLAG_WALL | CDEM_FLAG_BASE | CDEM_FLAG_MOVING, 0,
+                          NULL, err);
     /* lateral walls above the plate are not needed (and would shear nothing); salt elements
      * reaching above the plate's underside go, so that no salt starts pressed into the plate
      * (an overlap of tens of metres would compress the salt to tens of MPa, and the plate's
@@ -214,9 +223,11 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     for (long step = 1; step <= steps; step++) {
         for (size_t i = 0; i < c.s.n; i++) { /* the walls' motion of this step */
             const int k = couette_wall_kind(&c.s, i, H);
-            if (k == 1) {
+            if (k == 1) { /* (a cover plate is held at its height too) */
                 c.s.vx[i] = U;
                 c.s.x[i] += U * dt;
+                c.s.vy[i] = 0.0;
+                c.s.y[i] = H + rw;
             } else if (k == 2) {
                 c.s.vx[i] = U * fmin(fmax((c.s.y[i] - c.y_base) / H, 0.0), 1.0);
                 c.s.x[i] += c.s.vx[i] * dt;
@@ -283,7 +294,6 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     out->tau_salt = n_salt_avg ? tau_salt / (double)n_salt_avg : NAN;
     out->steps = steps;
     out->elements = (long)c.s.n;
-    (void)threads;
     salt_cell_close(&c);
     return 1;
 }

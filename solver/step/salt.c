@@ -203,6 +203,9 @@ void cdem_salt_free(cdem_salt *salt) {
     free(salt->gmy);
     free(salt->gfx);
     free(salt->gfy);
+    free(salt->gbm);
+    free(salt->gbx);
+    free(salt->gby);
     free(salt->gsalt);
     free(salt->lxx);
     free(salt->lxy);
@@ -356,7 +359,8 @@ cdem_status cdem_salt_after_build(cdem_salt *salt, const cdem_neighbour *nb, con
     if (salt->gcap < nodes) {
         const size_t c = nodes + nodes / 2 + 16;
         int ok = 1;
-        double **arrays[] = {&salt->gm, &salt->gmx, &salt->gmy, &salt->gfx, &salt->gfy};
+        double **arrays[] = {&salt->gm,  &salt->gmx, &salt->gmy, &salt->gfx,
+                             &salt->gfy, &salt->gbm, &salt->gbx, &salt->gby};
         for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
             double *q = realloc(*arrays[k], c * sizeof(double));
             if (q)
@@ -414,27 +418,36 @@ static inline void stencil_of(const cdem_salt *salt, double x, double y, stencil
         }
 }
 
-/* Adds the mass and momentum of element i to its nodes. */
-static inline void to_grid(cdem_salt *salt, const cdem_state *s, size_t i, const stencil *st) {
+/* Adds the mass and momentum of element i to its nodes (m, mx, my: one body's arrays). */
+static inline void to_grid(double *gm, double *gmx, double *gmy, const cdem_state *s, size_t i,
+                           const stencil *st) {
     const double m = s->mass[i], vx = s->vx[i], vy = s->vy[i];
     for (int k = 0; k < 9; k++) {
         if (st->node[k] < 0)
             continue;
         const double wm = st->w[k] * m;
-        salt->gm[st->node[k]] += wm;
-        salt->gmx[st->node[k]] += wm * vx;
-        salt->gmy[st->node[k]] += wm * vy;
+        gm[st->node[k]] += wm;
+        gmx[st->node[k]] += wm * vx;
+        gmy[st->node[k]] += wm * vy;
     }
+}
+
+/* 1 when a node belongs to the non-salt elements that join the grid (the cover, base, faults,
+ * walls, plates): their mass on it outweighs the salt's, or it lies within half a cell of one's
+ * surface (near: flag 4 of gsalt). It moves with them (a velocity node of the salt: the salt
+ * sticks to them), and its whole force goes to them, the reaction on a prescribed-velocity
+ * element, the salt's traction on a cover element (docs/solver.md, section 9.5). */
+static inline int owned(double m_free, double m_bound, int near) {
+    return m_bound > 0.0 && (m_bound >= m_free || near);
 }
 
 /* The continuum part: P2G, stress, node forces, G2P (into ex, ey). */
 static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *ey) {
     const size_t nodes = salt->gnx * salt->gny;
-    memset(salt->gm, 0, nodes * sizeof(double));
-    memset(salt->gmx, 0, nodes * sizeof(double));
-    memset(salt->gmy, 0, nodes * sizeof(double));
-    memset(salt->gfx, 0, nodes * sizeof(double));
-    memset(salt->gfy, 0, nodes * sizeof(double));
+    double *const arrays[] = {salt->gm,  salt->gmx, salt->gmy, salt->gfx,
+                              salt->gfy, salt->gbm, salt->gbx, salt->gby};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        memset(arrays[k], 0, nodes * sizeof(double));
     memset(salt->gsalt, 0, nodes);
     stencil st;
     size_t nm = 0;
@@ -442,7 +455,7 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
         if (!(s->flags[i] & CDEM_FLAG_SALT))
             continue;
         stencil_of(salt, s->x[i], s->y[i], &st);
-        to_grid(salt, s, i, &st);
+        to_grid(salt->gm, salt->gmx, salt->gmy, s, i, &st);
         for (int k = 0; k < 9; k++)
             if (st.node[k] >= 0 && st.w[k] > 0.0)
                 salt->gsalt[st.node[k]] = 1;
@@ -458,13 +471,37 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
         stencil_of(salt, s->x[i], s->y[i], &st);
         int touches = 0;
         for (int k = 0; k < 9 && !touches; k++)
-            touches = st.node[k] >= 0 && st.w[k] > 0.0 && salt->gsalt[st.node[k]];
+            touches = st.node[k] >= 0 && st.w[k] > 0.0 && (salt->gsalt[st.node[k]] & 1);
         if (!touches)
             continue;
-        to_grid(salt, s, i, &st);
+        to_grid(salt->gbm, salt->gbx, salt->gby, s, i, &st);
+        /* its nodes nearer than half a cell to its surface (or inside it) */
+        const double reach = s->radius[i] + 0.5 * salt->h;
+        for (int k = 0; k < 9; k++) {
+            const long g = st.node[k];
+            if (g < 0)
+                continue;
+            const double dx = (double)(salt->gx0 + g % (long)salt->gnx) * salt->h - s->x[i];
+            const double dy = (double)(salt->gy0 + g / (long)salt->gnx) * salt->h - s->y[i];
+            if (dx * dx + dy * dy <= reach * reach)
+                salt->gsalt[g] |= 4;
+        }
         salt->members[nm++] = (int32_t)i;
     }
     salt->n_members = nm;
+    /* each node's velocity (into gmx, gmy) and the divisors of its force's shares: the
+     * non-salt elements' mass on a node they own (gbm), else the salt's (gm) */
+    for (size_t g = 0; g < nodes; g++) {
+        if (owned(salt->gm[g], salt->gbm[g], (salt->gsalt[g] & 4) != 0)) {
+            salt->gmx[g] = salt->gbx[g] / salt->gbm[g];
+            salt->gmy[g] = salt->gby[g] / salt->gbm[g];
+            salt->gm[g] = 0.0;
+        } else {
+            salt->gmx[g] = salt->gm[g] > 0.0 ? salt->gmx[g] / salt->gm[g] : 0.0;
+            salt->gmy[g] = salt->gm[g] > 0.0 ? salt->gmy[g] / salt->gm[g] : 0.0;
+            salt->gbm[g] = 0.0;
+        }
+    }
     /* the salt's stress and the node forces */
     const double eta = salt->viscosity, inv_phi = 1.0 / salt->phi;
     for (size_t q = 0; q < n_salt; q++) {
@@ -473,9 +510,9 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
         double lxx = 0.0, lxy = 0.0, lyx = 0.0, lyy = 0.0; /* L_ab = d v_a / d x_b */
         for (int k = 0; k < 9; k++) {
             const long g = st.node[k];
-            if (g < 0 || !(salt->gm[g] > 0.0))
+            if (g < 0 || !(salt->gm[g] > 0.0 || salt->gbm[g] > 0.0))
                 continue;
-            const double vx = salt->gmx[g] / salt->gm[g], vy = salt->gmy[g] / salt->gm[g];
+            const double vx = salt->gmx[g], vy = salt->gmy[g];
             lxx += vx * st.gx[k];
             lxy += vx * st.gy[k];
             lyx += vy * st.gx[k];
@@ -502,16 +539,17 @@ static void grid_forces(cdem_salt *salt, const cdem_state *s, double *ex, double
             salt->gfy[g] -= area * (sxy * st.gx[k] + syy * st.gy[k]);
         }
     }
-    /* back to the elements, each its mass share of its nodes' forces */
+    /* back to the elements, each its mass share of the forces of the nodes of its body */
     for (size_t q = 0; q < nm; q++) {
         const size_t i = (size_t)salt->members[q];
+        const double *div = (s->flags[i] & CDEM_FLAG_SALT) ? salt->gm : salt->gbm;
         stencil_of(salt, s->x[i], s->y[i], &st);
         double fx = 0.0, fy = 0.0;
         for (int k = 0; k < 9; k++) {
             const long g = st.node[k];
-            if (g < 0 || !(salt->gm[g] > 0.0))
+            if (g < 0 || !(div[g] > 0.0))
                 continue;
-            const double share = st.w[k] * s->mass[i] / salt->gm[g];
+            const double share = st.w[k] * s->mass[i] / div[g];
             fx += share * salt->gfx[g];
             fy += share * salt->gfy[g];
         }

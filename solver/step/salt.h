@@ -63,7 +63,11 @@ typedef struct {
     long gx0, gy0;
     size_t gnx, gny, gcap;
     double *gm, *gmx, *gmy, *gfx, *gfy; /* node mass, momentum, force */
-    unsigned char *gsalt;               /* 1: a salt element weighs on the node */
+    double *gbm, *gbx, *gby;            /* the non-salt elements' node mass and momentum
+                                           (cover, base, faults, walls, plates) */
+    unsigned char *gsalt;               /* flags: 1 a salt element weighs on the node, 4 it
+                                           is within half a cell of a non-salt element's
+                                           surface */
 
     /* per element (ecap), valid for the state of the last build */
     size_t ecap;

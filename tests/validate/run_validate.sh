@@ -38,7 +38,8 @@
 # 11. docs/measured.md equals a fresh measurement of the default model (make measured);
 # 12. salt (docs/solver.md section 9.5; tests/test_salt.c with CDEM_SALT_VALIDATE=1, about
 #     4 minutes): simple shear at three rates over two decades (the salt's shear stress over
-#     its shear rate within 20 % of the set viscosity at each; the plate's measure printed),
+#     its shear rate within 20 % of the set viscosity at each, the plate's force within 20 %
+#     of eta U / H),
 #     Huppert's gravity current (exponent 0.20 +- 0.03, prefactor within 25 %), the salt's
 #     area within 1 % in both.
 BUILD=${1:-build}
