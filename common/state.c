@@ -2,6 +2,7 @@
  * index is valid in every array at all times. */
 #include "state.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -220,4 +221,16 @@ void cdem_id_map_free(cdem_id_map *map) {
         return;
     free(map->index);
     memset(map, 0, sizeof *map);
+}
+
+void cdem_state_free_y_range(const cdem_state *s, double *lo, double *hi) {
+    double l = INFINITY, h = -INFINITY;
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
+            continue;
+        l = fmin(l, s->y[i]);
+        h = fmax(h, s->y[i]);
+    }
+    *lo = l;
+    *hi = h;
 }

@@ -110,6 +110,11 @@ cdem_status cdem_state_init(cdem_state *s, size_t capacity, int with_stress, cde
 /* Releases every array; s may be NULL. Leaves s empty. */
 void cdem_state_free(cdem_state *s);
 
+/* The lowest and highest centre heights of the free elements (neither wall, fault, footwall
+ * display nor mylar: CDEM_FLAGS_BOUNDARY); lo = +inf and hi = -inf when there are none. The
+ * layers, the weak interval, the erosion level and the salt layer are measured on it. */
+void cdem_state_free_y_range(const cdem_state *s, double *lo, double *hi);
+
 /* Grows every array to hold at least capacity elements (geometric growth). */
 cdem_status cdem_state_reserve(cdem_state *s, size_t capacity, cdem_error *err);
 

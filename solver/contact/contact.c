@@ -174,13 +174,8 @@ cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "heterogeneity.weak_density_percent = %g: must be > 0 and <= 100",
                          p->weak_density_percent);
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        lo = fmin(lo, s->y[i]);
-        hi = fmax(hi, s->y[i]);
-    }
+    double lo, hi;
+    cdem_state_free_y_range(s, &lo, &hi);
     if (!(hi >= lo))
         return CDEM_OK; /* no free elements */
     const double th = p->weak_thickness_percent / 100.0 * (hi - lo);

@@ -31,13 +31,8 @@
 /* 24 pre-growth layers of equal thickness between the lowest and highest free-element
  * centres at the end of equilibration; layer 1 at the bottom; walls keep layer 0. */
 static void assign_layers(cdem_state *s) {
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        lo = fmin(lo, s->y[i]);
-        hi = fmax(hi, s->y[i]);
-    }
+    double lo, hi;
+    cdem_state_free_y_range(s, &lo, &hi);
     if (!(hi > lo))
         return;
     const double th = (hi - lo) / CDEM_PREGROWTH_LAYERS;
@@ -89,13 +84,8 @@ static void set_erosion_level(run_ctx *r) {
     r->erosion_y = INFINITY;
     if (!r->p->erosion)
         return;
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < r->s.n; i++) {
-        if (r->s.flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        lo = fmin(lo, r->s.y[i]);
-        hi = fmax(hi, r->s.y[i]);
-    }
+    double lo, hi;
+    cdem_state_free_y_range(&r->s, &lo, &hi);
     if (hi >= lo)
         r->erosion_y = lo + r->p->erosion_base_level * (hi - lo);
 }

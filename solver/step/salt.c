@@ -35,13 +35,8 @@ cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, cdem_stat
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_salt_place: NULL argument");
     if (p->salt_layer == CDEM_SALT_OFF)
         return CDEM_OK;
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & CDEM_FLAGS_BOUNDARY)
-            continue;
-        lo = fmin(lo, s->y[i]);
-        hi = fmax(hi, s->y[i]);
-    }
+    double lo, hi;
+    cdem_state_free_y_range(s, &lo, &hi);
     if (!(hi > lo))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "salt.layer: the assembly has no span of free "
