@@ -168,6 +168,11 @@ long cdem_model_increment_step(const cdem_model *m, int k) {
     return step < m->total_steps ? step : m->total_steps;
 }
 
+long cdem_model_inversion_step(const cdem_params *p, const cdem_model *m) {
+    const long def_steps = m->total_steps - m->equil_steps;
+    return p->inversion ? lround(p->inversion_percent / 100.0 * (double)def_steps) : def_steps + 1;
+}
+
 long cdem_model_sediment_events(const cdem_params *p, const cdem_model *m) {
     if (!p->sedimentation || m->sediment_steps < 1)
         return 0;

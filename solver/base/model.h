@@ -118,6 +118,10 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
 /* Time step at which increment k (0..n_increments_total) is written. */
 long cdem_model_increment_step(const cdem_model *m, int k);
 
+/* The deformation step (counted without settling steps) at which an inverting mode turns:
+ * inversion_percent of the deformation steps; past the last step when inversion is off. */
+long cdem_model_inversion_step(const cdem_params *p, const cdem_model *m);
+
 /* Number of sediment deposits the run makes when sedimentation is on (0 when it is off):
  * one every sediment_steps run steps after the equilibration, each one whose settling ends
  * by the last step (cdem_sediment_due's schedule; a settling never outlasts the interval,

@@ -191,9 +191,7 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
                          name, x_left, pl->y[pl->n - 1], max_heave, w.x_min, c->dip_base_deg);
     c->sense = p->fault_sense;
     c->inversion = p->inversion ? 1 : 0;
-    const long def_steps = m->total_steps - m->equil_steps;
-    c->k_inversion =
-        c->inversion ? lround(p->inversion_percent / 100.0 * (double)def_steps) : def_steps + 1;
+    c->k_inversion = cdem_model_inversion_step(p, m);
     const double db = c->dip_base_deg * M_PI / 180.0;
     c->heave = cos(db);
     c->throw_ = sin(db);

@@ -73,9 +73,7 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     c->dip_deg = p->fault_dip;
     c->sense = p->fault_sense;
     c->inversion = p->inversion ? 1 : 0;
-    const long def_steps = m->total_steps - m->equil_steps;
-    c->k_inversion =
-        c->inversion ? lround(p->inversion_percent / 100.0 * (double)def_steps) : def_steps + 1;
+    c->k_inversion = cdem_model_inversion_step(p, m);
     c->x_fault = p->fault_location * m->width_m;
     c->y_base = ymin;
     const double d = p->fault_dip * M_PI / 180.0;

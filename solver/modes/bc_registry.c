@@ -127,7 +127,7 @@ void cdem_bc_describe_inversion(const cdem_params *p, const cdem_model *m, FILE 
     long def_steps = m->total_steps - m->equil_steps;
     long deposits = cdem_model_sediment_events(p, m);
     long moving = def_steps - deposits * m->settling_steps;
-    long turn = lround(p->inversion_percent / 100.0 * (double)def_steps);
+    long turn = cdem_model_inversion_step(p, m);
     double before = (double)(turn < moving ? turn : moving) * m->displacement_per_step;
     double after = (double)(moving > turn ? moving - turn : 0) * m->displacement_per_step;
     double net = before - after;
