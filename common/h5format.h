@@ -85,6 +85,11 @@ typedef struct {
     double left_wall_force_y;   /* N */
     double right_wall_force_x;  /* N, the same for the right lateral wall */
     double right_wall_force_y;  /* N */
+    double salt_area;           /* m^2, the salt's material area (sum of J pi r^2 / phi over
+                                   the salt elements, solver/step/salt.h): conserved to within
+                                   its elastic compression; NaN without salt */
+    double salt_top;            /* m, the highest salt element's top (a diapir's crest);
+                                   NaN without salt */
     double axial_strain;        /* biaxial */
     double differential_stress; /* biaxial, N/m */
     double sea_level;           /* m, NaN when none */

@@ -77,6 +77,7 @@ static const char *const sense_words[] = {"normal", "reverse", NULL};
 static const char *const kin_words[] = {"ch", "cd", NULL};
 static const char *const vert_words[] = {"caldera", "piston", NULL};
 static const char *const walls_words[] = {"right", "both", NULL};
+static const char *const detach_sense_words[] = {"shortening", "extension", NULL};
 static const char *const weak_words[] = {"off", "lower", "upper", NULL};
 static const char *const flex_words[] = {"layer-contacts", "weak-layers", NULL};
 static const char *const sea_words[] = {"null", "low", "mid", "high", "very-high", NULL};
@@ -217,6 +218,8 @@ static const cdem_param_def param_table[] = {
      "two vertical faults: caldera (block down, extension) or piston (block up, compression)"},
     {"boundary", "detachment_walls", CDEM_PTYPE_ENUM, P_OFF(detachment_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
      "detachment: right wall moving, or both walls moving inward (each at the boundary speed)"},
+    {"boundary", "detachment_sense", CDEM_PTYPE_ENUM, P_OFF(detachment_sense), 0, "", "shortening", 0, 0, 0, 0, detach_sense_words,
+     "detachment: the moving walls go inward (shortening) or outward (extension)"},
     {"boundary", "repose_walls", CDEM_PTYPE_ENUM, P_OFF(repose_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
      "repose-collapse: right wall removed, or both, after equilibration"},
     {"boundary", "confining_pressure", CDEM_PTYPE_DOUBLE, P_OFF(confining_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,

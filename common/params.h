@@ -64,6 +64,9 @@ typedef enum {
 } cdem_fault_kinematics; /* constant heave / displacement */
 typedef enum { CDEM_VERT_CALDERA = 0, CDEM_VERT_PISTON = 1 } cdem_vertical_sense;
 typedef enum { CDEM_WALLS_RIGHT = 0, CDEM_WALLS_BOTH = 1 } cdem_walls_choice;
+/* detachment: the moving walls go inward (shortening) or outward (extension, thin-skinned
+ * extension of a cover spreading over its detachment, e.g. salt) */
+typedef enum { CDEM_DETACH_SHORTENING = 0, CDEM_DETACH_EXTENSION = 1 } cdem_detachment_sense;
 typedef enum { CDEM_WEAK_OFF = 0, CDEM_WEAK_LOWER = 1, CDEM_WEAK_UPPER = 2 } cdem_weak_interval;
 /* What damps the elements' motion (docs/solver.md, "Damping"). */
 typedef enum {
@@ -162,6 +165,7 @@ typedef struct {
     double vertical_fault_spacing;      /* distance to the second fault, fraction of base */
     cdem_vertical_sense vertical_sense; /* caldera (block down) or piston (block up) */
     cdem_walls_choice detachment_walls; /* right wall moving, or both */
+    cdem_detachment_sense detachment_sense; /* walls inward (shortening) or outward */
     cdem_walls_choice repose_walls;     /* right wall removed, or both */
     double confining_pressure;          /* biaxial: N/m on the free edges, >= 0 */
 

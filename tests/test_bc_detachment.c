@@ -18,14 +18,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-static void check_kinematics(cdem_walls_choice walls) {
+static void check_kinematics(cdem_walls_choice walls, cdem_detachment_sense sense) {
     const long K = 600;
     cdem_params p = fx_params(CDEM_MODE_DETACHMENT);
     p.detachment_walls = walls;
+    p.detachment_sense = sense;
+    const double out = sense == CDEM_DETACH_EXTENSION ? 1.0 : -1.0; /* right wall's sign */
     fx_result r;
     fx_run(p, K, &r);
     const double w = (double)K * DPS;                        /* each moving wall */
-    const double u = walls == CDEM_WALLS_BOTH ? 2.0 * w : w; /* total shortening */
+    const double u = walls == CDEM_WALLS_BOTH ? 2.0 * w : w; /* total shortening/extension */
     long n_left = 0, n_right = 0, n_base = 0;
     for (size_t i = 0; i < r.s0.n; i++) {
         const uint32_t f = r.s0.flags[i];
@@ -39,11 +41,11 @@ static void check_kinematics(cdem_walls_choice walls) {
             assert_true(dx == 0.0);
             assert_true(!(f & CDEM_FLAG_MOVING));
             n_base++;
-        } else if (r.s0.x[i] == WIDTH) { /* right wall: left by w */
-            assert_float_equal(dx, -w, 1e-9 * u);
+        } else if (r.s0.x[i] == WIDTH) { /* right wall: left (shortening) or right by w */
+            assert_float_equal(dx, out * w, 1e-9 * u);
             n_right++;
-        } else { /* left wall: right by w with "both", else still */
-            assert_float_equal(dx, walls == CDEM_WALLS_BOTH ? w : 0.0, 1e-9 * u);
+        } else { /* left wall: by w the other way with "both", else still */
+            assert_float_equal(dx, walls == CDEM_WALLS_BOTH ? -out * w : 0.0, 1e-9 * u);
             assert_int_equal((f & CDEM_FLAG_MOVING) != 0, walls == CDEM_WALLS_BOTH);
             n_left++;
         }
@@ -62,12 +64,22 @@ static void check_kinematics(cdem_walls_choice walls) {
 
 static void test_bc_detachment_right_wall(void **st) {
     (void)st;
-    check_kinematics(CDEM_WALLS_RIGHT);
+    check_kinematics(CDEM_WALLS_RIGHT, CDEM_DETACH_SHORTENING);
 }
 
 static void test_bc_detachment_both_walls(void **st) {
     (void)st;
-    check_kinematics(CDEM_WALLS_BOTH);
+    check_kinematics(CDEM_WALLS_BOTH, CDEM_DETACH_SHORTENING);
+}
+
+static void test_bc_detachment_extension_right_wall(void **st) {
+    (void)st;
+    check_kinematics(CDEM_WALLS_RIGHT, CDEM_DETACH_EXTENSION);
+}
+
+static void test_bc_detachment_extension_both_walls(void **st) {
+    (void)st;
+    check_kinematics(CDEM_WALLS_BOTH, CDEM_DETACH_EXTENSION);
 }
 
 /* The base is a wall: its contacts with elements use the wall material. */
@@ -89,6 +101,18 @@ static void test_bc_detachment_errors_and_view(void **st) {
     p.detachment_walls = (cdem_walls_choice)7;
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "detachment_walls = 7"));
+    p = fx_params(CDEM_MODE_DETACHMENT);
+    p.detachment_sense = (cdem_detachment_sense)5;
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_ERR_RANGE);
+    assert_non_null(strstr(err.msg, "detachment_sense = 5: must be shortening or extension"));
+    p = fx_params(CDEM_MODE_DETACHMENT);
+    p.detachment_sense = CDEM_DETACH_EXTENSION;
+    assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
+    char *ve = fx_view(&bc);
+    assert_non_null(strstr(ve, "moves right"));
+    assert_non_null(strstr(ve, "(extension)"));
+    free(ve);
+    cdem_bc_free(&bc);
     p = fx_params(CDEM_MODE_DETACHMENT);
     p.detachment_walls = CDEM_WALLS_BOTH;
     assert_int_equal(cdem_bc_init(&bc, &p, &m, &s, &err), CDEM_OK);
@@ -173,10 +197,123 @@ static void test_bc_detachment_cdem_run(void **st) {
     }
 }
 
+/* Extension through cdem_run on the default model: the base runs on past the right wall by
+ * one assembly width (one row of base discs, none lost), the right wall ends at its start
+ * plus the extension, the material follows it (the rightmost free element moves right by
+ * a good share of the wall's displacement, more than the leftmost) and nothing is removed. */
+static void test_bc_detachment_extension_run(void **st) {
+    (void)st;
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_DETACHMENT;
+    p.detachment_sense = CDEM_DETACH_EXTENSION;
+    p.display_interval = 20.0;
+    cdem_increment_info last;
+    cdem_model m;
+    const char *name = "test_bc_detachment_run_extension";
+    fx_cdem_run(p, name, 1200, &last, &m);
+    const double ext = 1200.0 * m.displacement_per_step;
+    assert_int_equal(last.step, m.equil_steps + 1200);
+    assert_float_equal(last.net_displacement, ext, 1e-9);
+    char path[1024], file[256];
+    snprintf(file, sizeof file, "%s.h5", name);
+    scratch_path(path, sizeof path, file);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    const size_t n = cdem_h5_reader_increment_count(r);
+    cdem_state s0 = {0}, s1 = {0};
+    assert_int_equal(cdem_h5_reader_load_increment(r, 0, &s0, NULL, &err), CDEM_OK);
+    assert_int_equal(cdem_h5_reader_load_increment(r, n - 1, &s1, NULL, &err), CDEM_OK);
+    assert_int_equal(s1.n, s0.n); /* nothing fell off the base */
+    double base_max = -INFINITY, wall_x0 = -INFINITY, wall_x1 = -INFINITY;
+    double right0 = -INFINITY, right1 = -INFINITY;
+    int32_t right_id = -1;
+    for (size_t i = 0; i < s0.n; i++) {
+        if (s0.flags[i] & CDEM_FLAG_BASE)
+            base_max = fmax(base_max, s0.x[i]);
+        else if ((s0.flags[i] & CDEM_FLAG_MOVING))
+            wall_x0 = fmax(wall_x0, s0.x[i]);
+        else if (!(s0.flags[i] & CDEM_FLAG_WALL) && s0.x[i] > right0) {
+            right0 = s0.x[i];
+            right_id = s0.id[i];
+        }
+    }
+    for (size_t i = 0; i < s1.n; i++) {
+        if ((s1.flags[i] & CDEM_FLAG_MOVING))
+            wall_x1 = fmax(wall_x1, s1.x[i]);
+        if (s1.id[i] == right_id)
+            right1 = s1.x[i];
+    }
+    /* the base reaches one assembly width past the right wall (to within one disc) */
+    assert_true(base_max >= wall_x0 + m.width_m - 2.0 * m.radius[0]);
+    if (fabs(wall_x1 - wall_x0 - ext) > 1e-6 * ext)
+        fail_msg("wall moved %.9f m from %.9f to %.9f, extension %.9f m (%zu increments)", wall_x1 - wall_x0, wall_x0, wall_x1, ext, n);
+    /* the material next to the wall spreads after it */
+    assert_true(right1 - right0 > 0.2 * ext);
+    cdem_state_free(&s0);
+    cdem_state_free(&s1);
+    cdem_h5_reader_close(r);
+}
+
+/* Extension over a basal salt layer: the series' salt_area stays within 1 % of its first
+ * sample (the salt's material area is conserved but for its elastic compression) and
+ * salt_top is the salt's highest top, inside the model; without salt both are NaN. */
+static void test_bc_detachment_extension_over_salt_series(void **st) {
+    (void)st;
+    for (int with_salt = 1; with_salt >= 0; with_salt--) {
+        cdem_params p;
+        cdem_params_defaults(&p);
+        p.mode = CDEM_MODE_DETACHMENT;
+        p.detachment_sense = CDEM_DETACH_EXTENSION;
+        p.display_interval = 5.0;
+        p.damping_mode = CDEM_DAMPING_CONTACT;
+        p.salt_layer = with_salt ? CDEM_SALT_BASAL : CDEM_SALT_OFF;
+        p.salt_thickness_percent = 30.0;
+        cdem_increment_info last;
+        cdem_model m;
+        const char *name = with_salt ? "test_bc_detachment_salt" : "test_bc_detachment_nosalt";
+        fx_cdem_run(p, name, 1000, &last, &m);
+        char path[1024], file[256];
+        snprintf(file, sizeof file, "%s.h5", name);
+        scratch_path(path, sizeof path, file);
+        cdem_error err;
+        cdem_h5_reader *r = NULL;
+        assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+        cdem_series_sample *smp = NULL;
+        size_t ns = 0;
+        assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);
+        assert_true(ns > 10);
+        if (!with_salt) {
+            for (size_t i = 0; i < ns; i++)
+                assert_true(isnan(smp[i].salt_area) && isnan(smp[i].salt_top));
+        } else {
+            const double a0 = smp[0].salt_area;
+            assert_true(a0 > 0.0);
+            /* about 30 % of the 10 x 2.5 km model's area (the span of centres, not the
+             * whole height) */
+            assert_true(a0 > 0.2 * m.width_m * m.height_m && a0 < 0.4 * m.width_m * m.height_m);
+            double worst = 0.0;
+            for (size_t i = 0; i < ns; i++) {
+                worst = fmax(worst, fabs(smp[i].salt_area / a0 - 1.0));
+                assert_true(smp[i].salt_top > 0.0 && smp[i].salt_top < 0.5 * m.height_m);
+            }
+            if (!(worst <= 0.01))
+                fail_msg("salt area changed by %.3g over the run, expected within 1 %%", worst);
+        }
+        free(smp);
+        cdem_h5_reader_close(r);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bc_detachment_right_wall),
         cmocka_unit_test(test_bc_detachment_both_walls),
+        cmocka_unit_test(test_bc_detachment_extension_right_wall),
+        cmocka_unit_test(test_bc_detachment_extension_both_walls),
+        cmocka_unit_test(test_bc_detachment_extension_run),
+        cmocka_unit_test(test_bc_detachment_extension_over_salt_series),
         cmocka_unit_test(test_bc_detachment_base_contacts_are_wall_class),
         cmocka_unit_test(test_bc_detachment_errors_and_view),
         cmocka_unit_test(test_bc_detachment_cdem_run),

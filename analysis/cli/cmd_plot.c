@@ -43,6 +43,8 @@ static const column_def columns[] = {
     COL(left_wall_force_y, "Left wall force y (N)"),
     COL(right_wall_force_x, "Right wall force x (N)"),
     COL(right_wall_force_y, "Right wall force y (N)"),
+    COL(salt_area, "Salt area (m^2)"),
+    COL(salt_top, "Salt top (m)"),
 };
 #undef COL
 #undef ICOL

@@ -23,7 +23,7 @@ static const cdem_cli_option series_options[] = {
      "the /series column to plot: time, step, kinetic_energy, contacts, bonds, n_elements, "
      "net_displacement, boundary_force_x, boundary_force_y, base_force_x, base_force_y, "
      "axial_strain, differential_stress, sea_level, left_wall_force_x, left_wall_force_y, "
-     "right_wall_force_x, right_wall_force_y"},
+     "right_wall_force_x, right_wall_force_y, salt_area, salt_top"},
     {"--x", "COLUMN",
      "the x axis, any column as for --y (default time; e.g. net_displacement, or "
      "axial_strain for a biaxial stress-strain curve)"},

@@ -59,9 +59,10 @@ static const cdem_cli_help help = {
              "time, kinetic_energy, contacts, bonds, n_elements, net_displacement, "
              "boundary_force_x, boundary_force_y, base_force_x, base_force_y, axial_strain, "
              "differential_stress, sea_level, left_wall_force_x, left_wall_force_y, "
-             "right_wall_force_x, right_wall_force_y; units in docs/format.md), then one line "
-             "per sample, full precision, nan for sea_level without sedimentation and for the "
-             "wall forces of files written before they were measured.",
+             "right_wall_force_x, right_wall_force_y, salt_area, salt_top; units in "
+             "docs/format.md), then one line per sample, full precision, nan for sea_level "
+             "without sedimentation, for salt_area and salt_top without salt, and for the "
+             "columns a file's writer did not yet measure (files written before them).",
     .options = series_options,
 };
 

@@ -128,7 +128,7 @@ typedef struct {
                          reads as NaN (its writer did not measure it) */
 } series_column;
 
-#define N_SERIES 18
+#define N_SERIES 20
 extern const series_column h5i_series_columns[N_SERIES];
 
 /* Per-element datasets of an increment: the rows of CDEM_STATE_FIELDS (state.h) marked

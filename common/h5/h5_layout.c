@@ -41,6 +41,8 @@ const series_column h5i_series_columns[] = {
     SCOL_OPTIONAL(left_wall_force_y, COL_F64),
     SCOL_OPTIONAL(right_wall_force_x, COL_F64),
     SCOL_OPTIONAL(right_wall_force_y, COL_F64),
+    SCOL_OPTIONAL(salt_area, COL_F64),
+    SCOL_OPTIONAL(salt_top, COL_F64),
 };
 #undef SCOL
 #undef SCOL_OPTIONAL
@@ -292,17 +294,21 @@ const char *h5i_bad_sample(const cdem_series_sample *q, int blown_up, unsigned a
         memcpy(&v, (const char *)q + sc->offset, sizeof v);
         *column = sc->name;
         const int sea = !strcmp(sc->name, "sea_level");
-        if (isnan(v) && (sea || (absent >> c & 1u)))
-            continue; /* no sedimentation; a column the file does not have (not measured) */
+        const int salt = !strncmp(sc->name, "salt_", 5);
+        if (isnan(v) && (sea || salt || (absent >> c & 1u)))
+            continue; /* no sedimentation, no salt; a column the file does not have */
         if (!isfinite(v)) {
             if (blown_up)
                 continue; /* a run that blew up: its last samples may hold Inf or NaN */
             return say_why(buf, cap, "%s = %.15g must be a finite number", sc->name, v);
         }
-        if ((sea || !strcmp(sc->name, "net_displacement")) && !within(v, CDEM_FILE_MAX_LENGTH))
+        if ((sea || !strcmp(sc->name, "net_displacement") || !strcmp(sc->name, "salt_top")) &&
+            !within(v, CDEM_FILE_MAX_LENGTH))
             return say_why(buf, cap, "%s = %.15g m must be within -1e7..1e7 m", sc->name, v);
         if (!strcmp(sc->name, "kinetic_energy") && v < 0.0)
             return say_why(buf, cap, "kinetic_energy = %.15g J/m must be >= 0", v);
+        if (!strcmp(sc->name, "salt_area") && !(v >= 0.0 && v <= 1e14))
+            return say_why(buf, cap, "salt_area = %.15g m^2 must be within 0..1e14 m^2", v);
         if (!strcmp(sc->name, "axial_strain") && !within(v, CDEM_FILE_MAX_STRAIN))
             return say_why(buf, cap, "axial_strain = %.15g must be within -1e6..1e6", v);
         if (!strcmp(sc->name, "differential_stress") && !within(v, CDEM_FILE_MAX_STRESS))

@@ -111,6 +111,11 @@ cdem_status run_write_sample(run_ctx *r, cdem_error *err) {
     q.right_wall_force_x = wall[1][0];
     q.right_wall_force_y = wall[1][1];
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
+    q.salt_area = q.salt_top = NAN;
+    if (r->salt.elements > 0 && r->salt.phi > 0.0) {
+        long count;
+        cdem_salt_measures(s, r->salt.phi, &q.salt_area, &q.salt_top, &count);
+    }
     cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;
 }
