@@ -14,7 +14,8 @@ wide over the part of the model that holds salt:
   surface        the highest top of the free elements of a column.
 And the salt body's area: the salt discs drawn on a PIXEL m raster, closed (dilated, then
 eroded) by a disc of half the salt's mean radius so that the pores between touching discs
-count as salt, and not the open ground around the body. It is a geometric measure, unlike
+count as salt, and not the open ground around the body, and its holes filled (a hole is
+inside the body, whether the elements around it spread or another body's elements fill it). It is a geometric measure, unlike
 the series' salt_area (the salt's own material area, sum of J pi r^2 / phi, which only the
 grid's velocity divergence changes): when salt elements crowd onto each other (they have
 no repulsion between them, docs/solver.md section 9) the body shrinks while salt_area does
@@ -85,7 +86,7 @@ def body_area(inc):
     k = max(1, int(round(0.5 * r.mean() / PIXEL)))
     yy, xx = np.mgrid[-k:k + 1, -k:k + 1]
     disc = xx * xx + yy * yy <= k * k
-    closed = ndimage.binary_closing(img, structure=disc)
+    closed = ndimage.binary_fill_holes(ndimage.binary_closing(img, structure=disc))
     return float(closed.sum()) * PIXEL * PIXEL
 
 
