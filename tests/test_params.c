@@ -252,7 +252,7 @@ static void test_params_every_enum_word_and_a_wrong_one(void **state) {
         for (int w = 0; d->choices[w]; w++)
             assert_msg_has(&err, d->choices[w]);
     }
-    assert_int_equal(enums, 17);
+    assert_int_equal(enums, 18);
     assert_int_equal(parse(&p, "[surface]\nsea_level_rise = very-high\n", &err), CDEM_OK);
     assert_int_equal(p.sea_level_rise, CDEM_SEA_VERY_HIGH);
     assert_string_equal(cdem_mode_name(CDEM_MODE_VERTICAL_FAULTS), "vertical-faults");
