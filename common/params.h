@@ -153,21 +153,21 @@ typedef struct {
     double layered_friction_value; /* friction coefficient of those layers, >= 0 */
 
     /* [boundary] */
-    cdem_mode mode;                     /* faulting / boundary mode */
-    cdem_fault_sense fault_sense;       /* planar/listric/irregular: normal or reverse */
-    double fault_location;              /* fraction of the base length, 0-1 (exclusive) */
-    double fault_dip;                   /* degrees, planar: dip; listric: basal dip */
-    int inversion;                      /* 0/1: reverse the sense during the run */
-    double inversion_percent;           /* % of total displacement at which it inverts, 0-100 */
-    cdem_fault_kinematics kinematics;   /* listric/irregular: CH or CD */
-    char fault_file[CDEM_PATH_MAX];     /* irregular: text file of x y vertices in m */
-    double vertical_fault_location;     /* two vertical faults: first fault, fraction of base */
-    double vertical_fault_spacing;      /* distance to the second fault, fraction of base */
-    cdem_vertical_sense vertical_sense; /* caldera (block down) or piston (block up) */
-    cdem_walls_choice detachment_walls; /* right wall moving, or both */
+    cdem_mode mode;                         /* faulting / boundary mode */
+    cdem_fault_sense fault_sense;           /* planar/listric/irregular: normal or reverse */
+    double fault_location;                  /* fraction of the base length, 0-1 (exclusive) */
+    double fault_dip;                       /* degrees, planar: dip; listric: basal dip */
+    int inversion;                          /* 0/1: reverse the sense during the run */
+    double inversion_percent;               /* % of total displacement at which it inverts, 0-100 */
+    cdem_fault_kinematics kinematics;       /* listric/irregular: CH or CD */
+    char fault_file[CDEM_PATH_MAX];         /* irregular: text file of x y vertices in m */
+    double vertical_fault_location;         /* two vertical faults: first fault, fraction of base */
+    double vertical_fault_spacing;          /* distance to the second fault, fraction of base */
+    cdem_vertical_sense vertical_sense;     /* caldera (block down) or piston (block up) */
+    cdem_walls_choice detachment_walls;     /* right wall moving, or both */
     cdem_detachment_sense detachment_sense; /* walls inward (shortening) or outward */
-    cdem_walls_choice repose_walls;     /* right wall removed, or both */
-    double confining_pressure;          /* biaxial: N/m on the free edges, >= 0 */
+    cdem_walls_choice repose_walls;         /* right wall removed, or both */
+    double confining_pressure;              /* biaxial: N/m on the free edges, >= 0 */
 
     /* [surface] */
     double overburden_pressure;         /* N/m on the top surface; 0 = off */

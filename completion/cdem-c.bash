@@ -142,7 +142,7 @@ _cdem_strain() {
             --min-rows) return ;;
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
         esac
-        opts="--increment --quantity --threshold --bin --min-rows -o --output -h --help" ;;
+        opts="--increment --quantity --threshold --bin --min-rows --include-salt -o --output -h --help" ;;
     wedge)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;

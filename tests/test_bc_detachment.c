@@ -248,7 +248,8 @@ static void test_bc_detachment_extension_run(void **st) {
     /* the base reaches one assembly width past the right wall (to within one disc) */
     assert_true(base_max >= wall_x0 + m.width_m - 2.0 * m.radius[0]);
     if (fabs(wall_x1 - wall_x0 - ext) > 1e-6 * ext)
-        fail_msg("wall moved %.9f m from %.9f to %.9f, extension %.9f m (%zu increments)", wall_x1 - wall_x0, wall_x0, wall_x1, ext, n);
+        fail_msg("wall moved %.9f m from %.9f to %.9f, extension %.9f m (%zu increments)",
+                 wall_x1 - wall_x0, wall_x0, wall_x1, ext, n);
     /* the material next to the wall spreads after it */
     assert_true(right1 - right0 > 0.2 * ext);
     cdem_state_free(&s0);

@@ -1,6 +1,6 @@
 /* cmd_faults: the faults subcommand of cdem-strain:
  *   faults RUN.h5 [--increment K|last|equil|first] [--quantity NAME] [--threshold V]
- *                 [--bin M] [--min-rows N] [-o OUT.csv]
+ *                 [--bin M] [--min-rows N] [--include-salt] [-o OUT.csv]
  *       fault zones picked from a strain field (measure/faults.h): one CSV row per zone
  *       with where it reaches up and down, its dip and dip direction; a summary on stderr. */
 #include "analysis.h"
@@ -15,7 +15,8 @@
 #include <stdlib.h>
 
 static const char synopsis[] = "RUN.h5 [--increment K|last|equil|first] [--quantity NAME] "
-                               "[--threshold V] [--bin M] [--min-rows N] [-o OUT.csv]";
+                               "[--threshold V] [--bin M] [--min-rows N] [--include-salt] "
+                               "[-o OUT.csv]";
 static const char *const forms[] = {synopsis, NULL};
 static const cdem_cli_option options[] = {
     {"--increment", "K|last|equil|first", "the increment (default last)"},
@@ -25,6 +26,9 @@ static const cdem_cli_option options[] = {
      "median + 3 x 1.4826 x MAD of the cells)"},
     {"--bin", "M", "cell size in m (default 2 x the largest free radius)"},
     {"--min-rows", "N", "cells of height a zone must span, >= 2 (default 4)"},
+    {"--include-salt", NULL,
+     "count the salt's elements too (default: the cover's only; a salt's strain is flow, "
+     "not faulting)"},
     {"-o, --output", "OUT.csv", "output file (default: standard output)"},
     {NULL, NULL, NULL}};
 static const cdem_cli_help help = {
@@ -91,7 +95,8 @@ static int run(int argc, char **argv) {
             if (!cdem_cmd_parse_number(val, &x) || x < 2 || x > 100000 || x != floor(x))
                 return cdem_cmd_usage(&help, "--min-rows must be a whole number >= 2");
             o.min_rows = (int)x;
-        }
+        } else if (cdem_cli_option_is(opt, "--include-salt"))
+            o.include_salt = 1;
     }
     if (!file)
         return cdem_cmd_usage(&help, "missing the run file (RUN.h5)");

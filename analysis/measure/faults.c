@@ -34,6 +34,13 @@ void cdem_faults_default_options(cdem_faults_options *o) {
     o->bin = 0.0;
     o->min_rows = 4;
     o->max_shift = 3.0;
+    o->include_salt = 0;
+}
+
+/* 1 when element i takes part: free, with a value, and not salt unless asked for. */
+static int counts(const cdem_state *s, const double *v, size_t i, int include_salt) {
+    return cdem_surface_is_free(s, i) && isfinite(v[i]) &&
+           (include_salt || !(s->flags[i] & CDEM_FLAG_SALT));
 }
 
 void cdem_faults_free(cdem_faults_result *res) {
@@ -60,11 +67,11 @@ static int cmp_zone(const void *a, const void *b) {
 
 /* Bins the free elements' values (mean per cell, NaN where empty) and smooths each row 1-2-1
  * over the cells that have a value. */
-static void bin_values(const cdem_state *s, const double *v, double x0, double y0, double h,
-                       long nx, long ny, double *sum, double *cnt, double *out) {
+static void bin_values(const cdem_state *s, const double *v, int include_salt, double x0, double y0,
+                       double h, long nx, long ny, double *sum, double *cnt, double *out) {
     const cdem_grid g = {.x0 = x0, .y0 = y0, .cell = h, .nx = (size_t)nx, .ny = (size_t)ny};
     for (size_t i = 0; i < s->n; i++) {
-        if (!cdem_surface_is_free(s, i) || !isfinite(v[i]))
+        if (!counts(s, v, i, include_salt))
             continue;
         const size_t c = cdem_grid_cell(&g, s->x[i], s->y[i]);
         sum[c] += v[i];
@@ -277,7 +284,7 @@ cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_fa
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
     size_t nfree = 0;
     for (size_t i = 0; i < s->n; i++) {
-        if (!cdem_surface_is_free(s, i) || !isfinite(v[i]))
+        if (!counts(s, v, i, o->include_salt))
             continue;
         nfree++;
         xmin = fmin(xmin, s->x[i]);
@@ -287,7 +294,8 @@ cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_fa
         rmax = fmax(rmax, s->radius[i]);
     }
     if (nfree == 0)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "faults: no free element has a value");
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "faults: no free element has a value%s",
+                         o->include_salt ? "" : " (salt elements left out: --include-salt)");
     double h = o->bin > 0.0 ? o->bin : 2.0 * rmax;
     while (((xmax - xmin) / h + 1.0) * ((ymax - ymin) / h + 1.0) > FAULTS_MAX_CELLS)
         h *= 2.0;
@@ -303,7 +311,7 @@ cdem_status cdem_faults_pick(const cdem_state *s, const double *v, const cdem_fa
         st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "faults: out of memory for %ld x %ld cells", nx, ny);
         goto done;
     }
-    bin_values(s, v, xmin, ymin, h, nx, ny, sum, cnt, g);
+    bin_values(s, v, o->include_salt, xmin, ymin, h, nx, ny, sum, cnt, g);
     /* sum is free after binning: the scratch of the threshold's medians */
     const double thr = o->threshold > 0.0 ? o->threshold : outlier_threshold(g, nx * ny, sum);
     for (long j = ny - 1; j >= 0 && np >= 0; j--)

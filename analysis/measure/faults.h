@@ -2,7 +2,9 @@
  * counted and measured (dip, dip direction, where they reach the surface) instead of
  * described.
  *
- * Method (free elements only; boundary elements and NaN values are ignored):
+ * Method (free elements only; boundary elements and NaN values are ignored, and salt elements
+ * unless include_salt: a viscous salt's strain is flow, spread through the layer, not a
+ * fault's, and it raised the field's outlier bound of a salt model above its cover's faults):
  *   1. Bin the values on a grid of square cells of side `bin` (default 2 x the largest free
  *      radius: about one element across) and smooth each row along x with weights 1-2-1.
  *   2. In every row, each maximal run of cells at or above `threshold` is one pick, placed at
@@ -39,6 +41,7 @@ typedef struct {
     double bin;       /* m, cell size; <= 0: 2 x the largest free radius */
     int min_rows;     /* rows a zone must span to count, >= 2 (default 4) */
     double max_shift; /* largest x shift between linked picks, in cells per row (default 3) */
+    int include_salt; /* 1: salt elements count too (default 0: the cover's faults only) */
 } cdem_faults_options;
 
 typedef struct {

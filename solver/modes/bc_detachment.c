@@ -26,12 +26,12 @@
 #include <string.h>
 
 typedef struct {
-    int walls;              /* cdem_walls_choice: right or both */
-    double outward;         /* +1: extension (walls outward), -1: shortening (inward) */
-    double x_mid;           /* m, walls left of this are the left wall */
-    double net; /* m, total shortening or extension so far (sum over the moving walls), >= 0 */
-    long n_left;            /* moving left-wall elements (0 for "right") */
-    long n_right;           /* moving right-wall elements */
+    int walls;      /* cdem_walls_choice: right or both */
+    double outward; /* +1: extension (walls outward), -1: shortening (inward) */
+    double x_mid;   /* m, walls left of this are the left wall */
+    double net;     /* m, total shortening or extension so far (sum over the moving walls), >= 0 */
+    long n_left;    /* moving left-wall elements (0 for "right") */
+    long n_right;   /* moving right-wall elements */
     double step_du, step_v; /* this step's move and speed of each wall (step_begin) */
 } detach_ctx;
 
