@@ -198,7 +198,6 @@ void cdem_salt_free(cdem_salt *salt) {
     free(salt->gmy);
     free(salt->gfx);
     free(salt->gfy);
-    free(salt->gv);
     free(salt->gbm);
     free(salt->gbx);
     free(salt->gby);
@@ -355,8 +354,8 @@ cdem_status cdem_salt_after_build(cdem_salt *salt, const cdem_neighbour *nb, con
     if (salt->gcap < nodes) {
         const size_t c = nodes + nodes / 2 + 16;
         int ok = 1;
-        double **arrays[] = {&salt->gm, &salt->gmx, &salt->gmy, &salt->gfx, &salt->gfy,
-                             &salt->gv, &salt->gbm, &salt->gbx, &salt->gby};
+        double **arrays[] = {&salt->gm,  &salt->gmx, &salt->gmy, &salt->gfx,
+                             &salt->gfy, &salt->gbm, &salt->gbx, &salt->gby};
         for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) {
             double *q = realloc(*arrays[k], c * sizeof(double));
             if (q)
@@ -604,10 +603,8 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
     memset(salt->gmx, 0, nodes * sizeof(double));
     memset(salt->gmy, 0, nodes * sizeof(double));
     memset(salt->gfx, 0, nodes * sizeof(double));
-    memset(salt->gv, 0, nodes * sizeof(double));
     stencil st;
     const double h = salt->h;
-    const double inv_phi_h2 = 1.0 / (salt->phi * h * h);
     for (size_t i = 0; i < s->n; i++) {
         if (!(s->flags[i] & CDEM_FLAG_SALT))
             continue;
@@ -625,29 +622,13 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             salt->gmx[g] += wm * (s->vx[i] + salt->lxx[i] * dx + salt->lxy[i] * dy);
             salt->gmy[g] += wm * (s->vy[i] + salt->lyx[i] * dx + salt->lyy[i] * dy);
             salt->gfx[g] += wm * s->area_ratio[i]; /* the nodes' mean J */
-            /* the salt's volume fraction on the node (crowding, salt.h) */
-            salt->gv[g] +=
-                st.w[k] * s->area_ratio[i] * M_PI * s->radius[i] * s->radius[i] * inv_phi_h2;
         }
-    }
-    /* the volume of the cover's elements on the salt's grid (the last evaluation's members),
-     * so that the salt's fraction is the grid's occupied fraction where it meets the cover,
-     * not a deficit. Not the boundaries': a base or a plate is a row of discs closer than
-     * their diameter, whose areas would count the salt crowded beside it. */
-    for (size_t q = 0; q < salt->n_members; q++) {
-        const size_t i = (size_t)salt->members[q];
-        if (s->flags[i] & (CDEM_FLAG_SALT | CDEM_FLAGS_BOUNDARY))
-            continue;
-        stencil_of(salt, s->x[i], s->y[i], &st);
-        for (int k = 0; k < 9; k++)
-            if (st.node[k] >= 0)
-                salt->gv[st.node[k]] += st.w[k] * M_PI * s->radius[i] * s->radius[i] * inv_phi_h2;
     }
     for (size_t i = 0; i < s->n; i++) {
         if (!(s->flags[i] & CDEM_FLAG_SALT))
             continue;
         stencil_of(salt, s->x[i], s->y[i], &st);
-        double vx = 0.0, vy = 0.0, j = 0.0, w = 0.0, fraction = 0.0;
+        double vx = 0.0, vy = 0.0, j = 0.0, w = 0.0;
         for (int k = 0; k < 9; k++) {
             const long g = st.node[k];
             if (g < 0 || !(salt->gm[g] > 0.0))
@@ -655,7 +636,6 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             vx += st.w[k] * salt->gmx[g] / salt->gm[g];
             vy += st.w[k] * salt->gmy[g] / salt->gm[g];
             j += st.w[k] * salt->gfx[g] / salt->gm[g];
-            fraction += st.w[k] * salt->gv[g];
             w += st.w[k];
         }
         if (w > 0.0) {
@@ -666,9 +646,7 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             s->vy[i] = vy / w;
             s->x[i] += dt * (s->vx[i] - hvx);
             s->y[i] += dt * (s->vy[i] - hvy);
-            /* toward the grid's mean J, or less where the salt crowds (salt.h) */
-            s->area_ratio[i] +=
-                CDEM_SALT_J_RELAX * (cdem_salt_crowded_j(j / w, fraction) - s->area_ratio[i]);
+            s->area_ratio[i] += CDEM_SALT_J_RELAX * (j / w - s->area_ratio[i]);
         }
     }
 }

@@ -63,7 +63,6 @@ typedef struct {
     long gx0, gy0;
     size_t gnx, gny, gcap;
     double *gm, *gmx, *gmy, *gfx, *gfy; /* node mass, momentum, force */
-    double *gv;                         /* the salt's volume fraction on the node (crowding) */
     double *gbm, *gbx, *gby;            /* the non-salt elements' node mass and momentum
                                            (cover, base, faults, walls, plates) */
     unsigned char *gsalt;               /* flags: 1 a salt element weighs on the node, 4 it
@@ -184,22 +183,6 @@ void cdem_salt_stress(const cdem_salt *salt, cdem_state *s);
 static inline double cdem_salt_pressure(double bulk_modulus, double area_ratio) {
     const double p = bulk_modulus * (1.0 / area_ratio - 1.0);
     return p > 0.0 ? p : 0.0;
-}
-
-/* Crowding. J sees only the grid's divergence, so salt elements can gather inside the grid's
- * cells (3-5 elements a cell) without any J changing: measured, the salt body lost 12-61 % of
- * its area in the examples while its material area held within 1 % (docs/solver.md 9.5). The
- * grid's own measure of it is the salt's volume fraction f: the material areas J pi r^2 / phi
- * of the salt elements spread on the nodes with the B-spline weights, per node area h^2,
- * interpolated back to an element. Inside a placed salt f is 0.92-0.97 (at its edges less,
- * down to 0.5). Where f exceeds CDEM_SALT_CROWD_START, the J an element relaxes toward
- * (cdem_salt_project) is the grid's mean J scaled by CDEM_SALT_CROWD_START / f: a crowded
- * salt is a compressed salt, its pressure K (1/J - 1) rises over the relaxation's ~100 steps
- * and pushes it apart. (A pressure taken from f at once, without the relaxation, set the
- * time step: at 0.1 K it blew up, at 0.01 K it did not hold the salt.) */
-#define CDEM_SALT_CROWD_START 1.05
-static inline double cdem_salt_crowded_j(double mean_j, double fraction) {
-    return fraction > CDEM_SALT_CROWD_START ? mean_j * CDEM_SALT_CROWD_START / fraction : mean_j;
 }
 
 /* What the series reports of the salt (run_output.c): its material area sum J pi r^2 / phi
