@@ -170,6 +170,18 @@ __attribute__((unused)) static char *fx_view(const cdem_bc *bc) {
     return buf;
 }
 
+/* Opens the run file fx_cdem_run wrote for `name` (in the scratch folder). */
+__attribute__((unused)) static cdem_h5_reader *fx_open_run(const char *name) {
+    char path[1024], file[256];
+    snprintf(file, sizeof file, "%s.h5", name);
+    scratch_path(path, sizeof path, file);
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
+        fail_msg("%s: %s", path, err.msg);
+    return r;
+}
+
 /* Runs a small default-based model of mode p (10 x 2.5 units, 60 s equilibration) through
  * cdem_run, stopped `def_steps` deformation steps after equilibration; returns the info of
  * the last increment written and the model. */
@@ -191,8 +203,7 @@ __attribute__((unused)) static void fx_cdem_run(cdem_params p, const char *name,
     o.max_steps = m->equil_steps + def_steps;
     if (cdem_run(&p, &o, &err) != CDEM_OK)
         fail_msg("cdem_run: %s", err.msg);
-    cdem_h5_reader *r = NULL;
-    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_h5_reader *r = fx_open_run(name);
     const size_t n = cdem_h5_reader_increment_count(r);
     assert_true(n > 1);
     assert_int_equal(cdem_h5_reader_increment_info(r, n - 1, last, &err), CDEM_OK);

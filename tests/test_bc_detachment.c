@@ -153,12 +153,8 @@ static void test_bc_detachment_cdem_run(void **st) {
         assert_int_equal(last.step, m.equil_steps + 300);
         const double walls = k == 0 ? 1.0 : 2.0; /* moving walls */
         assert_float_equal(last.net_displacement, walls * 300.0 * m.displacement_per_step, 1e-9);
-        char path[1024], file[256];
-        snprintf(file, sizeof file, "%s.h5", name); /* the file fx_cdem_run wrote */
-        scratch_path(path, sizeof path, file);
         cdem_error err;
-        cdem_h5_reader *r = NULL;
-        assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+        cdem_h5_reader *r = fx_open_run(name); /* the file fx_cdem_run wrote */
         const size_t n = cdem_h5_reader_increment_count(r);
         int deform = 0;
         double prev = 0.0;
@@ -215,12 +211,8 @@ static void test_bc_detachment_extension_run(void **st) {
     const double ext = 1200.0 * m.displacement_per_step;
     assert_int_equal(last.step, m.equil_steps + 1200);
     assert_float_equal(last.net_displacement, ext, 1e-9);
-    char path[1024], file[256];
-    snprintf(file, sizeof file, "%s.h5", name);
-    scratch_path(path, sizeof path, file);
     cdem_error err;
-    cdem_h5_reader *r = NULL;
-    assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+    cdem_h5_reader *r = fx_open_run(name); /* the file fx_cdem_run wrote */
     const size_t n = cdem_h5_reader_increment_count(r);
     cdem_state s0 = {0}, s1 = {0};
     assert_int_equal(cdem_h5_reader_load_increment(r, 0, &s0, NULL, &err), CDEM_OK);
@@ -275,12 +267,8 @@ static void test_bc_detachment_extension_over_salt_series(void **st) {
         cdem_model m;
         const char *name = with_salt ? "test_bc_detachment_salt" : "test_bc_detachment_nosalt";
         fx_cdem_run(p, name, 1000, &last, &m);
-        char path[1024], file[256];
-        snprintf(file, sizeof file, "%s.h5", name);
-        scratch_path(path, sizeof path, file);
         cdem_error err;
-        cdem_h5_reader *r = NULL;
-        assert_int_equal(cdem_h5_reader_open(path, &r, &err), CDEM_OK);
+        cdem_h5_reader *r = fx_open_run(name); /* the file fx_cdem_run wrote */
         cdem_series_sample *smp = NULL;
         size_t ns = 0;
         assert_int_equal(cdem_h5_reader_read_series(r, &smp, &ns, &err), CDEM_OK);

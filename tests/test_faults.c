@@ -42,15 +42,21 @@ static double *band_values(const cdem_state *s, int nb, const double *x0, const 
     return v;
 }
 
+/* The packing and the values of a graben: a 60-degree fault dipping right from x = 3 km and a
+ * 45-degree one dipping left from x = 10 km; they do not meet above the base. */
+static const double graben_x0[2] = {3000.0, 10000.0}, graben_dip[2] = {60.0, 45.0};
+static const int graben_right[2] = {1, 0};
+static double *graben(cdem_state *s) {
+    make_packing(s, 6000, W, H, 3);
+    return band_values(s, 2, graben_x0, graben_dip, graben_right);
+}
+
 static void test_faults_two_bands(void **unused) {
     (void)unused;
     cdem_state s;
-    make_packing(&s, 6000, W, H, 3);
-    /* a graben: a 60-degree fault dipping right from x = 3 km and a 45-degree one dipping left
-     * from x = 10 km; they do not meet above the base */
-    const double x0[2] = {3000.0, 10000.0}, dip[2] = {60.0, 45.0};
-    const int right[2] = {1, 0};
-    double *v = band_values(&s, 2, x0, dip, right);
+    double *v = graben(&s);
+    const double *x0 = graben_x0, *dip = graben_dip;
+    const int *right = graben_right;
     cdem_faults_options o;
     cdem_faults_default_options(&o);
     cdem_faults_result r;
@@ -82,10 +88,7 @@ static void test_faults_two_bands(void **unused) {
 static void test_faults_leave_out_the_salt(void **unused) {
     (void)unused;
     cdem_state s;
-    make_packing(&s, 6000, W, H, 3);
-    const double x0[2] = {3000.0, 10000.0}, dip[2] = {60.0, 45.0};
-    const int right[2] = {1, 0};
-    double *v = band_values(&s, 2, x0, dip, right);
+    double *v = graben(&s);
     cdem_faults_options o;
     cdem_faults_default_options(&o);
     cdem_faults_result plain, cover, all;
