@@ -7,7 +7,11 @@
  * packing, gravity off, the lateral walls free slip (salt.wall_contact). The plate moves at U to
  * the right; the lateral walls are hinged: each of their elements moves at U (y - y_b) / H, so the
  * box is a simple-shear box whose side walls follow the affine profile (cdem-c has no periodic
- * boundaries). The salt starts with the affine velocity profile and is sheared to `strain`; over
+ * boundaries). With open_ends (make validate's long cells) the lateral walls are left out and
+ * the box's ends are free: hinged free-slip walls, which hold the salt by their pairs' repulsion
+ * alone, make its J run away after about 500,000 steps (docs/solver.md 9.5), and gravity is off,
+ * so the salt stays in the box without them.
+ * The salt starts with the affine velocity profile and is sheared to `strain`; over
  * the second half the shear stress is measured (a) on the plate, tau = -sum fx / L, and (b) as the
  * mean continuum shear stress of the salt elements of the middle half of the box (x from W/4 to
  * 3W/4); the rate as U / H (nominal) and as the slope of the mean velocity profile over the middle
@@ -138,9 +142,10 @@ static int couette_wall_kind(const cdem_state *s, size_t i, double gap) {
 /* Simple shear at plate speed U to `strain` (see the top). J starts at 1 / (1 + P / K) for a
  * confining pressure P. cover_plate: the plate's elements are free (cover) elements whose motion
  * the cell imposes each step, so that the salt module couples them as cover, not as a
- * prescribed-velocity boundary. Returns 0 with err set when the set-up or a step fails. */
+ * prescribed-velocity boundary. open_ends: no lateral walls (see the top). Returns 0 with err
+ * set when the set-up or a step fails. */
 __attribute__((unused)) static int couette_run(double U, double strain, double confining,
-                                               int cover_plate, couette_result *out,
+                                               int cover_plate, int open_ends, couette_result *out,
                                                cdem_error *err) {
     memset(out, 0, sizeof *out);
     cdem_params p = salt_cell_params(8.0, 2.0, 0);
@@ -191,7 +196,9 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     for (size_t i = 0; i < c.s.n; i++)
         keep[i] = !((c.s.flags[i] & CDEM_FLAG_WALL) && !(c.s.flags[i] & CDEM_FLAG_BASE) &&
                     c.s.y[i] > H + 2.0 * rw) &&
-                  !((c.s.flags[i] & CDEM_FLAG_SALT) && c.s.y[i] + c.s.radius[i] > H);
+                  !((c.s.flags[i] & CDEM_FLAG_SALT) && c.s.y[i] + c.s.radius[i] > H) &&
+                  !(open_ends && (c.s.flags[i] & CDEM_FLAG_WALL) &&
+                    !(c.s.flags[i] & CDEM_FLAG_BASE) && c.s.y[i] > 0.0);
     cdem_state_compact(&c.s, keep, NULL);
     free(keep);
     /* the salt measured again in the box it now fills, and the module set up with it */

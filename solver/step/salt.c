@@ -587,22 +587,15 @@ void cdem_salt_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *
     }
 }
 
-void cdem_salt_update_area(const cdem_salt *salt, cdem_state *s, double dt) {
-    if (!salt->on || salt->gnx == 0)
-        return;
-    for (size_t i = 0; i < s->n; i++)
-        if (s->flags[i] & CDEM_FLAG_SALT)
-            s->area_ratio[i] *= exp(dt * (salt->lxx[i] + salt->lyy[i]));
-}
-
 void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
     if (!salt->on || salt->gnx == 0)
         return;
     const size_t nodes = salt->gnx * salt->gny;
-    memset(salt->gm, 0, nodes * sizeof(double));
-    memset(salt->gmx, 0, nodes * sizeof(double));
-    memset(salt->gmy, 0, nodes * sizeof(double));
-    memset(salt->gfx, 0, nodes * sizeof(double));
+    /* gm, gmx, gmy: the salt's mass and affine (APIC) momentum; gbx, gby: its plain momentum,
+     * whose divergence J follows; gfx: its mass-weighted J */
+    double *const arrays[] = {salt->gm, salt->gmx, salt->gmy, salt->gfx, salt->gbx, salt->gby};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+        memset(arrays[k], 0, nodes * sizeof(double));
     stencil st;
     const double h = salt->h;
     for (size_t i = 0; i < s->n; i++) {
@@ -621,6 +614,8 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             salt->gm[g] += wm;
             salt->gmx[g] += wm * (s->vx[i] + salt->lxx[i] * dx + salt->lxy[i] * dy);
             salt->gmy[g] += wm * (s->vy[i] + salt->lyx[i] * dx + salt->lyy[i] * dy);
+            salt->gbx[g] += wm * s->vx[i];
+            salt->gby[g] += wm * s->vy[i];
             salt->gfx[g] += wm * s->area_ratio[i]; /* the nodes' mean J */
         }
     }
@@ -628,14 +623,16 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
         if (!(s->flags[i] & CDEM_FLAG_SALT))
             continue;
         stencil_of(salt, s->x[i], s->y[i], &st);
-        double vx = 0.0, vy = 0.0, j = 0.0, w = 0.0;
+        double vx = 0.0, vy = 0.0, j = 0.0, w = 0.0, div = 0.0;
         for (int k = 0; k < 9; k++) {
             const long g = st.node[k];
             if (g < 0 || !(salt->gm[g] > 0.0))
                 continue;
-            vx += st.w[k] * salt->gmx[g] / salt->gm[g];
-            vy += st.w[k] * salt->gmy[g] / salt->gm[g];
-            j += st.w[k] * salt->gfx[g] / salt->gm[g];
+            const double inv_m = 1.0 / salt->gm[g];
+            vx += st.w[k] * salt->gmx[g] * inv_m;
+            vy += st.w[k] * salt->gmy[g] * inv_m;
+            div += (st.gx[k] * salt->gbx[g] + st.gy[k] * salt->gby[g]) * inv_m;
+            j += st.w[k] * salt->gfx[g] * inv_m;
             w += st.w[k];
         }
         if (w > 0.0) {
@@ -646,6 +643,7 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             s->vy[i] = vy / w;
             s->x[i] += dt * (s->vx[i] - hvx);
             s->y[i] += dt * (s->vy[i] - hvy);
+            s->area_ratio[i] *= exp(dt * div);
             s->area_ratio[i] += CDEM_SALT_J_RELAX * (j / w - s->area_ratio[i]);
         }
     }

@@ -149,15 +149,12 @@ cdem_status cdem_salt_after_build(cdem_salt *salt, const cdem_neighbour *nb, con
                                   cdem_error *err);
 
 /* The salt's forces of the current positions and velocities added into ex, ey (one per
- * element); tr L and the stress of each salt element kept for cdem_salt_update_area and
+ * element); L and the stress of each salt element kept for cdem_salt_project and
  * cdem_salt_stress. */
 void cdem_salt_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *ey);
 
-/* After a time step of length dt: J_i <- J_i exp(dt tr L_i) for every salt element. */
-void cdem_salt_update_area(const cdem_salt *salt, cdem_state *s, double dt);
-
-/* After a time step of length dt (and the area update), the salt made a continuum of
- * material points again (MPM's transfer back from the grid), from a grid of the salt alone:
+/* After a time step of length dt, the salt made a continuum of material points again (MPM's
+ * transfer back from the grid), from a grid of the salt alone:
  *  - each salt element's velocity is replaced by the grid's at its centre, the grid's
  *    velocities made from the salt's new velocities with each element's velocity gradient L
  *    (an affine transfer, APIC): a linear field passes unchanged, momentum and angular
@@ -165,11 +162,16 @@ void cdem_salt_update_area(const cdem_salt *salt, cdem_state *s, double dt);
  *    material points) are removed;
  *  - it is moved as that velocity moves it rather than with its own mid-step velocity
  *    (x += dt (v_grid - v_half)), as a material point is advected by the grid;
- *  - its area ratio is relaxed by CDEM_SALT_J_RELAX toward the grid's mass-weighted mean of
- *    the salt's J around it, which keeps the salt's area (sum m J) exactly.
- * Without them the elements drift inside the grid's cells and their J (each integrates the
- * divergence where it stands) random-walk apart: the salt gathers in bands a cell apart under
- * gravity within minutes of model time, and its pressure noise reaches its mean. */
+ *  - its area ratio follows the divergence of the salt's own velocities on that grid,
+ *    J <- J exp(dt div v), the plain (not affine) momentum over the mass of the nodes: the
+ *    field the element moves with, so that salt that converges is compressed and its pressure
+ *    resists (J following tr L of the forces' grid, whose nodes next to the cover and the base
+ *    carry their velocities, let the salt's elements crowd unseen: docs/solver.md 9.5);
+ *  - then relaxed by CDEM_SALT_J_RELAX toward the grid's mass-weighted mean of the salt's J
+ *    around it, which keeps the salt's area (sum m J) exactly.
+ * Without them the elements drift inside the grid's cells and their J random-walk apart: the
+ * salt gathers in bands a cell apart under gravity within minutes of model time, and its
+ * pressure noise reaches its mean. */
 void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt);
 
 /* The fraction of its difference to the grid's mean J that an element's J loses in a step. */

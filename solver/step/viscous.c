@@ -90,7 +90,6 @@ void cdem_viscous_finish(cdem_viscous *v, cdem_state *s, int kick, double dt, do
         }
     }
     if (kick && dt > 0.0) {
-        cdem_salt_update_area(&v->salt, s, dt);
         cdem_salt_project(&v->salt, s, dt);
     }
 }
