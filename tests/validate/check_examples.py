@@ -9,6 +9,10 @@
   planar/fig7c-caldera    at least two fault zones, one each way; no void
   growth/fig12a-...       more than one fault zone (thrusts), and an undeformed foreland:
                           the deformed wedge shorter than 85 % of the belt
+  salt-detachment/...     (issue 37, not the paper) the salt keeps its body: its geometric
+                          area (salt_measure.py) within 20 % of the end of equilibration's in
+                          both quick runs; the shortened salt thickens (its mean top rises);
+                          the wedge over salt has a lower taper than its twin without salt
 
 usage: check_examples.py CDEM_STRAIN EXAMPLES_OUT
 (EXAMPLES_OUT is the folder `make -C examples quick EXAMPLES_OUT=...` wrote into.)
@@ -39,6 +43,40 @@ def voids(strain, h5):
     text = run([strain, "voids", h5])
     return (int(re.search(r"voids = (\d+)", text).group(1)),
             float(re.search(r"steepest surface slope = ([\d.]+)", text).group(1)))
+
+
+def salt_checks(strain, out, check):
+    """examples/salt-detachment's quick runs (docs/solver.md 9.5: before J followed the field
+    that moves the salt, the contraction's salt body lost 61 % and its mean top fell)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, os.path.join(here, "..", "..", "examples", "salt-detachment"))
+    import h5py
+    import numpy as np
+    import salt_measure as sm
+    tops = {}
+    for name in ("ext-salt", "con-salt"):
+        with h5py.File(os.path.join(out, "salt-detachment", name + ".h5"), "r") as f:
+            ix = f["increments/index"][:]
+            equil = [k for k in range(len(ix)) if int(ix["phase"][k]) == 0]
+            first, last = sm.increment(f, equil[-1] if equil else 0), sm.increment(f, len(ix) - 1)
+        a0, a1 = sm.body_area(first), sm.body_area(last)
+        check(abs(a1 / a0 - 1.0) <= 0.2, "salt %s: body %.2f -> %.2f km2 (%+.1f %%)" %
+              (name, a0 / 1e6, a1 / 1e6, 100.0 * (a1 / a0 - 1.0)))
+        salt = lambda inc: (inc["flags"] & sm.SALT) != 0
+        x0 = min(first["x"][salt(first)].min(), last["x"][salt(last)].min()) - sm.COL
+        x1 = max(first["x"][salt(first)].max(), last["x"][salt(last)].max()) + sm.COL
+        tops[name] = (np.nanmean(sm.columns(first, x0, x1)[:, 1]),
+                      np.nanmean(sm.columns(last, x0, x1)[:, 1]))
+    t0, t1 = tops["con-salt"]
+    check(t1 > t0, "salt con-salt: mean salt top %.0f -> %.0f m (the shortened salt thickens)" %
+          (t0, t1))
+    taper = {}
+    for name in ("con-salt", "con-nosalt"):
+        h5 = os.path.join(out, "salt-detachment", name + ".h5")
+        w = list(csv.DictReader(io.StringIO(run([strain, "wedge", h5, "--increment", "last"]))))
+        taper[name] = float(w[-1]["taper_deg"])
+    check(taper["con-salt"] < taper["con-nosalt"], "salt: taper %.1f deg over salt, %.1f without"
+          % (taper["con-salt"], taper["con-nosalt"]))
 
 
 def main():
@@ -80,6 +118,8 @@ def main():
     frac = float(w["length_m"]) / belt
     check(frac < 0.85, "12A deformed length %.0f m of a %.0f m belt (%.0f %%)" %
           (float(w["length_m"]), belt, 100 * frac))
+
+    salt_checks(strain, out, check)
 
     for line in lines:
         print("check_examples: ok: " + line)
