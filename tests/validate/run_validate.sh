@@ -32,7 +32,8 @@
 #  9. every example pipeline of examples/ at reduced size (make -C examples quick: runs,
 #     analyses and pictures; docs/times.md has its time), and the paper's measurable features
 #     on those runs (tests/validate/check_examples.py: the 7A graben, no void, the 7C
-#     faults, more than one thrust and an undeformed foreland in 12A).
+#     faults, more than one thrust and an undeformed foreland in 12A; over salt, the salt's
+#     body kept within 20 %, the shortened salt thickening, a lower taper than without salt).
 # 10. every code block of README.md, docs/guide.md and docs/format.md, the long ones too
 #     (tests/docs/run_doc_blocks.py --all; make test runs the quick ones);
 # 11. docs/measured.md equals a fresh measurement of the default model (make measured);
