@@ -249,20 +249,27 @@ static void test_bc_detachment_extension_run(void **st) {
     cdem_h5_reader_close(r);
 }
 
+/* A detachment over a basal salt layer of 30 % (layer = off: the same model without salt), an
+ * increment every 5 m, contact damping (salt requires it): the salt tests' model. */
+static cdem_params salt_params(cdem_salt_layer_choice layer) {
+    cdem_params p;
+    cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_DETACHMENT;
+    p.display_interval = 5.0;
+    p.damping_mode = CDEM_DAMPING_CONTACT;
+    p.salt_layer = layer;
+    p.salt_thickness_percent = 30.0;
+    return p;
+}
+
 /* Extension over a basal salt layer: the series' salt_area stays within 1 % of its first
  * sample (the salt's material area is conserved but for its elastic compression) and
  * salt_top is the salt's highest top, inside the model; without salt both are NaN. */
 static void test_bc_detachment_extension_over_salt_series(void **st) {
     (void)st;
     for (int with_salt = 1; with_salt >= 0; with_salt--) {
-        cdem_params p;
-        cdem_params_defaults(&p);
-        p.mode = CDEM_MODE_DETACHMENT;
+        cdem_params p = salt_params(with_salt ? CDEM_SALT_BASAL : CDEM_SALT_OFF);
         p.detachment_sense = CDEM_DETACH_EXTENSION;
-        p.display_interval = 5.0;
-        p.damping_mode = CDEM_DAMPING_CONTACT;
-        p.salt_layer = with_salt ? CDEM_SALT_BASAL : CDEM_SALT_OFF;
-        p.salt_thickness_percent = 30.0;
         cdem_increment_info last;
         cdem_model m;
         const char *name = with_salt ? "test_bc_detachment_salt" : "test_bc_detachment_nosalt";
@@ -305,14 +312,8 @@ static void test_bc_detachment_extension_over_salt_series(void **st) {
  * keeps the salt carrying its cover (not bypassed by the pairs, not blown up): 0.8 to 1.5. */
 static void test_bc_detachment_salt_carries_its_cover(void **st) {
     (void)st;
-    cdem_params p;
-    cdem_params_defaults(&p);
-    p.mode = CDEM_MODE_DETACHMENT;
-    p.display_interval = 5.0;
-    p.damping_mode = CDEM_DAMPING_CONTACT;
+    cdem_params p = salt_params(CDEM_SALT_BASAL);
     p.calculate_stress = 1;
-    p.salt_layer = CDEM_SALT_BASAL;
-    p.salt_thickness_percent = 30.0;
     cdem_increment_info last;
     cdem_model m;
     fx_cdem_run(p, "test_bc_detachment_salt_load", 500, &last, &m);
