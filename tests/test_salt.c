@@ -12,7 +12,9 @@
  *          shear rate within 20 % of the set viscosity, the plate's force within 20 % of
  *          eta U / H (a plate of wall elements, and one of cover elements), no slip at the
  *          plates (bulk rate within 10 % of U / H) and the area within 1 %;
- *   salt-6 bad input: a negative viscosity or density, a layer as thick as the assembly.
+ *   salt-6 bad input: a negative viscosity or density, a layer as thick as the assembly;
+ *   salt-7 the projection: a salt moving as one body moves as one, its J unchanged, whatever
+ *          velocity gradient the forces' grid saw.
  * The long checks (three rates over two decades, the gravity current) run under
  * CDEM_SALT_VALIDATE=1 (make validate). */
 #include <setjmp.h>
@@ -152,6 +154,62 @@ static void test_salt_forces_conserve_momentum(void **state) {
     if (!(fabs(fx) < 1e-9 * scale * (double)c.s.n && fabs(fy) < 1e-9 * scale * (double)c.s.n))
         fail_msg("net force (%g, %g) N is not zero (largest element force %g N)", fx, fy, scale);
     salt_cell_close(&c);
+}
+
+/* salt-7: the projection moves the salt with the field whose divergence J follows. A salt
+ * moving as one body (every element at the same velocity, no force) while the forces' grid saw
+ * it converge or spread (a velocity gradient L with a divergence, as where the cover's or the
+ * base's velocities sit on the salt's nodes) must move as one body, its J unchanged: moved by
+ * the affine field, which carries that L, the elements next to the salt's edges moved apart
+ * while J did not see it (docs/solver.md 9.5). */
+static void test_salt_projection_moves_with_j(void **state) {
+    (void)state;
+    for (int sign = -1; sign <= 1; sign += 2) {
+        salt_cell c;
+        open_cell(&c, 1.0);
+        cdem_error err;
+        assert_int_equal(cdem_integrator_prime(&c.it, &c.s, &err), CDEM_OK);
+        cdem_salt *salt = &c.it.viscous.salt;
+        const double U = 0.3, V = -0.1, dt = c.it.dt, a = sign * 1e-2;
+        double *x0 = malloc(c.s.n * sizeof *x0), *y0 = malloc(c.s.n * sizeof *y0);
+        assert_non_null(x0);
+        assert_non_null(y0);
+        for (size_t i = 0; i < c.s.n; i++) {
+            x0[i] = c.s.x[i];
+            y0[i] = c.s.y[i];
+            if (!(c.s.flags[i] & CDEM_FLAG_SALT))
+                continue;
+            c.s.vx[i] = U;
+            c.s.vy[i] = V;
+            c.s.fx[i] = c.s.fy[i] = 0.0;
+            salt->lxx[i] = salt->lyy[i] = a;
+            salt->lxy[i] = salt->lyx[i] = 0.0;
+        }
+        cdem_salt_project(salt, &c.s, dt);
+        double moved = 0.0, j_off = 0.0, v_off = 0.0;
+        long n = 0;
+        for (size_t i = 0; i < c.s.n; i++) {
+            if (!(c.s.flags[i] & CDEM_FLAG_SALT))
+                continue;
+            moved = fmax(moved, hypot(c.s.x[i] - x0[i], c.s.y[i] - y0[i]));
+            j_off = fmax(j_off, fabs(c.s.area_ratio[i] - 1.0));
+            v_off = fmax(v_off, hypot(c.s.vx[i] - U, c.s.vy[i] - V));
+            n++;
+        }
+        printf("salt-7: L = %+g I on %ld salt elements: largest extra displacement %.3g m (the "
+               "affine field would move them by up to %.3g m), largest |J - 1| %.3g, largest "
+               "velocity change %.3g m/s (the affine transfer's)\n",
+               a, n, moved, fabs(a) * dt * salt->h, j_off, v_off);
+        assert_true(n > 100);
+        assert_true(v_off > 0.0); /* the velocities did take the affine field's */
+        if (!(moved < 1e-9 * fabs(a) * dt * salt->h))
+            fail_msg("a salt moving as one body moved apart by %g m in a step", moved);
+        if (!(j_off < 1e-12))
+            fail_msg("a salt moving as one body changed its J by %g", j_off);
+        free(x0);
+        free(y0);
+        salt_cell_close(&c);
+    }
 }
 
 /* salt-4: the placement of salt.layer in a built assembly. */
@@ -369,6 +427,7 @@ int main(void) {
         cmocka_unit_test(test_salt_law_kernel),
         cmocka_unit_test(test_salt_viscous_kernel_simple_shear),
         cmocka_unit_test(test_salt_forces_conserve_momentum),
+        cmocka_unit_test(test_salt_projection_moves_with_j),
         cmocka_unit_test(test_salt_placement),
         cmocka_unit_test(test_salt_bad_input),
         cmocka_unit_test(test_salt_couette_short),

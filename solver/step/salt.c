@@ -592,7 +592,7 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
         return;
     const size_t nodes = salt->gnx * salt->gny;
     /* gm, gmx, gmy: the salt's mass and affine (APIC) momentum; gbx, gby: its plain momentum,
-     * whose divergence J follows; gfx: its mass-weighted J */
+     * which moves the salt and whose divergence J follows; gfx: its mass-weighted J */
     double *const arrays[] = {salt->gm, salt->gmx, salt->gmy, salt->gfx, salt->gbx, salt->gby};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
         memset(arrays[k], 0, nodes * sizeof(double));
@@ -623,7 +623,7 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
         if (!(s->flags[i] & CDEM_FLAG_SALT))
             continue;
         stencil_of(salt, s->x[i], s->y[i], &st);
-        double vx = 0.0, vy = 0.0, j = 0.0, w = 0.0, div = 0.0;
+        double vx = 0.0, vy = 0.0, px = 0.0, py = 0.0, j = 0.0, w = 0.0, div = 0.0;
         for (int k = 0; k < 9; k++) {
             const long g = st.node[k];
             if (g < 0 || !(salt->gm[g] > 0.0))
@@ -631,18 +631,23 @@ void cdem_salt_project(cdem_salt *salt, cdem_state *s, double dt) {
             const double inv_m = 1.0 / salt->gm[g];
             vx += st.w[k] * salt->gmx[g] * inv_m;
             vy += st.w[k] * salt->gmy[g] * inv_m;
+            px += st.w[k] * salt->gbx[g] * inv_m;
+            py += st.w[k] * salt->gby[g] * inv_m;
             div += (st.gx[k] * salt->gbx[g] + st.gy[k] * salt->gby[g]) * inv_m;
             j += st.w[k] * salt->gfx[g] * inv_m;
             w += st.w[k];
         }
         if (w > 0.0) {
-            /* the drift moved it with v_half = v - (dt/2) F / m; it moves with the grid */
+            /* the drift moved it with v_half = v - (dt/2) F / m; it moves with the salt's plain
+             * field, whose divergence J follows (the affine one carries the forces' L: moved
+             * by it the salt spread unseen), and takes the affine field's velocity, which keeps
+             * the shear the plain one would average away (docs/solver.md 9.5) */
             const double hvx = s->vx[i] - 0.5 * dt * s->fx[i] / s->mass[i];
             const double hvy = s->vy[i] - 0.5 * dt * s->fy[i] / s->mass[i];
             s->vx[i] = vx / w;
             s->vy[i] = vy / w;
-            s->x[i] += dt * (s->vx[i] - hvx);
-            s->y[i] += dt * (s->vy[i] - hvy);
+            s->x[i] += dt * (px / w - hvx);
+            s->y[i] += dt * (py / w - hvy);
             s->area_ratio[i] *= exp(dt * div);
             s->area_ratio[i] += CDEM_SALT_J_RELAX * (j / w - s->area_ratio[i]);
         }

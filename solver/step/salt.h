@@ -160,13 +160,14 @@ void cdem_salt_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *
  *    (an affine transfer, APIC): a linear field passes unchanged, momentum and angular
  *    momentum are kept, and the element motions the grid cannot see (the null space of the
  *    material points) are removed;
- *  - it is moved as that velocity moves it rather than with its own mid-step velocity
- *    (x += dt (v_grid - v_half)), as a material point is advected by the grid;
- *  - its area ratio follows the divergence of the salt's own velocities on that grid,
- *    J <- J exp(dt div v), the plain (not affine) momentum over the mass of the nodes: the
- *    field the element moves with, so that salt that converges is compressed and its pressure
- *    resists (J following tr L of the forces' grid, whose nodes next to the cover and the base
- *    carry their velocities, let the salt's elements crowd unseen: docs/solver.md 9.5);
+ *  - it is moved by the salt's own velocities on that grid, the plain (not affine) momentum
+ *    over the mass of the nodes, rather than with its own mid-step velocity
+ *    (x += dt (v_plain - v_half)), as a material point is advected by the grid;
+ *  - its area ratio follows the divergence of that same field, J <- J exp(dt div v_plain), so
+ *    that salt that converges is compressed and salt that spreads is dilated, and its pressure
+ *    resists both (J following tr L of the forces' grid, whose nodes next to the cover and the
+ *    base carry their velocities, let the salt's elements crowd unseen; moving them with the
+ *    affine field, which carries that L, spread them by 11 % at rest unseen: docs/solver.md 9.5);
  *  - then relaxed by CDEM_SALT_J_RELAX toward the grid's mass-weighted mean of the salt's J
  *    around it, which keeps the salt's area (sum m J) exactly.
  * Without them the elements drift inside the grid's cells and their J random-walk apart: the
