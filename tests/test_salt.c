@@ -197,7 +197,7 @@ static void test_salt_projection_moves_with_j(void **state) {
             n++;
         }
         printf("salt-7: L = %+g I on %ld salt elements: largest extra displacement %.3g m (the "
-               "affine field would move them by up to %.3g m), largest |J - 1| %.3g, largest "
+               "affine field's scale a dt h: %.3g m), largest |J - 1| %.3g, largest "
                "velocity change %.3g m/s (the affine transfer's)\n",
                a, n, moved, fabs(a) * dt * salt->h, j_off, v_off);
         assert_true(n > 100);
