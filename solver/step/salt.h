@@ -6,8 +6,9 @@
  * its area ratio J (p = K (1/J - 1), no tension); a force evaluation does P2G (the salt, then
  * the non-salt elements that share its nodes: the no-slip contacts), the gradient and
  * sigma = -p I + 2 eta D', the node forces and G2P, and the salt's pairs with the law of
- * common/laws/law_salt.h; after a step J follows tr L and the salt is projected back onto the
- * grid (cdem_salt_project). The formulas and measurements: docs/solver.md, section 9.
+ * common/laws/law_salt.h; after a step the salt is projected back onto a grid of its own
+ * (cdem_salt_project), which moves it and whose divergence J follows. The formulas and
+ * measurements: docs/solver.md, section 9.
  * Determinism: serial sums in element or pair order, the same bits for any thread count.
  * Lifetime: the grid, the scratch and the pair list are sized at list builds, never in a step.
  * Ownership: cdem_salt owns its scratch, never the state. Units: SI (m, s, kg per metre, N per
