@@ -15,7 +15,9 @@ OUT=$1
 mkdir -p "$OUT"
 
 # name | set (keep200 or default) | overrides, applied to the biaxial and the repose runs
-# alike (the biaxial test has no gravity, so a gravity override leaves it as it is)
+# alike (the biaxial test has no gravity, so a gravity override leaves it as it is) | "plain"
+# when the overrides change the collapse's test set-up, not the material: the biaxial tests
+# then run without them
 variants() {
     echo "6C as in results.md (the paper's parameters)|keep200|"
     echo "smooth base (assembly.base_spacing = 1)|keep200|-s assembly.base_spacing=1"
@@ -27,19 +29,24 @@ variants() {
     echo "contact dashpots instead of the drag (damping_mode = contact)|keep200|-s physics.damping_mode=contact"
     echo "gravity 24.5 m/s2 (2.5 x)|keep200|-s physics.gravity=24.525"
     echo "walls and base of the biaxial test (wall friction and C0 = 0)|keep200|-s material.wall_friction=0 -s material.wall_cohesion=0"
+    echo "equilibration 358 s (6A's 800 s in 6C's time, 800 / sqrt 5), runtime 6218 s|keep200|-s time.equilibration=358 -s time.runtime=6218|plain"
+    echo "equilibration 400 s (the paper's usual for a run other than the biaxial), runtime 6260 s|keep200|-s time.equilibration=400 -s time.runtime=6260|plain"
     echo "6A as in results.md|default|"
     echo "6A, gravity 1.962 m/s2 (1/5)|default|-s physics.gravity=1.962"
     echo "6A, walls and base of the biaxial test (wall friction and C0 = 0)|default|-s material.wall_friction=0 -s material.wall_cohesion=0"
+    echo "6A as 6C's copy five times larger (gravity / 5, times x 5, C0 5e7 N; phi: 6A's)|default|-s physics.gravity=1.962 -s time.equilibration=4000 -s time.runtime=33300 -s time.display_interval=300 -s material.element_cohesion=5e7 -s material.wall_cohesion=5e7|plain"
 }
 biax_ini() { case $1 in keep200) echo biaxial-200m-keep.ini ;; *) echo biaxial.ini ;; esac; }
 repose_ini() { case $1 in keep200) echo repose-200m-keep.ini ;; *) echo repose.ini ;; esac; }
 
 # the commands of every run not yet made, one per line, run JOBS at a time
-variants | while IFS='|' read -r name set over; do
+variants | while IFS='|' read -r name set over plain; do
     d="$OUT/$(slug "$name")"
     mkdir -p "$d"
+    biax="$over"
+    [ "$plain" = plain ] && biax=""
     for p in 0 5 10 15 20; do
-        done_run "$d/b$p.h5" || echo "$RUN --force -q $(biax_ini "$set") $over -s boundary.confining_pressure=${p}e6 -o $d/b$p.h5 > $d/b$p.log 2>&1"
+        done_run "$d/b$p.h5" || echo "$RUN --force -q $(biax_ini "$set") $biax -s boundary.confining_pressure=${p}e6 -o $d/b$p.h5 > $d/b$p.log 2>&1"
     done
     for s in 1 2 3; do
         done_run "$d/repose$s.h5" || echo "$RUN --force -q $(repose_ini "$set") $over -s assembly.seed=$s -o $d/repose$s.h5 > $d/repose$s.log 2>&1"
@@ -59,7 +66,7 @@ echo "repose angle within 5 deg of phi. Rows starting 6A: the default assembly (
 echo
 echo "| variant | C (MPa) | phi (deg) | repose, seeds 1 / 2 / 3 (deg) | mean | mean - phi |"
 echo "|---|---|---|---|---|---|"
-variants | while IFS='|' read -r name set over; do
+variants | while IFS='|' read -r name set over plain; do
     d="$OUT/$(slug "$name")"
     "$STRAIN" mohr "$d"/b0.h5 "$d"/b5.h5 "$d"/b10.h5 "$d"/b15.h5 "$d"/b20.h5 > "$d/mohr.txt" 2>&1 || true
     c=$(sed -n 's/^cohesion = \([0-9.]*\) +- \([0-9.]*\) MPa.*/\1 ± \2/p' "$d/mohr.txt")
