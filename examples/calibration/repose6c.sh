@@ -39,7 +39,17 @@ variants() {
 biax_ini() { case $1 in keep200) echo biaxial-200m-keep.ini ;; *) echo biaxial.ini ;; esac; }
 repose_ini() { case $1 in keep200) echo repose-200m-keep.ini ;; *) echo repose.ini ;; esac; }
 
+# More packings of 6C and of 6A as in results.md (seeds 1-3 are those of the first rows):
+# how often one collapse of each lands within 5 deg of its phi.
+PACKINGS="4 5 6 7 8 9 10 11 12"
+first_dir() { case $1 in keep200) slug "6C as in results.md (the paper's parameters)" ;; *) slug "6A as in results.md" ;; esac; }
+# run file of packing $2 of set $1
+packing_file() {
+    case $2 in 1 | 2 | 3) echo "$OUT/$(first_dir "$1")/repose$2.h5" ;; *) echo "$OUT/packings-$1/repose$2.h5" ;; esac
+}
+
 # the commands of every run not yet made, one per line, run JOBS at a time
+{
 variants | while IFS='|' read -r name set over plain; do
     d="$OUT/$(slug "$name")"
     mkdir -p "$d"
@@ -51,7 +61,15 @@ variants | while IFS='|' read -r name set over plain; do
     for s in 1 2 3; do
         done_run "$d/repose$s.h5" || echo "$RUN --force -q $(repose_ini "$set") $over -s assembly.seed=$s -o $d/repose$s.h5 > $d/repose$s.log 2>&1"
     done
-done > "$OUT/commands.txt"
+done
+for set in keep200 default; do
+    mkdir -p "$OUT/packings-$set"
+    for s in $PACKINGS; do
+        f=$(packing_file $set $s)
+        done_run "$f" || echo "$RUN --force -q $(repose_ini $set) -s assembly.seed=$s -o $f > ${f%.h5}.log 2>&1"
+    done
+done
+} > "$OUT/commands.txt"
 run_commands "$OUT/commands.txt"
 
 echo "# Fig. 6C: what sets the slope (README.md, \"Where we still disagree: 6C\")"
@@ -82,4 +100,31 @@ variants | while IFS='|' read -r name set over plain; do
     stats=$(for s in 1 2 3; do sed -n 's/^angle of repose = \([0-9.]*\) deg.*/\1/p' "$d/repose$s.txt"; done |
         awk -v phi="${phi:-0}" '{ t += $1; n++ } END { if (n) printf "%.1f | %+.1f", t / n, t / n - phi; else printf "? | ?" }')
     echo "| $name | ${c:-?} | ${phi:-?} | $angles | $stats |"
+done
+
+echo
+echo "Twelve packings (assembly.seed 1-12) of each assembly as in results.md: the angle of each"
+echo "collapse, their mean and standard deviation, the mean's distance from phi with the standard"
+echo "errors of the mean and of phi combined, and how many land within 5 deg of phi (the paper shows"
+echo "one collapse of each)."
+echo
+echo "| assembly | phi (deg) | repose, seeds 1-12 (deg) | mean ± sd | mean - phi ± its standard error | within 5 deg of phi |"
+echo "|---|---|---|---|---|---|"
+for set in keep200 default; do
+    phi=$(sed -n 's/.*friction angle = \([0-9.]*\) +- [0-9.]* deg.*/\1/p' "$OUT/$(first_dir $set)/mohr.txt")
+    phi_se=$(sed -n 's/.*friction angle = [0-9.]* +- \([0-9.]*\) deg.*/\1/p' "$OUT/$(first_dir $set)/mohr.txt")
+    list=""
+    for s in 1 2 3 $PACKINGS; do
+        f=$(packing_file $set $s)
+        "$STRAIN" repose "$f" > "${f%.h5}.txt" 2>/dev/null || true
+        a=$(sed -n 's/^angle of repose = \([0-9.]*\) deg.*/\1/p' "${f%.h5}.txt")
+        list="$list${list:+ }${a:-nan}"
+    done
+    stats=$(echo "$list" | tr ' ' '\n' | awk -v phi="$phi" -v phi_se="$phi_se" '$1 != "nan" { x[n++] = $1; t += $1 }
+        END { m = t / n; for (i = 0; i < n; i++) v += (x[i] - m) ^ 2; k = 0
+              for (i = 0; i < n; i++) if (x[i] - phi <= 5 && phi - x[i] <= 5) k++
+              sd = sqrt(v / (n - 1))
+              printf "%.1f ± %.1f | %+.1f ± %.1f | %d of %d", m, sd, m - phi, sqrt(sd * sd / n + phi_se * phi_se), k, n }')
+    name=$([ $set = keep200 ] && echo "6C (200 m, Table 1 constants)" || echo "6A (default)")
+    echo "| $name | $phi | $(echo "$list" | sed 's/ / \/ /g') | $stats |"
 done
