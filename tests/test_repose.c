@@ -372,6 +372,103 @@ static void test_repose_command_says_when_moving_or_poor(void **state) {
     }
 }
 
+/* The spread of several runs' angles: mean, sample standard deviation, standard error and
+ * range, runs without a measure (NaN) left out. */
+static void test_repose_spread_of_angles(void **state) {
+    (void)state;
+    const double angles[4] = {30.0, NAN, 34.0, 32.0};
+    cdem_repose_spread sp;
+    cdem_repose_spread_of(angles, 4, &sp);
+    assert_int_equal(sp.n, 3);
+    assert_near(sp.mean_deg, 32.0, 1e-12);
+    assert_near(sp.sd_deg, 2.0, 1e-12); /* sqrt((4 + 0 + 4) / 2) */
+    assert_near(sp.se_deg, 2.0 / sqrt(3.0), 1e-12);
+    assert_near(sp.min_deg, 30.0, 0);
+    assert_near(sp.max_deg, 34.0, 0);
+    cdem_repose_spread_of(angles, 1, &sp); /* one run: no spread */
+    assert_int_equal(sp.n, 1);
+    assert_near(sp.mean_deg, 30.0, 0);
+    assert_true(isnan(sp.sd_deg) && isnan(sp.se_deg));
+    cdem_repose_spread_of(angles + 1, 1, &sp); /* none measured */
+    assert_int_equal(sp.n, 0);
+    assert_true(isnan(sp.mean_deg) && isnan(sp.min_deg));
+}
+
+/* The angle printed first by a repose report. */
+static double reported_angle(const char *out) {
+    const char *p = strstr(out, "angle of repose = ");
+    assert_non_null(p);
+    return strtod(p + strlen("angle of repose = "), NULL);
+}
+
+/* Several runs of one material: each reported under its name, then their mean, standard
+ * deviation and range, how many fit well and settled; a run that cannot be read is named on
+ * stderr, left out of the spread and makes the exit status 1; -o takes one run. */
+static void test_repose_command_several_runs(void **state) {
+    (void)state;
+    char h5a[512], h5b[512], missing[512];
+    scratch_path(h5a, sizeof h5a, "repose-packing-a.h5");
+    scratch_path(h5b, sizeof h5b, "repose-packing-b.h5");
+    scratch_path(missing, sizeof missing, "repose-packing-missing.h5");
+    remove(missing);
+    double stopped[9] = {0, 50, 100, 150, 200, 200, 200, 200, 200};
+    cdem_state straight = {0}, convex = {0};
+    make_pile(&straight, wedge_surface, 3);
+    make_pile(&convex, convex_surface, 5);
+    write_collapse(h5a, &straight, stopped, 9);
+    write_collapse(h5b, &convex, stopped, 9);
+    static char out[32768];
+    char errs[4096];
+    char *one_a[] = {"repose", h5a}, *one_b[] = {"repose", h5b};
+    assert_int_equal(run_repose_captured(one_a, 2, out, sizeof out, errs, sizeof errs), 0);
+    const double a = reported_angle(out);
+    assert_int_equal(run_repose_captured(one_b, 2, out, sizeof out, errs, sizeof errs), 0);
+    const double b = reported_angle(out);
+    assert_true(fabs(a - b) > 1.0); /* two different slopes, so the spread is not zero */
+
+    char *both[] = {"repose", h5a, h5b};
+    assert_int_equal(run_repose_captured(both, 3, out, sizeof out, errs, sizeof errs), 0);
+    char expect[1024];
+    snprintf(expect, sizeof expect, "run %s:\nangle of repose = ", h5a);
+    assert_non_null(strstr(out, expect));
+    snprintf(expect, sizeof expect, "\nrun %s:\nangle of repose = ", h5b);
+    assert_non_null(strstr(out, expect));
+    const char *sum = strstr(out, "over 2 runs: angle of repose ");
+    assert_non_null(sum);
+    assert_near(strtod(sum + strlen("over 2 runs: angle of repose "), NULL), 0.5 * (a + b), 0.006);
+    /* a and b as printed (2 decimals): the spread's numbers agree to within their rounding */
+    const char *sd = strstr(sum, "standard deviation ");
+    assert_non_null(sd);
+    assert_near(strtod(sd + strlen("standard deviation "), NULL), fabs(a - b) / sqrt(2.0), 0.011);
+    const char *se = strstr(sum, "standard error of the mean ");
+    assert_non_null(se);
+    assert_near(strtod(se + strlen("standard error of the mean "), NULL), fabs(a - b) / 2.0, 0.011);
+    assert_non_null(strstr(sum, "good fits: 1 of 2 runs; settled: 2 of 2 runs"));
+
+    char *with_missing[] = {"repose", h5a, missing, h5b};
+    assert_int_equal(run_repose_captured(with_missing, 4, out, sizeof out, errs, sizeof errs), 1);
+    assert_non_null(strstr(out, "over 3 runs: angle of repose "));
+    assert_non_null(strstr(out, "not measured: 1 of 3 runs"));
+    snprintf(expect, sizeof expect, "cdem-strain repose: %s: cannot open", missing);
+    assert_non_null(strstr(errs, expect));
+
+    char png[512];
+    scratch_path(png, sizeof png, "repose-packings.png");
+    char *drawn[] = {"repose", h5a, h5b, "-o", png};
+    assert_int_equal(run_repose_captured(drawn, 5, out, sizeof out, errs, sizeof errs), 2);
+    assert_non_null(strstr(errs, "-o draws one run: give one RUN.h5 with -o"));
+    assert_int_equal(access(png, F_OK), -1);
+    cdem_state_free(&straight);
+    cdem_state_free(&convex);
+    const char *names[6] = {"repose-packing-a.h5",  "repose-packing-a.xmf", "repose-packing-b.h5",
+                            "repose-packing-b.xmf", "repose-out.txt",       "repose-err.txt"};
+    for (int k = 0; k < 6; k++) {
+        char path[512];
+        scratch_path(path, sizeof path, names[k]);
+        remove(path);
+    }
+}
+
 /* fontconfig, which cairo's text uses, keeps a process-lifetime configuration that only
  * FcFini releases (as in test_render.c). LeakSanitizer reads this hook in the asan build. */
 const char *__lsan_default_suppressions(void);
@@ -389,6 +486,8 @@ int main(void) {
         cmocka_unit_test(test_repose_curved_slope_is_a_poor_fit),
         cmocka_unit_test(test_repose_motion_between_increments),
         cmocka_unit_test(test_repose_command_says_when_moving_or_poor),
+        cmocka_unit_test(test_repose_spread_of_angles),
+        cmocka_unit_test(test_repose_command_several_runs),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     cairo_debug_reset_static_data(); /* drop cairo's font caches before LeakSanitizer looks */

@@ -1,7 +1,8 @@
 /* cmd_plot: what the calibration and evolution plot subcommands of cdem-strain share:
  *   plot-series RUN.h5 [RUN2.h5 ...] --y COLUMN [--x COLUMN] -o OUT    (cmd_plot_series.c)
  *   mohr RUN1.h5 RUN2.h5 ... | --data FILE  [-o OUT]   (Mohr-Coulomb fit; cmd_mohr.c)
- *   repose RUN.h5 [--increment K] [-o OUT]             (angle of repose; cmd_repose.c)
+ *   repose RUN.h5 ... [--increment K] [-o OUT]         (angle of repose, and the spread
+ *                                                       of several packings; cmd_repose.c)
  *   voids RUN.h5 [--increment K] [--window M]          (open space and cliffs; cmd_voids.c)
  * one option parser (each command accepts the options its help lists), the time-series
  * columns, and reading a run's series or one increment. The commands return the process

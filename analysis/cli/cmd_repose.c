@@ -12,7 +12,7 @@
 
 static const char *const repose_forms[] = {
     "RUN.h5 [--increment K|last|equil|first] [-o OUT.png|.pdf|.svg] [--width N] [--height N]",
-    NULL};
+    "RUN1.h5 RUN2.h5 ... [--increment K|last|equil|first]", NULL};
 static const cdem_cli_option repose_options[] = {
     {"--increment", "K|last|equil|first", "the increment (default last)"},
     {"-o, --output", "OUT.png|.pdf|.svg", "the free surface with the fitted flanks"},
@@ -26,7 +26,10 @@ static const cdem_cli_help help = {
              "on each flank, with the fit's quality (a curved, rough or uncertain slope is a "
              "poor fit) and whether the slope has settled (at rest in the last increment, its "
              "angle within 2 deg over the last third of the run); both warnings also go to "
-             "stderr (docs/rendering.md, \"cdem-strain repose\").",
+             "stderr. One collapse's angle depends on its packing (a standard deviation of "
+             "2-3 deg): given several runs of one material (other assembly.seed), it reports "
+             "each and then their mean, standard deviation, standard error and range, the "
+             "material's angle of repose (docs/rendering.md, \"cdem-strain repose\").",
     .options = repose_options,
 };
 
@@ -225,40 +228,92 @@ static cdem_status judge_settling(cdem_h5_reader *r, const char *file, size_t k,
     return CDEM_OK;
 }
 
-int cdem_cmd_plot_repose(int argc, char **argv) {
-    cdem_plot_args a = {.cmd = "repose", .help = &help};
-    int rc = cdem_cmd_plot_parse_one(argc, argv, &a);
-    if (rc)
-        return rc;
-    cdem_error err;
-    cdem_render_format fmt;
-    if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
-        return cdem_cmd_fail(a.cmd, NULL, &err);
+/* Measures one run (file, the increment of a) and prints its report: its angle (NaN when it
+ * cannot be measured), whether a flank is a poor fit and whether the slope still moves; the
+ * picture when a->out is given. */
+static cdem_status measure_run(const cdem_plot_args *a, const char *file, double *angle, int *poor,
+                               int *moving, cdem_error *err) {
+    cdem_plot_args one = *a;
+    one.files[0] = file;
+    one.n_files = 1;
     cdem_h5_reader *r;
     cdem_state s = {0};
     cdem_increment_info info;
     cdem_repose_result res;
-    cdem_status st = cdem_cmd_plot_open_increment(&a, &r, &s, &info, &err);
+    *angle = NAN;
+    *poor = *moving = 0;
+    cdem_status st = cdem_cmd_plot_open_increment(&one, &r, &s, &info, err);
     cdem_params prm;
-    if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &err) == CDEM_OK &&
+    cdem_error ignored;
+    if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &ignored) == CDEM_OK &&
         prm.mode != CDEM_MODE_REPOSE)
         fprintf(stderr, "cdem-strain repose: note: %s is a '%s' run, not a repose-collapse run\n",
-                a.files[0], cdem_mode_name(prm.mode));
+                file, cdem_mode_name(prm.mode));
     if (st == CDEM_OK)
-        st = cdem_repose_measure(&s, &res, &err);
-    int moving = 0;
+        st = cdem_repose_measure(&s, &res, err);
     if (st == CDEM_OK) {
-        print_measure(a.files[0], &res, &info);
+        print_measure(file, &res, &info);
+        *angle = res.angle_deg;
+        *poor = res.poor != 0;
         size_t k;
-        st = cdem_h5_reader_find_increment(r, a.increment ? a.increment : "last", &k, &err);
+        st = cdem_h5_reader_find_increment(r, a->increment ? a->increment : "last", &k, err);
         if (st == CDEM_OK)
-            st = judge_settling(r, a.files[0], k, &s, &info, &res, &moving, &err);
+            st = judge_settling(r, file, k, &s, &info, &res, moving, err);
     }
-    if (st == CDEM_OK && a.out)
-        st = repose_figure(&a, &s, (int)info.number, &res, moving, &err);
+    if (st == CDEM_OK && a->out)
+        st = repose_figure(a, &s, (int)info.number, &res, *moving, err);
     cdem_state_free(&s);
     cdem_h5_reader_close(r);
-    return st == CDEM_OK ? 0 : cdem_cmd_fail(a.cmd, a.files[0], &err);
+    return st;
+}
+
+/* The spread of the angles of several runs (packings of one material): a material's angle
+ * of repose is their mean, not one collapse's. */
+static void print_spread(const double *angles, const int *poor, const int *moving, size_t n) {
+    cdem_repose_spread sp;
+    cdem_repose_spread_of(angles, n, &sp);
+    size_t good = 0, settled = 0;
+    for (size_t k = 0; k < n; k++)
+        if (isfinite(angles[k])) {
+            good += !poor[k];
+            settled += !moving[k];
+        }
+    printf("\nover %zu runs: angle of repose %.2f deg (mean)", n, sp.mean_deg);
+    if (sp.n >= 2)
+        printf(", standard deviation %.2f deg, standard error of the mean %.2f deg, range %.2f "
+               "to %.2f deg",
+               sp.sd_deg, sp.se_deg, sp.min_deg, sp.max_deg);
+    printf("\n  good fits: %zu of %zu runs; settled: %zu of %zu runs\n", good, sp.n, settled, sp.n);
+    if (sp.n < n)
+        printf("  not measured: %zu of %zu runs (their errors are on stderr)\n", n - sp.n, n);
+}
+
+int cdem_cmd_plot_repose(int argc, char **argv) {
+    cdem_plot_args a = {.cmd = "repose", .help = &help};
+    int rc = cdem_cmd_plot_parse(argc, argv, &a);
+    if (rc)
+        return rc;
+    if (a.n_files == 0)
+        return cdem_cmd_usage(a.help, "need a run file (RUN.h5), or several runs of one material");
+    if (a.n_files > 1 && a.out)
+        return cdem_cmd_usage(a.help, "-o draws one run: give one RUN.h5 with -o");
+    cdem_error err;
+    cdem_render_format fmt;
+    if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
+        return cdem_cmd_fail(a.cmd, NULL, &err);
+    double angles[CDEM_PLOT_MAX_FILES];
+    int poor[CDEM_PLOT_MAX_FILES], moving[CDEM_PLOT_MAX_FILES];
+    rc = 0;
+    for (size_t k = 0; k < a.n_files; k++) {
+        if (a.n_files > 1)
+            printf("%srun %s:\n", k ? "\n" : "", a.files[k]);
+        fflush(stdout); /* the report and a failure's message in the order they happen */
+        if (measure_run(&a, a.files[k], &angles[k], &poor[k], &moving[k], &err) != CDEM_OK)
+            rc = cdem_cmd_fail(a.cmd, a.files[k], &err);
+    }
+    if (a.n_files > 1)
+        print_spread(angles, poor, moving, a.n_files);
+    return rc;
 }
 
 const cdem_command cdem_command_repose = {"repose", "angle of repose of the free surface", &help,

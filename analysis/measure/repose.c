@@ -234,3 +234,29 @@ void cdem_repose_settled(const double *angles, size_t n, const cdem_repose_motio
     out->at_rest = last && r_max > 0 && last->mean < CDEM_REPOSE_REST_FRACTION * r_max &&
                    last->n_matched == last->n_before; /* and none left the model */
 }
+
+void cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out) {
+    memset(out, 0, sizeof *out);
+    double sum = 0, lo = INFINITY, hi = -INFINITY;
+    for (size_t k = 0; k < n; k++)
+        if (isfinite(angles[k])) {
+            sum += angles[k];
+            lo = fmin(lo, angles[k]);
+            hi = fmax(hi, angles[k]);
+            out->n++;
+        }
+    out->mean_deg = out->min_deg = out->max_deg = out->sd_deg = out->se_deg = NAN;
+    if (!out->n)
+        return;
+    out->mean_deg = sum / (double)out->n;
+    out->min_deg = lo;
+    out->max_deg = hi;
+    if (out->n < 2)
+        return;
+    double ss = 0; /* two passes: the squares about the mean, not sum x^2 - n mean^2 */
+    for (size_t k = 0; k < n; k++)
+        if (isfinite(angles[k]))
+            ss += (angles[k] - out->mean_deg) * (angles[k] - out->mean_deg);
+    out->sd_deg = sqrt(ss / (double)(out->n - 1));
+    out->se_deg = out->sd_deg / sqrt((double)out->n);
+}

@@ -28,6 +28,11 @@
  * largest radius in the last increment and none left the model in it, and its angle is
  * stable when it varies by at most 2 degrees over the increments given (cdem-strain repose
  * gives those of the last third of the run).
+ *
+ * Spread: one collapse's angle depends on its packing (examples/calibration/repose-6c.md:
+ * a standard deviation of 2-3 degrees over twelve packings), so a material's angle of
+ * repose is the mean over several packings; cdem_repose_spread_of summarises the angles
+ * of such runs (mean, sample standard deviation, the mean's standard error, range).
  * Ownership: the caller owns the states and arrays. Thread safety: pure functions; scratch
  * memory is allocated per call. Units: m; angles in degrees. */
 #ifndef CDEM_REPOSE_H
@@ -114,5 +119,17 @@ typedef struct {
  * of its last increment; r_max is the largest free radius (m). */
 void cdem_repose_settled(const double *angles, size_t n, const cdem_repose_motion *last,
                          double r_max, cdem_repose_settling *out);
+
+/* The angles of repose of several runs of one material (its packings). */
+typedef struct {
+    size_t n;                /* angles summarised (the finite ones given) */
+    double mean_deg;         /* their mean; NaN when n = 0 */
+    double sd_deg;           /* sample standard deviation (n - 1); NaN when n < 2 */
+    double se_deg;           /* standard error of the mean, sd / sqrt(n); NaN when n < 2 */
+    double min_deg, max_deg; /* range; NaN when n = 0 */
+} cdem_repose_spread;
+
+/* Summarises angles[0..n) (degrees; NaN entries, runs without a measure, are left out). */
+void cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out);
 
 #endif

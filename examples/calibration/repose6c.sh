@@ -113,18 +113,29 @@ echo "|---|---|---|---|---|---|"
 for set in keep200 default; do
     phi=$(sed -n 's/.*friction angle = \([0-9.]*\) +- [0-9.]* deg.*/\1/p' "$OUT/$(first_dir $set)/mohr.txt")
     phi_se=$(sed -n 's/.*friction angle = [0-9.]* +- \([0-9.]*\) deg.*/\1/p' "$OUT/$(first_dir $set)/mohr.txt")
-    list=""
-    for s in 1 2 3 $PACKINGS; do
-        f=$(packing_file $set $s)
-        "$STRAIN" repose "$f" > "${f%.h5}.txt" 2>/dev/null || true
-        a=$(sed -n 's/^angle of repose = \([0-9.]*\) deg.*/\1/p' "${f%.h5}.txt")
-        list="$list${list:+ }${a:-nan}"
-    done
-    stats=$(echo "$list" | tr ' ' '\n' | awk -v phi="$phi" -v phi_se="$phi_se" '$1 != "nan" { x[n++] = $1; t += $1 }
-        END { m = t / n; for (i = 0; i < n; i++) v += (x[i] - m) ^ 2; k = 0
-              for (i = 0; i < n; i++) if (x[i] - phi <= 5 && phi - x[i] <= 5) k++
-              sd = sqrt(v / (n - 1))
-              printf "%.1f ± %.1f | %+.1f ± %.1f | %d of %d", m, sd, m - phi, sqrt(sd * sd / n + phi_se * phi_se), k, n }')
+    files=""
+    for s in 1 2 3 $PACKINGS; do files="$files $(packing_file $set $s)"; done
+    # the spread as cdem-strain repose gives it for several runs of one material
+    # shellcheck disable=SC2086
+    "$STRAIN" repose $files > "$OUT/packings-$set/spread.txt" 2>/dev/null || true
+    list=$(sed -n 's/^angle of repose = \([0-9.]*\) deg.*/\1/p' "$OUT/packings-$set/spread.txt" | tr '\n' ' ')
+    line=$(grep "^over " "$OUT/packings-$set/spread.txt")
+    mean=$(echo "$line" | sed -n 's/.*angle of repose \([0-9.]*\) deg (mean).*/\1/p')
+    sd=$(echo "$line" | sed -n 's/.*standard deviation \([0-9.]*\) deg.*/\1/p')
+    se=$(echo "$line" | sed -n 's/.*standard error of the mean \([0-9.]*\) deg.*/\1/p')
+    stats=$(echo "$list" | tr ' ' '\n' | awk -v phi="$phi" -v phi_se="$phi_se" -v m="$mean" -v se="$se" '
+        NF { n++; if ($1 - phi <= 5 && phi - $1 <= 5) k++ }
+        END { printf "%+.1f ± %.1f | %d of %d", m - phi, sqrt(se * se + phi_se * phi_se), k, n }')
     name=$([ $set = keep200 ] && echo "6C (200 m, Table 1 constants)" || echo "6A (default)")
-    echo "| $name | $phi | $(echo "$list" | sed 's/ / \/ /g') | $stats |"
+    printf '| %s | %s | %s | %.1f ± %.1f | %s |\n' "$name" "$phi" "$(echo $list | sed 's/ / \/ /g')" "$mean" "$sd" "$stats"
+done
+echo
+echo "The spreads as \`cdem-strain repose\` prints them for the twelve runs of each:"
+for set in keep200 default; do
+    echo
+    echo "$([ $set = keep200 ] && echo 6C || echo 6A):"
+    echo
+    echo '```'
+    sed -n '/^over /,$p' "$OUT/packings-$set/spread.txt"
+    echo '```'
 done
