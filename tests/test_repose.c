@@ -452,6 +452,10 @@ static void test_repose_command_several_runs(void **state) {
     snprintf(expect, sizeof expect, "cdem-strain repose: %s: cannot open", missing);
     assert_non_null(strstr(errs, expect));
 
+    char *none[] = {"repose", missing, missing};
+    assert_int_equal(run_repose_captured(none, 3, out, sizeof out, errs, sizeof errs), 1);
+    assert_non_null(strstr(out, "over 2 runs: none measured"));
+
     char png[512];
     scratch_path(png, sizeof png, "repose-packings.png");
     char *drawn[] = {"repose", h5a, h5b, "-o", png};

@@ -278,6 +278,10 @@ static void print_spread(const double *angles, const int *poor, const int *movin
             good += !poor[k];
             settled += !moving[k];
         }
+    if (!sp.n) {
+        printf("\nover %zu runs: none measured (their errors are on stderr)\n", n);
+        return;
+    }
     printf("\nover %zu runs: angle of repose %.2f deg (mean)", n, sp.mean_deg);
     if (sp.n >= 2)
         printf(", standard deviation %.2f deg, standard error of the mean %.2f deg, range %.2f "
@@ -308,8 +312,10 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
         if (a.n_files > 1)
             printf("%srun %s:\n", k ? "\n" : "", a.files[k]);
         fflush(stdout); /* the report and a failure's message in the order they happen */
-        if (measure_run(&a, a.files[k], &angles[k], &poor[k], &moving[k], &err) != CDEM_OK)
+        if (measure_run(&a, a.files[k], &angles[k], &poor[k], &moving[k], &err) != CDEM_OK) {
+            angles[k] = NAN; /* a run whose report failed half-way is not counted either */
             rc = cdem_cmd_fail(a.cmd, a.files[k], &err);
+        }
     }
     if (a.n_files > 1)
         print_spread(angles, poor, moving, a.n_files);
