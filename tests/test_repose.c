@@ -378,18 +378,19 @@ static void test_repose_spread_of_angles(void **state) {
     (void)state;
     const double angles[4] = {30.0, NAN, 34.0, 32.0};
     cdem_repose_spread sp;
-    cdem_repose_spread_of(angles, 4, &sp);
+    cdem_error err;
+    assert_int_equal(cdem_repose_spread_of(angles, 4, &sp, &err), CDEM_OK);
     assert_int_equal(sp.n, 3);
     assert_near(sp.mean_deg, 32.0, 1e-12);
     assert_near(sp.sd_deg, 2.0, 1e-12); /* sqrt((4 + 0 + 4) / 2) */
     assert_near(sp.se_deg, 2.0 / sqrt(3.0), 1e-12);
     assert_near(sp.min_deg, 30.0, 0);
     assert_near(sp.max_deg, 34.0, 0);
-    cdem_repose_spread_of(angles, 1, &sp); /* one run: no spread */
+    assert_int_equal(cdem_repose_spread_of(angles, 1, &sp, &err), CDEM_OK); /* one run */
     assert_int_equal(sp.n, 1);
     assert_near(sp.mean_deg, 30.0, 0);
     assert_true(isnan(sp.sd_deg) && isnan(sp.se_deg));
-    cdem_repose_spread_of(angles + 1, 1, &sp); /* none measured */
+    assert_int_equal(cdem_repose_spread_of(angles + 1, 1, &sp, &err), CDEM_OK); /* none */
     assert_int_equal(sp.n, 0);
     assert_true(isnan(sp.mean_deg) && isnan(sp.min_deg));
 }

@@ -269,9 +269,10 @@ static cdem_status measure_run(const cdem_plot_args *a, const char *file, double
 
 /* The spread of the angles of several runs (packings of one material): a material's angle
  * of repose is their mean, not one collapse's. */
-static void print_spread(const double *angles, const int *poor, const int *moving, size_t n) {
+static cdem_status print_spread(const double *angles, const int *poor, const int *moving, size_t n,
+                                cdem_error *err) {
     cdem_repose_spread sp;
-    cdem_repose_spread_of(angles, n, &sp);
+    CDEM_TRY(cdem_repose_spread_of(angles, n, &sp, err));
     size_t good = 0, settled = 0;
     for (size_t k = 0; k < n; k++)
         if (isfinite(angles[k])) {
@@ -280,7 +281,7 @@ static void print_spread(const double *angles, const int *poor, const int *movin
         }
     if (!sp.n) {
         printf("\nover %zu runs: none measured (their errors are on stderr)\n", n);
-        return;
+        return CDEM_OK;
     }
     printf("\nover %zu runs: angle of repose %.2f deg (mean)", n, sp.mean_deg);
     if (sp.n >= 2)
@@ -290,6 +291,7 @@ static void print_spread(const double *angles, const int *poor, const int *movin
     printf("\n  good fits: %zu of %zu runs; settled: %zu of %zu runs\n", good, sp.n, settled, sp.n);
     if (sp.n < n)
         printf("  not measured: %zu of %zu runs (their errors are on stderr)\n", n - sp.n, n);
+    return CDEM_OK;
 }
 
 int cdem_cmd_plot_repose(int argc, char **argv) {
@@ -317,8 +319,8 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
             rc = cdem_cmd_fail(a.cmd, a.files[k], &err);
         }
     }
-    if (a.n_files > 1)
-        print_spread(angles, poor, moving, a.n_files);
+    if (a.n_files > 1 && print_spread(angles, poor, moving, a.n_files, &err) != CDEM_OK)
+        rc = cdem_cmd_fail(a.cmd, NULL, &err);
     return rc;
 }
 

@@ -4,6 +4,7 @@
 
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_fit.h>
+#include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -235,28 +236,24 @@ void cdem_repose_settled(const double *angles, size_t n, const cdem_repose_motio
                    last->n_matched == last->n_before; /* and none left the model */
 }
 
-void cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out) {
+cdem_status cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out,
+                                  cdem_error *err) {
     memset(out, 0, sizeof *out);
-    double sum = 0, lo = INFINITY, hi = -INFINITY;
-    for (size_t k = 0; k < n; k++)
-        if (isfinite(angles[k])) {
-            sum += angles[k];
-            lo = fmin(lo, angles[k]);
-            hi = fmax(hi, angles[k]);
-            out->n++;
-        }
     out->mean_deg = out->min_deg = out->max_deg = out->sd_deg = out->se_deg = NAN;
-    if (!out->n)
-        return;
-    out->mean_deg = sum / (double)out->n;
-    out->min_deg = lo;
-    out->max_deg = hi;
-    if (out->n < 2)
-        return;
-    double ss = 0; /* two passes: the squares about the mean, not sum x^2 - n mean^2 */
+    double *x = malloc((n ? n : 1) * sizeof *x);
+    if (!x)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "repose: no memory for %zu angles", n);
     for (size_t k = 0; k < n; k++)
         if (isfinite(angles[k]))
-            ss += (angles[k] - out->mean_deg) * (angles[k] - out->mean_deg);
-    out->sd_deg = sqrt(ss / (double)(out->n - 1));
-    out->se_deg = out->sd_deg / sqrt((double)out->n);
+            x[out->n++] = angles[k];
+    if (out->n) {
+        out->mean_deg = gsl_stats_mean(x, 1, out->n);
+        gsl_stats_minmax(&out->min_deg, &out->max_deg, x, 1, out->n);
+    }
+    if (out->n >= 2) {
+        out->sd_deg = gsl_stats_sd_m(x, 1, out->n, out->mean_deg); /* divides by n - 1 */
+        out->se_deg = out->sd_deg / sqrt((double)out->n);
+    }
+    free(x);
+    return CDEM_OK;
 }

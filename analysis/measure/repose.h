@@ -129,7 +129,9 @@ typedef struct {
     double min_deg, max_deg; /* range; NaN when n = 0 */
 } cdem_repose_spread;
 
-/* Summarises angles[0..n) (degrees; NaN entries, runs without a measure, are left out). */
-void cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out);
+/* Summarises angles[0..n) (degrees; NaN entries, runs without a measure, are left out).
+ * Fails only without memory for a copy of the finite angles. */
+cdem_status cdem_repose_spread_of(const double *angles, size_t n, cdem_repose_spread *out,
+                                  cdem_error *err);
 
 #endif

@@ -28,15 +28,12 @@ seeds() {
     v=$(for k in 2 3; do f=$OUT/repose-$1-seed$k.txt; [ -f "$f" ] && repose "$f"; done | awk '{printf "%s%s", (NR>1?" / ":""), $1}')
     echo "${v:--}"
 }
-# the mean and standard deviation of the collapses of the three packings (seeds 1, 2, 3) as
-# `cdem-strain repose` gives them for several runs of one material, "mean sd"; empty
-# without the other packings (QUICK=1)
+# the mean and standard deviation of the collapses of the three packings (seeds 1, 2, 3),
+# "mean sd", from `cdem-strain repose` given the three runs (the Makefile's
+# repose-SET-packings.txt); empty without the other packings (QUICK=1)
 spread() {
-    fs="$OUT/repose-$1.h5"
-    for k in 2 3; do [ -f "$OUT/repose-$1-seed$k.h5" ] && fs="$fs $OUT/repose-$1-seed$k.h5"; done
-    # shellcheck disable=SC2086
-    "$STRAIN" repose $fs 2>/dev/null |
-        sed -n 's/^over [0-9]* runs: angle of repose \([0-9.]*\) deg (mean), standard deviation \([0-9.]*\) deg.*/\1 \2/p'
+    sed -n 's/^over [0-9]* runs: angle of repose \([0-9.]*\) deg (mean), standard deviation \([0-9.]*\) deg.*/\1 \2/p' \
+        "$OUT/repose-$1-packings.txt" 2>/dev/null || true
 }
 # "M ± S" of spread, or "-"
 spread_text() { v=$(spread "$1"); [ -n "$v" ] && echo "$v" | awk '{printf "%.2f ± %.2f", $1, $2}' || echo "-"; }
@@ -67,6 +64,10 @@ echo
 echo "| set | paper | elements (paper) | peak q at 0 / 5 / 10 / 15 / 20 MPa (MPa) | C (MPa) | phi (deg) | unconfined: measured / envelope (MPa) | axial strain to 90 % of the peak (mean, 5-20 MPa) | repose (deg) | repose, packings 2 / 3 (deg) | repose, mean of packings 1-3 ± sd (deg) |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for set in "$@"; do
+    # the packings' report is the Makefile's; without it the judging below would fall back
+    # to seed 1 unseen
+    [ -f "$OUT/repose-$set-packings.txt" ] ||
+        { echo "results.sh: $OUT/repose-$set-packings.txt is missing (make makes it)" >&2; exit 1; }
     case $set in
         default) fig="4A, 6A"; paper=2121 ;;
         half) fig="4B, 6B"; paper=8342 ;;
