@@ -83,6 +83,18 @@ simulate biaxial "$EX/calibration/biaxial.ini" -s time.equilibration=400 -s time
     -s boundary.confining_pressure=5e6
 analyse biaxial
 $STRAIN export-biaxial biaxial.h5 -o biaxial-export.txt
+# salt (issue 45: the process plug-in must leave these identical): a basal band under a
+# detachment, an interval under a planar fault, and a salt run stopped and resumed
+simulate salt-detachment "$EX/salt-detachment/extension.ini" -s assembly.width=6 \
+    -s time.runtime=800 -s time.display_interval=50
+analyse salt-detachment
+simulate salt-planar "$EX/salt-extension/salt.ini" -s assembly.width=6 -s time.runtime=700 \
+    -s salt.layer=interval -s salt.interval_bottom_percent=20 -s salt.interval_top_percent=40
+analyse salt-planar
+simulate salt-resumed "$EX/salt-extension/salt.ini" -s assembly.width=5 -s assembly.height=2 \
+    -s time.equilibration=100 -s time.runtime=300 --max-steps 8000 || [ $? -eq 3 ]
+$RUN -q --resume salt-resumed.h5
+analyse salt-resumed
 # stopped early (exit status 3 is not an error here), then resumed: the checkpoint codec
 simulate resumed -s assembly.height=2.5 -s time.equilibration=100 -s time.runtime=150 \
     --max-steps 4000 || [ $? -eq 3 ]
