@@ -165,6 +165,7 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
         return 0;
     c.m.gravity = 0.0;
     c.it.loads.gravity = 0.0;
+    cdem_loads_set_gravity(&c.it.loads, 0.0, 0.0);
     /* the gap: the packing's mean top (the highest top in columns of a largest diameter), so
      * that the plate touches the salt across the box, not only its highest elements */
     const double col = 2.0 * c.m.max_radius;

@@ -70,6 +70,7 @@ static void open_cell(salt_cell *c, double j0) {
         fail_msg("salt cell: %s", err.msg);
     c->m.gravity = 0.0;
     c->it.loads.gravity = 0.0;
+    cdem_loads_set_gravity(&c->it.loads, 0.0, 0.0);
 }
 
 /* salt-2: the viscous kernel on an affine simple shear v = (rate (y - H/2), 0): the salt

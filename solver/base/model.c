@@ -23,6 +23,17 @@ static const double damping_per_dt = 3.0e9;
 static const double kn_per_radius = 19944125.80;
 static const double damping_per_radius = 1091596.58430158;
 
+void cdem_model_gravity_vector(double g, double tilt_deg, double *gx, double *gy) {
+    if (tilt_deg == 0.0) { /* exactly straight down: no rounding of sin and cos */
+        *gx = 0.0;
+        *gy = -g;
+        return;
+    }
+    const double t = tilt_deg * M_PI / 180.0;
+    *gx = g * sin(t);
+    *gy = -(g * cos(t));
+}
+
 /* Sea-level rise factors, in cdem_sea_level_rise order. */
 static const double sea_factor[] = {0.0, 0.25, 0.5, 0.75, 1.0};
 
@@ -32,6 +43,11 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_model_derive: NULL argument");
     memset(m, 0, sizeof *m);
     m->mode = mode ? *mode : cdem_model_mode_default();
+    if (!(fabs(m->mode.gravity_tilt) < 90.0))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "cannot derive the model: the mode tilts gravity by %g degrees: must be "
+                         "within (-90, 90)",
+                         m->mode.gravity_tilt);
     if (!(p->unit_scaling > 0) || !(p->width > 0) || !(p->height > 0) || !(p->density > 0) ||
         !(p->runtime > 0) || !(p->equilibration >= 0) || !(p->display_interval > 0) ||
         !isfinite(p->runtime) || !isfinite(p->unit_scaling) || !isfinite(p->density))

@@ -48,12 +48,29 @@ typedef struct {
                                 comes to rest on it) */
     const char *input;      /* a file the run reads besides the parameter file, or NULL */
     const char *input_what; /* how messages name it */
+    double gravity_tilt;    /* degrees, in (-90, 90): gravity's angle from -y, positive toward
+                               +x (the model's frame tilted with a margin that dips toward +x);
+                               0: straight down. A mode may turn it further step by step
+                               (bc.h, the gravity hook) */
 } cdem_model_mode;
 
 /* The mode part of a mode without a derive hook. */
 static inline cdem_model_mode cdem_model_mode_default(void) {
-    return (cdem_model_mode){NULL, 1, NULL, 0.0, 0.0, 0.0, NULL, NULL};
+    return (cdem_model_mode){.gravity_off = NULL,
+                             .moving_boundaries = 1,
+                             .still = NULL,
+                             .base_spacing = 0.0,
+                             .base_beyond_left = 0.0,
+                             .base_beyond_right = 0.0,
+                             .input = NULL,
+                             .input_what = NULL,
+                             .gravity_tilt = 0.0};
 }
+
+/* Gravity's acceleration (m/s^2) in the model's frame for a tilt of tilt_deg degrees from -y
+ * toward +x: (g sin t, -g cos t). A tilt of 0 gives exactly (+0, -g), so that an untilted run
+ * has the bits of gravity as a scalar along -y (force_pairs.h, the finish). */
+void cdem_model_gravity_vector(double g, double tilt_deg, double *gx, double *gy);
 
 /* The salt's constants (salt.*; docs/solver.md, "Salt"), all 0 when salt.layer = off. The
  * model runs at natural lengths, densities and gravity but with time compressed by
@@ -92,7 +109,8 @@ typedef struct {
     double dt;                     /* s, 0.25 sqrt(min_mass / kn) */
     double boundary_speed;         /* m/s, CDEM_BOUNDARY_ACCEL * dt */
     double displacement_per_step;  /* m, boundary_speed * dt */
-    double gravity;                /* m/s^2 actually applied (0 when the mode turns it off) */
+    double gravity;                /* m/s^2, the magnitude actually applied (0 when the mode
+                                      turns it off); its direction: mode.gravity_tilt */
     double width_m, height_m;      /* assembly size in m */
     long equil_steps;              /* time steps of equilibration, round(equilibration / dt) */
     long total_steps;              /* time steps of the whole run, round(runtime / dt) */

@@ -78,6 +78,11 @@ typedef struct {
      * init; a stored one that differs fails with CDEM_ERR_CONFLICT) */
     cdem_status (*save)(const void *ctx, cdem_snapshot *snap, cdem_error *err);
     cdem_status (*restore)(void *ctx, const cdem_snapshot *snap, cdem_error *err);
+    /* may be NULL (gravity keeps the direction the model gave it, mode.gravity_tilt): gravity's
+     * acceleration (m/s^2, the model's frame) for deformation step k >= 1, g its magnitude: a
+     * mode whose frame turns (a tilting margin) sets it here each step; it holds through
+     * the steps that do not call the mode (sediment settling), and checkpoints keep it */
+    void (*gravity)(const void *ctx, long k, double g, double *gx, double *gy);
     /* Before the run, from the parameters alone (cdem_run_validate, cdem_bc_derive_model, the
      * summary), in this order in the parameter check: */
     /* may be NULL: the mode's own rules, one cdem_rule_add each (the message names the mode,
@@ -141,6 +146,9 @@ cdem_bc_move_fn cdem_bc_step_move_of(const cdem_bc *bc, long k);
 /* The once-only half of step k's apply (ops->step_begin; the same k, du, dt as
  * cdem_bc_apply). Only when cdem_bc_step_move_of returned a function. */
 cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_error *err);
+/* Gravity for deformation step k (>= 1) from the mode's gravity hook into *gx, *gy: 1 when the
+ * mode sets it, 0 (nothing written) when it has no hook, k < 1 or bc is NULL. */
+int cdem_bc_gravity(const cdem_bc *bc, long k, double g, double *gx, double *gy);
 /* 1 when the mode moves boundaries during equilibration (ops->moves_in_equilibration). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
 double cdem_bc_net_displacement(const cdem_bc *bc);

@@ -208,6 +208,13 @@ int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k) {
     return bc->ops->boundary_only || (k <= 0 && !bc->ops->moves_in_equilibration);
 }
 
+int cdem_bc_gravity(const cdem_bc *bc, long k, double g, double *gx, double *gy) {
+    if (!bc || !bc->ops || !bc->ops->gravity || k < 1)
+        return 0;
+    bc->ops->gravity(bc->ctx, k, g, gx, gy);
+    return 1;
+}
+
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc) {
     return bc && bc->ops && bc->ops->moves_in_equilibration;
 }

@@ -44,9 +44,21 @@ cdem_status cdem_run_capture(const cdem_run_ctx *r, cdem_snapshot *snap, cdem_er
  * it over the defaults. Not by its text: the help comments are reworded between builds, and
  * a parameter added since reads as its default, which is the value the earlier build ran
  * with (the torn-index evidence of issue 35 was written before two such changes). */
-static cdem_status check_params(const cdem_snapshot *snap, const cdem_params *p, cdem_error *err) {
+static cdem_status check_params(const cdem_snapshot *snap, const cdem_params *p,
+                                const char *params_eff, cdem_error *err) {
     const cdem_snapshot_array *a = NULL;
     CDEM_TRY(cdem_ckpt_get_array(snap, "run", "params", CDEM_SNAP_U8, SIZE_MAX, &a, err));
+    if ((int)p->mode >= CDEM_MODE_WORDS) {
+        /* a fixture of the tests (common/modes.def) has no word a parameter file can hold, so
+         * its set cannot be parsed back: it resumes (in memory, by the tests) only from a
+         * checkpoint whose text is this run's own */
+        if (a->count == strlen(params_eff) && memcmp(a->data, params_eff, a->count) == 0)
+            return CDEM_OK;
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint run.params: a run in the tests' mode %s resumes only from "
+                         "a checkpoint of the same parameter text",
+                         cdem_mode_name(p->mode));
+    }
     char *text = malloc(a->count + 1);
     if (!text)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory comparing a checkpoint's parameters");
@@ -96,7 +108,7 @@ cdem_status run_restore(run_ctx *r, const cdem_snapshot *snap, cdem_error *err) 
                          "resumes bit-identically only with the version that started it",
                          (int)(ver->count > 64 ? 64 : ver->count), (const char *)ver->data,
                          CDEM_VERSION);
-    CDEM_TRY(check_params(snap, r->p, err));
+    CDEM_TRY(check_params(snap, r->p, r->ckpt.params_eff, err));
     const long total = r->m.total_steps;
     int64_t step = 0, next_inc = 0, next_inc_step = 0, lws = 0, lci = 0, removed = 0, eroded = 0,
             k_def = 0;

@@ -165,8 +165,15 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, "damping", "%.8g N s/m; x %g on deformation steps (physics.deformation_damping)",
              m->damping, p->deformation_damping);
     line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
-    line(f, "gravity", "%g m/s^2%s%s%s", m->gravity, m->mode.gravity_off ? " (" : "",
-         m->mode.gravity_off ? m->mode.gravity_off : "", m->mode.gravity_off ? ")" : "");
+    if (m->mode.gravity_tilt != 0.0 && m->gravity > 0.0) {
+        double gx, gy;
+        cdem_model_gravity_vector(m->gravity, m->mode.gravity_tilt, &gx, &gy);
+        line(f, "gravity", "%g m/s^2, tilted %g degrees from -y toward %s: (%.6g, %.6g) m/s^2",
+             m->gravity, fabs(m->mode.gravity_tilt), m->mode.gravity_tilt > 0.0 ? "+x" : "-x", gx,
+             gy);
+    } else
+        line(f, "gravity", "%g m/s^2%s%s%s", m->gravity, m->mode.gravity_off ? " (" : "",
+             m->mode.gravity_off ? m->mode.gravity_off : "", m->mode.gravity_off ? ")" : "");
     line(f, "density", "%g kg/m^3", p->density);
     line(f, "stress calculation", "%s", on_off(p->calculate_stress));
 

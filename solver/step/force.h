@@ -89,11 +89,11 @@ typedef struct {
 
 /* The loads the element finish adds to the contact-force sum of a free element. */
 typedef struct {
-    double gravity;       /* m/s^2: -m g in y */
-    double surface_force; /* N: in -y on elements flagged CDEM_FLAG_SURFACE */
-    double edge_force;    /* N: on elements flagged CDEM_FLAG_BIAXIAL_EDGE, +x left of
-                             edge_x_mid, -x elsewhere */
-    double edge_x_mid;    /* m */
+    double gravity_x, gravity_y; /* m/s^2: gravity's acceleration (the weight m g) */
+    double surface_force;        /* N: in -y on elements flagged CDEM_FLAG_SURFACE */
+    double edge_force;           /* N: on elements flagged CDEM_FLAG_BIAXIAL_EDGE, +x left of
+                                    edge_x_mid, -x elsewhere */
+    double edge_x_mid;           /* m */
 } cdem_force_loads;
 
 /* What one pass needs besides the pair list and the state. */

@@ -95,14 +95,19 @@ CDEM_LANES_INLINE __m256d cdem_lanes_flags4(const uint32_t *flags, uint32_t bits
 
 /* The constants of the finish, broadcast. */
 typedef struct {
-    __m256d g, sf, ef, mid, hdt, c, chdt, one, dt2;
+    __m256d gx, gy, sf, ef, mid, hdt, c, chdt, one, dt2;
 } cdem_lanes_finish;
 
 CDEM_LANES_INLINE cdem_lanes_finish cdem_lanes_finish_setup(const cdem_force_elements *e) {
-    return (cdem_lanes_finish){_mm256_set1_pd(e->gravity),    _mm256_set1_pd(e->surface_force),
-                               _mm256_set1_pd(e->edge_force), _mm256_set1_pd(e->edge_x_mid),
-                               _mm256_set1_pd(e->hdt),        _mm256_set1_pd(e->c),
-                               _mm256_set1_pd(e->c * e->hdt), _mm256_set1_pd(1.0),
+    return (cdem_lanes_finish){_mm256_set1_pd(e->lift_x),
+                               _mm256_set1_pd(e->lift_y),
+                               _mm256_set1_pd(e->surface_force),
+                               _mm256_set1_pd(e->edge_force),
+                               _mm256_set1_pd(e->edge_x_mid),
+                               _mm256_set1_pd(e->hdt),
+                               _mm256_set1_pd(e->c),
+                               _mm256_set1_pd(e->c * e->hdt),
+                               _mm256_set1_pd(1.0),
                                _mm256_set1_pd(e->dt2)};
 }
 
@@ -119,13 +124,14 @@ CDEM_LANES_INLINE int cdem_lanes_finish4(const cdem_lanes_finish *k, const cdem_
     const __m256d surf = cdem_lanes_flags4(e->flags + i, CDEM_FLAG_SURFACE);
     const __m256d edge = cdem_lanes_flags4(e->flags + i, CDEM_FLAG_BIAXIAL_EDGE);
     const __m256d m = _mm256_loadu_pd(e->mass + i);
-    /* sy -= m g + (surface ? surface_force : 0) */
+    /* sy -= m lift_y + (surface ? surface_force : 0); sx -= m lift_x (the scalar finish's order) */
     const __m256d ty =
-        _mm256_sub_pd(sy, _mm256_add_pd(_mm256_mul_pd(m, k->g), _mm256_and_pd(k->sf, surf)));
+        _mm256_sub_pd(sy, _mm256_add_pd(_mm256_mul_pd(m, k->gy), _mm256_and_pd(k->sf, surf)));
+    const __m256d sxg = _mm256_sub_pd(sx, _mm256_mul_pd(m, k->gx));
     /* sx += x < mid ? edge_force : -edge_force, on the edge elements */
     const __m256d left = _mm256_cmp_pd(_mm256_loadu_pd(e->x + i), k->mid, _CMP_LT_OQ);
     const __m256d tx = _mm256_blendv_pd(
-        sx, _mm256_add_pd(sx, _mm256_blendv_pd(_mm256_xor_pd(k->ef, sign), k->ef, left)), edge);
+        sxg, _mm256_add_pd(sxg, _mm256_blendv_pd(_mm256_xor_pd(k->ef, sign), k->ef, left)), edge);
     __m256d vxi = _mm256_loadu_pd(vx + i), vyi = _mm256_loadu_pd(vy + i);
     if (e->kick) {
         const __m256d inv = e->kick_finish ? _mm256_loadu_pd(e->kick_finish + i)

@@ -41,9 +41,12 @@ typedef struct {
  * element arrays of the pass and the run loop's guard (the written arrays are passed apart,
  * as restrict parameters: docs/performance.md, "Choices in the force pass"). */
 typedef struct {
-    int kick;                  /* 1: the damped second half kick */
-    double hdt, c;             /* s, dt / 2; N s/m, the damping of the step */
-    double gravity;            /* m/s^2: -m g in y */
+    int kick;      /* 1: the damped second half kick */
+    double hdt, c; /* s, dt / 2; N s/m, the damping of the step */
+    /* m/s^2: minus gravity's acceleration, (0 - gx, 0 - gy): the finish subtracts m times it
+     * from the sum. Subtracting m x (+0) leaves a sum's bits as they are (also a -0 sum), so
+     * the default (0, -g), here (+0, g), gives the bits of gravity as a scalar along -y */
+    double lift_x, lift_y;
     double surface_force;      /* N: in -y on elements flagged CDEM_FLAG_SURFACE */
     double edge_force;         /* N: on CDEM_FLAG_BIAXIAL_EDGE, +x left of edge_x_mid */
     double edge_x_mid;         /* m */
@@ -67,7 +70,8 @@ static CDEM_INLINE void cdem_force_finish_one(const cdem_force_elements *e, long
         return;
     }
     const double m = e->mass[i];
-    sy -= m * e->gravity + ((fl & CDEM_FLAG_SURFACE) ? e->surface_force : 0.0);
+    sx -= m * e->lift_x;
+    sy -= m * e->lift_y + ((fl & CDEM_FLAG_SURFACE) ? e->surface_force : 0.0);
     if (fl & CDEM_FLAG_BIAXIAL_EDGE)
         sx += e->x[i] < e->edge_x_mid ? e->edge_force : -e->edge_force;
     if (e->kick) {

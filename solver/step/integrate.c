@@ -45,7 +45,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     it->dt = m->dt;
     it->damping = m->damping;
     const double max_radius = m->max_radius > 0.0 ? m->max_radius : m->radius[CDEM_NUM_RADII - 1];
-    cdem_loads_init(&it->loads, m->gravity, max_radius);
+    cdem_loads_init(&it->loads, m->gravity, m->mode.gravity_tilt, max_radius);
     cdem_removal_init(&it->removal, max_radius);
     CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
     CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
@@ -287,6 +287,9 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         drift(it, s);
     it->step++;
     cdem_loads_begin_step(&it->loads, it->step);
+    double gx, gy; /* a mode whose frame turns sets gravity for this step (bc.h) */
+    if (cdem_bc_gravity(bc, k, it->loads.gravity, &gx, &gy))
+        cdem_loads_set_gravity(&it->loads, gx, gy);
     /* a split mode's per-element moves go into the pass's region too (bc.h step_move) */
     const cdem_bc_move_fn move = drift_in_pass ? cdem_bc_step_move_of(bc, k) : NULL;
     if (move)
@@ -415,6 +418,8 @@ cdem_status cdem_integrator_snapshot_put(const cdem_integrator *it, int boundary
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "dt", it->dt, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "damping", it->damping, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "gravity", ld->gravity, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "gravity_x", ld->gravity_x, err));
+    CDEM_TRY(cdem_ckpt_put_f64(snap, P, "gravity_y", ld->gravity_y, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "overburden_force", ld->overburden_force, err));
     CDEM_TRY(cdem_ckpt_put_f64(snap, P, "confining_pressure", ld->confining_pressure, err));
     CDEM_TRY(cdem_ckpt_put_i64(snap, P, "step", it->step, err));
@@ -441,6 +446,13 @@ cdem_status cdem_integrator_snapshot_get(cdem_integrator *it, const cdem_snapsho
     CDEM_TRY(cdem_ckpt_check_f64(snap, P, "dt", it->dt, err));
     CDEM_TRY(cdem_ckpt_check_f64(snap, P, "damping", it->damping, err));
     CDEM_TRY(cdem_ckpt_check_f64(snap, P, "gravity", ld->gravity, err));
+    /* the direction of the step the checkpoint follows (a mode may turn it: bc.h); absent
+     * from checkpoints written before gravity was a vector, whose gravity was straight down,
+     * as cdem_loads_init set it */
+    if (cdem_snapshot_get(snap, "it.gravity_x") || cdem_snapshot_get(snap, "it.gravity_y")) {
+        CDEM_TRY(cdem_ckpt_get_f64(snap, P, "gravity_x", &ld->gravity_x, err));
+        CDEM_TRY(cdem_ckpt_get_f64(snap, P, "gravity_y", &ld->gravity_y, err));
+    }
     CDEM_TRY(cdem_ckpt_check_f64(snap, P, "overburden_force", ld->overburden_force, err));
     CDEM_TRY(cdem_ckpt_check_f64(snap, P, "confining_pressure", ld->confining_pressure, err));
     CDEM_TRY(cdem_contact_snapshot_check(&it->law, snap, err));

@@ -9,10 +9,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-void cdem_loads_init(cdem_loads *l, double gravity, double max_radius) {
+void cdem_loads_init(cdem_loads *l, double gravity, double tilt_deg, double max_radius) {
     memset(l, 0, sizeof *l);
     l->gravity = gravity;
+    cdem_model_gravity_vector(gravity, tilt_deg, &l->gravity_x, &l->gravity_y);
     l->column_width = 2.0 * max_radius;
+}
+
+void cdem_loads_set_gravity(cdem_loads *l, double gx, double gy) {
+    l->gravity_x = gx;
+    l->gravity_y = gy;
 }
 
 void cdem_loads_free(cdem_loads *l) {
@@ -164,7 +170,8 @@ cdem_status cdem_loads_after_build(cdem_loads *l, cdem_state *s, cdem_error *err
 
 cdem_force_loads cdem_loads_of_step(const cdem_loads *l) {
     const cdem_force_loads f = {
-        .gravity = l->gravity,
+        .gravity_x = l->gravity_x,
+        .gravity_y = l->gravity_y,
         .surface_force = l->overburden_force,
         .edge_force = l->confining_pressure * l->column_width * l->confining_factor,
         .edge_x_mid = l->edge_x_mid,

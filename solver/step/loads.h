@@ -16,7 +16,9 @@
 #include "state.h"
 
 typedef struct {
-    double gravity;      /* m/s^2, applied in -y, >= 0 */
+    double gravity;              /* m/s^2, the magnitude (>= 0): checked on resume */
+    double gravity_x, gravity_y; /* m/s^2, the acceleration of this step in the model's frame:
+                                    (0, -gravity) unless a mode tilts it (set_gravity) */
     double column_width; /* m, width of the surface columns and edge bands = 2 x max radius */
 
     /* overburden (on when overburden_force > 0) */
@@ -35,8 +37,13 @@ typedef struct {
     size_t bandcap;             /* capacity of band_lo, band_hi */
 } cdem_loads;
 
-/* Gravity on, overburden and confinement off; columns 2 x max_radius wide. */
-void cdem_loads_init(cdem_loads *l, double gravity, double max_radius);
+/* Gravity of magnitude `gravity` tilted by tilt_deg degrees from -y toward +x
+ * (cdem_model_gravity_vector), overburden and confinement off; columns 2 x max_radius wide. */
+void cdem_loads_init(cdem_loads *l, double gravity, double tilt_deg, double max_radius);
+
+/* Gravity's acceleration from now on (m/s^2, the model's frame): a mode that turns the frame
+ * (bc.h, the gravity hook) sets it each step. */
+void cdem_loads_set_gravity(cdem_loads *l, double gx, double gy);
 void cdem_loads_free(cdem_loads *l);
 
 /* Enables the overburden: pressure in N/m (>= 0, finite; 0 disables) on the top surface.
