@@ -138,13 +138,15 @@ void run_log_wrote(const run_ctx *r, cdem_status st, int had_writer) {
                  100.0 * (double)r->gov.steps_on_one / (double)steps);
     /* the sidecar as ParaView opens it: "./NAME.xmf", never a bare name (xdmf.h) */
     char *xmf = cdem_xdmf_path_for(r->opt->output_path);
+    char kernel[96];
+    cdem_force_path_describe(&r->it.force, cdem_law_name(r->p->granular_law), kernel,
+                             sizeof kernel);
     fprintf(r->opt->log,
             "cdem-run: wrote %s (%.1f MB; %d increments, numbered 0..%d; %zu elements at the end; "
             "%ld steps in %.1f s wall time, %.3g element-steps/s on %s; pair kernel %s; stop "
             "reason: %s%s); ParaView: %s%s\n",
             r->opt->output_path, mb, r->next_inc, r->next_inc - 1, r->s.n, steps, wall,
-            wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads,
-            cdem_force_path_name(r->it.force.path), how, hint,
+            wall > 0.0 ? r->prog.element_steps / wall : 0.0, threads, kernel, how, hint,
             xmf ? cdem_xdmf_open_prefix(xmf) : "", xmf ? xmf : "?");
     free(xmf);
 }

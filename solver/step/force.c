@@ -39,7 +39,7 @@ static cdem_force_path path_of(cdem_force *f) {
         f->path = cdem_force_path_choose(req);
         /* no request and two vector paths: the first passes measure which is faster here */
         if ((!req || !*req || strcmp(req, "auto") == 0) && f->path == CDEM_FORCE_PATH_AVX2 &&
-            cdem_force_path_usable(CDEM_FORCE_PATH_AVX512)) {
+            !f->law_scalar_only && cdem_force_path_usable(CDEM_FORCE_PATH_AVX512)) {
             f->measure_left = 2 * CDEM_FORCE_MEASURE_PASSES;
             f->measure_time[0] = f->measure_time[1] = 0.0;
         }
@@ -465,6 +465,14 @@ const char *cdem_force_path_name(cdem_force_path path) {
            : path == CDEM_FORCE_PATH_AVX512 ? "avx512"
            : path == CDEM_FORCE_PATH_SCALAR ? "scalar"
                                             : "auto";
+}
+
+void cdem_force_path_describe(const cdem_force *f, const char *law, char *buf, size_t cap) {
+    const int vector = f->path == CDEM_FORCE_PATH_AVX2 || f->path == CDEM_FORCE_PATH_AVX512;
+    if (vector && f->law_scalar_only)
+        snprintf(buf, cap, "%s, scalar for law %s", cdem_force_path_name(f->path), law);
+    else
+        snprintf(buf, cap, "%s", cdem_force_path_name(f->path));
 }
 
 int cdem_force_chunks_wanted(const cdem_neighbour *nb, long par_min, long n) {

@@ -83,6 +83,10 @@ typedef struct {
                                any path cdem_force_path_usable accepts) */
     int measure_left;       /* passes left of the measured choice between the AVX2 and the
                                AVX-512 kernels (cdem_force_pass), 0: none */
+    int law_scalar_only;    /* 1: the run's law has no vector kernel (cdem_force_law_vectorised),
+                               so a vector path evaluates its pairs by the scalar kernel: the
+                               two vector paths are not measured (they would time the same
+                               scalar loop) and the log says so (cdem_force_path_describe) */
     double measure_time[2]; /* s: their fastest pass so far by the wall clock (AVX2, AVX-512;
                                0: none yet) */
 } cdem_force;
@@ -134,8 +138,19 @@ cdem_force_path cdem_force_path_choose(const char *request);
 /* 1 when this build and this CPU run path (SCALAR always; AVX2), else 0. */
 int cdem_force_path_usable(cdem_force_path path);
 
-/* "auto", "scalar" or "avx2". */
+/* "auto", "scalar", "avx2" or "avx512". */
 const char *cdem_force_path_name(cdem_force_path path);
+
+/* 1 when the law has a vector pair kernel (its row's AVX2 kernel in laws.def, which the
+ * AVX-512 path widens), 0 when the vector paths evaluate its pairs one by one with its scalar
+ * kernel (the same bits, not the same speed) or this build has no vector path
+ * (force_avx2.c). */
+int cdem_force_law_vectorised(cdem_granular_law law);
+
+/* The pair kernel that ran, as the run's log names it: the path's name, and on a vector path
+ * with a law that has no vector kernel, which (e.g. "avx2, scalar for law test-scalar-only"):
+ * a slower path is never reported as the vector one. */
+void cdem_force_path_describe(const cdem_force *f, const char *law, char *buf, size_t cap);
 
 /* Grows the buffers for the pair list nb of n elements (after each list build, outside the
  * step's hot loops). */

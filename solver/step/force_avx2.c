@@ -257,6 +257,25 @@ AVX2 int cdem_force_avx2_drift(const cdem_force_drift_args *d, long lo, long hi)
     return moved != 0;
 }
 
+/* 1 for a kernel, 0 for NULL: a function's name compared with NULL would be a warning */
+static int has_lanes(law_lanes lanes) {
+    return lanes != NULL;
+}
+
+int cdem_force_law_vectorised(cdem_granular_law law) {
+    switch (law) { /* one case per row of laws.def */
+#define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
+    case CDEM_LAW_##ID:                                                                            \
+        return has_lanes(lanes);
+#define CDEM_TEST_LAW CDEM_LAW
+#include "laws/laws.def"
+#undef CDEM_LAW
+#undef CDEM_TEST_LAW
+    default:
+        return 0;
+    }
+}
+
 const cdem_force_kernels *cdem_force_kernels_avx2(void) {
     static const cdem_force_kernels k = {pairs_avx2, cdem_force_avx2_scatter,
                                          cdem_force_avx2_finish, cdem_force_avx2_drift,
@@ -269,6 +288,11 @@ const cdem_force_kernels *cdem_force_kernels_avx2(void) {
 
 const cdem_force_kernels *cdem_force_kernels_avx2(void) {
     return NULL;
+}
+
+int cdem_force_law_vectorised(cdem_granular_law law) {
+    (void)law;
+    return 0; /* no vector path in this build */
 }
 
 #endif

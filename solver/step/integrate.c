@@ -48,6 +48,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     cdem_loads_init(&it->loads, m->gravity, m->mode.gravity_tilt, max_radius);
     cdem_removal_init(&it->removal, max_radius);
     CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
+    it->force.law_scalar_only = !cdem_force_law_vectorised(it->law.granular);
     CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
                                  RESORT_EVERY, err));
     cdem_viscous_init(&it->viscous, m);
