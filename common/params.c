@@ -98,186 +98,191 @@ static const char *const section_names[] = {"assembly",      "time",     "physic
 
 /* clang-format off */
 static const cdem_param_def param_table[] = {
-    /* section, key, type, offset, size, unit, default, min, max, min_excl, max_excl, choices, help */
+    /* section, key, type, offset, size, unit, default, min, max, min_excl, max_excl, choices, help,
+       recorded_when_set */
     {"assembly", "width", CDEM_PTYPE_DOUBLE, P_OFF(width), 0, "units", "10", 0, 1e6, 1, 0, NULL,
-     "assembly width in model units (cdem's box: 10 to 100; beyond it, bounded by the memory the run needs, at least 8 largest diameters)"},
+     "assembly width in model units (cdem's box: 10 to 100; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0},
     {"assembly", "height", CDEM_PTYPE_DOUBLE, P_OFF(height), 0, "units", "5", 0, 1e6, 1, 0, NULL,
-     "assembly height in model units (cdem's box: 2.5 to 7.5; beyond it, bounded by the memory the run needs, at least 8 largest diameters)"},
+     "assembly height in model units (cdem's box: 2.5 to 7.5; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0},
     {"assembly", "unit_scaling", CDEM_PTYPE_DOUBLE, P_OFF(unit_scaling), 0, "m", "1000", 1, 1e6, 0, 0, NULL,
-     "length of one model unit (cdem: 100 to 1000; the contact constants scale with the radius below 1000 m, docs/solver.md)"},
+     "length of one model unit (cdem: 100 to 1000; the contact constants scale with the radius below 1000 m, docs/solver.md)", 0},
     {"assembly", "half_radii", CDEM_PTYPE_BOOL, P_OFF(half_radii), 0, "", "off", 0, 1, 0, 0, NULL,
-     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step); radius_scale = 0.5 is the same"},
+     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step); radius_scale = 0.5 is the same", 0},
     {"assembly", "radius_scale", CDEM_PTYPE_DOUBLE, P_OFF(radius_scale), 0, "", "1", 0.001, 1000, 0, 0, NULL,
-     "the four element radii 0.05, 0.075, 0.1, 0.125 units times this (the paper's distribution kept): 0.5 is cdem's half radii, 0.1 cdem2D's finer assemblies; elements per area grow as 1/radius_scale^2, the time step shrinks with radius_scale"},
+     "the four element radii 0.05, 0.075, 0.1, 0.125 units times this (the paper's distribution kept): 0.5 is cdem's half radii, 0.1 cdem2D's finer assemblies; elements per area grow as 1/radius_scale^2, the time step shrinks with radius_scale", 0},
     {"assembly", "wall_height_multiplier", CDEM_PTYPE_INT, P_OFF(wall_height_multiplier), 0, "", "1", 1, 4, 0, 0, NULL,
-     "lateral wall height as a multiple of the assembly height"},
+     "lateral wall height as a multiple of the assembly height", 0},
     {"assembly", "base_spacing", CDEM_PTYPE_DOUBLE, P_OFF(base_spacing), 0, "wall radii", "2", 1, 2, 0, 0, NULL,
-     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base); the biaxial test's platens are always smooth (1)"},
+     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base); the biaxial test's platens are always smooth (1)", 0},
     {"assembly", "seed", CDEM_PTYPE_LONG, P_OFF(seed), 0, "", "1", 0, 2147483647.0, 0, 0, NULL,
-     "random seed of the packing and of all other randomness"},
+     "random seed of the packing and of all other randomness", 0},
 
     {"time", "runtime", CDEM_PTYPE_DOUBLE, P_OFF(runtime), 0, "s", "2000", 100, 1e6, 0, 0, NULL,
-     "total simulated time (simulation time, not geological time)"},
+     "total simulated time (simulation time, not geological time)", 0},
     {"time", "equilibration", CDEM_PTYPE_DOUBLE, P_OFF(equilibration), 0, "s", "400", 100, 1e6, 0, 0, NULL,
-     "equilibration time before any boundary moves; must be shorter than runtime"},
+     "equilibration time before any boundary moves; must be shorter than runtime", 0},
     {"time", "display_interval", CDEM_PTYPE_DOUBLE, P_OFF(display_interval), 0, "m", "5", 0.1, 1000, 0, 0, NULL,
-     "boundary displacement between display increments (seconds for mode = repose)"},
+     "boundary displacement between display increments (seconds for mode = repose)", 0},
 
     {"physics", "gravity", CDEM_PTYPE_DOUBLE, P_OFF(gravity), 0, "m/s^2", "9.81", 0.5, 25, 0, 0, NULL,
-     "gravitational acceleration (not applied in the biaxial test)"},
+     "gravitational acceleration (not applied in the biaxial test)", 0},
     {"physics", "density", CDEM_PTYPE_DOUBLE, P_OFF(density), 0, "kg/m^3", "2500", 1500, 3500, 0, 0, NULL,
-     "element density"},
+     "element density", 0},
     {"physics", "keep_constants", CDEM_PTYPE_BOOL, P_OFF(keep_constants), 0, "", "off", 0, 1, 0, 0, NULL,
-     "keep the 1000 m spring and damping constants whatever the unit scaling"},
+     "keep the 1000 m spring and damping constants whatever the unit scaling", 0},
     {"physics", "deformation_damping", CDEM_PTYPE_DOUBLE, P_OFF(deformation_damping), 0, "", "1", 0, 1, 0, 0, NULL,
-     "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)"},
+     "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)", 0},
     {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
-     "store per-element stress in every increment"},
+     "store per-element stress in every increment", 0},
     {"physics", "damping_mode", CDEM_PTYPE_ENUM, P_OFF(damping_mode), 0, "", "absolute", 0, 0, 0, 0, damping_words,
-     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)"},
+     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)", 0},
     {"physics", "contact_damping", CDEM_PTYPE_DOUBLE, P_OFF(contact_damping), 0, "", "0.2", 0, 1, 0, 0, NULL,
-     "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))"},
+     "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))", 0},
 
     {"material", "material", CDEM_PTYPE_ENUM, P_OFF(material), 0, "", "granular", 0, 0, 0, 0, material_words,
-     "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)"},
+     "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)", 0},
     {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
-     "granular: cohesion lost at the first slip (on) or when the pair separates (off)"},
+     "granular: cohesion lost at the first slip (on) or when the pair separates (off)", 0},
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
      "granular: how the cohesion C0 enters a contact's shear strength"
 #define CDEM_LAW(ID, word, description, scalar, lanes) "; " word ": " description
 #include "laws/laws.def"
 #undef CDEM_LAW
-    },
+     , 0},
     {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "initial", 0, 0, 0, 0, cohesive_words,
-     "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)"},
+     "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)", 0},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
-     "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on"},
+     "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on", 0},
     {"material", "element_friction", CDEM_PTYPE_DOUBLE, P_OFF(element.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-element friction coefficient"},
+     "element-element friction coefficient", 0},
     {"material", "element_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(element.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-element cohesion force"},
+     "element-element cohesion force", 0},
     {"material", "element_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(element.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-element bond breaks when r - R >= breaking_strain * R"},
+     "bonded: element-element bond breaks when r - R >= breaking_strain * R", 0},
     {"material", "wall_friction", CDEM_PTYPE_DOUBLE, P_OFF(wall.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-wall friction coefficient (lateral walls, biaxial platens; the base too unless base_friction is set)"},
+     "element-wall friction coefficient (lateral walls, biaxial platens; the base too unless base_friction is set)", 0},
     {"material", "wall_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(wall.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-wall cohesion force"},
+     "element-wall cohesion force", 0},
     {"material", "wall_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(wall.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-wall breaking strain"},
+     "bonded: element-wall breaking strain", 0},
     {"material", "base_friction", CDEM_PTYPE_DOUBLE, P_OFF(base.friction), 0, "", "wall", 0, 10, 0, 0, as_wall_words,
-     "element-base friction coefficient (the base row; biaxial: the bottom platen); wall = wall_friction"},
+     "element-base friction coefficient (the base row; biaxial: the bottom platen); wall = wall_friction", 0},
     {"material", "base_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(base.cohesion), 0, "N", "wall", 0, 1e15, 0, 0, as_wall_words,
-     "element-base cohesion force; wall = wall_cohesion"},
+     "element-base cohesion force; wall = wall_cohesion", 0},
     {"material", "base_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(base.breaking_strain), 0, "", "wall", 0, 1, 1, 0, as_wall_words,
-     "bonded: element-base breaking strain; wall = wall_breaking_strain"},
+     "bonded: element-base breaking strain; wall = wall_breaking_strain", 0},
     {"material", "fault_friction", CDEM_PTYPE_DOUBLE, P_OFF(fault.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-fault friction coefficient (set 0 for CH kinematics)"},
+     "element-fault friction coefficient (set 0 for CH kinematics)", 0},
     {"material", "fault_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(fault.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-fault cohesion force (set 0 for CH kinematics)"},
+     "element-fault cohesion force (set 0 for CH kinematics)", 0},
     {"material", "fault_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(fault.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-fault breaking strain"},
+     "bonded: element-fault breaking strain", 0},
 
     {"heterogeneity", "flexural_slip", CDEM_PTYPE_BOOL, P_OFF(flexural_slip), 0, "", "off", 0, 1, 0, 0, NULL,
-     "contacts between different pre-growth layers have no friction/cohesion (or no bond)"},
+     "contacts between different pre-growth layers have no friction/cohesion (or no bond)", 0},
     {"heterogeneity", "flexural_slip_style", CDEM_PTYPE_ENUM, P_OFF(flexural_slip_style), 0, "", "layer-contacts", 0, 0, 0, 0, flex_words,
-     "which contacts flexural slip makes strengthless: every contact between two different pre-growth layers (layer-contacts, the manual's and the paper's), or every contact of an element of layers 4, 8, 12, 16 and 20 (weak-layers, the original's versions 4.1-4.2)"},
+     "which contacts flexural slip makes strengthless: every contact between two different pre-growth layers (layer-contacts, the manual's and the paper's), or every contact of an element of layers 4, 8, 12, 16 and 20 (weak-layers, the original's versions 4.1-4.2)", 0},
     {"heterogeneity", "weak_interval", CDEM_PTYPE_ENUM, P_OFF(weak_interval), 0, "", "off", 0, 0, 0, 0, weak_words,
-     "weak and/or light interval at the bottom (lower) or top (upper) of the assembly"},
+     "weak and/or light interval at the bottom (lower) or top (upper) of the assembly", 0},
     {"heterogeneity", "weak_thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_thickness_percent), 0, "%", "50", 0, 100, 0, 0, NULL,
-     "thickness of the weak interval, % of the assembly height"},
+     "thickness of the weak interval, % of the assembly height", 0},
     {"heterogeneity", "weak_strength_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_strength_percent), 0, "%", "0", 0, 100, 0, 0, NULL,
-     "strength kept in the weak interval, % of the material values (0 = frictionless/unbonded)"},
+     "strength kept in the weak interval, % of the material values (0 = frictionless/unbonded)", 0},
     {"heterogeneity", "weak_density_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_density_percent), 0, "%", "100", 50, 100, 0, 0, NULL,
-     "density of the weak interval, % of the density"},
+     "density of the weak interval, % of the density", 0},
     {"heterogeneity", "layered_friction", CDEM_PTYPE_BOOL, P_OFF(layered_friction), 0, "", "off", 0, 1, 0, 0, NULL,
-     "layers 5-8, 13-16 and 21-24 take layered_friction_value (granular only)"},
+     "layers 5-8, 13-16 and 21-24 take layered_friction_value (granular only)", 0},
     {"heterogeneity", "layered_friction_value", CDEM_PTYPE_DOUBLE, P_OFF(layered_friction_value), 0, "", "0.1", 0, 10, 0, 0, NULL,
-     "friction coefficient of layers 5-8, 13-16 and 21-24"},
+     "friction coefficient of layers 5-8, 13-16 and 21-24", 0},
 
     {"boundary", "mode", CDEM_PTYPE_ENUM, P_OFF(mode), 0, "", "planar-fault", 0, 0, 0, 0, mode_words,
-     "boundary / faulting mode"},
+     "boundary / faulting mode", 0},
     {"boundary", "fault_sense", CDEM_PTYPE_ENUM, P_OFF(fault_sense), 0, "", "normal", 0, 0, 0, 0, sense_words,
-     "planar/listric/irregular fault: normal or reverse displacement"},
+     "planar/listric/irregular fault: normal or reverse displacement", 0},
     {"boundary", "fault_location", CDEM_PTYPE_DOUBLE, P_OFF(fault_location), 0, "", "0.5", 0, 1, 1, 1, NULL,
-     "fault location at the base, fraction of the base length"},
+     "fault location at the base, fraction of the base length", 0},
     {"boundary", "fault_dip", CDEM_PTYPE_DOUBLE, P_OFF(fault_dip), 0, "degrees", "30", 0, 90, 1, 0, NULL,
-     "planar: fault dip; listric: dip of the lowest segment (it steepens to 90)"},
+     "planar: fault dip; listric: dip of the lowest segment (it steepens to 90)", 0},
     {"boundary", "inversion", CDEM_PTYPE_BOOL, P_OFF(inversion), 0, "", "off", 0, 1, 0, 0, NULL,
-     "invert the fault sense during the run (planar/listric/irregular)"},
+     "invert the fault sense during the run (planar/listric/irregular)", 0},
     {"boundary", "inversion_percent", CDEM_PTYPE_DOUBLE, P_OFF(inversion_percent), 0, "%", "50", 0, 100, 1, 1, NULL,
-     "% of the total displacement at which the sense inverts"},
+     "% of the total displacement at which the sense inverts", 0},
     {"boundary", "kinematics", CDEM_PTYPE_ENUM, P_OFF(kinematics), 0, "", "ch", 0, 0, 0, 0, kin_words,
-     "listric/irregular: constant heave (ch) or constant displacement (cd, mylar sheet)"},
+     "listric/irregular: constant heave (ch) or constant displacement (cd, mylar sheet)", 0},
     {"boundary", "fault_file", CDEM_PTYPE_STRING, P_OFF(fault_file), CDEM_PATH_MAX, "", "", 0, 0, 0, 0, NULL,
-     "irregular fault: text file of x y vertices in m, from the base up-dip"},
+     "irregular fault: text file of x y vertices in m, from the base up-dip", 0},
     {"boundary", "vertical_fault_location", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_location), 0, "", "0.35", 0, 1, 1, 1, NULL,
-     "two vertical faults: first fault, fraction of the base length"},
+     "two vertical faults: first fault, fraction of the base length", 0},
     {"boundary", "vertical_fault_spacing", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_spacing), 0, "", "0.3", 0, 1, 1, 1, NULL,
-     "two vertical faults: distance to the second fault, fraction of the base length"},
+     "two vertical faults: distance to the second fault, fraction of the base length", 0},
     {"boundary", "vertical_sense", CDEM_PTYPE_ENUM, P_OFF(vertical_sense), 0, "", "caldera", 0, 0, 0, 0, vert_words,
-     "two vertical faults: caldera (block down, extension) or piston (block up, compression)"},
+     "two vertical faults: caldera (block down, extension) or piston (block up, compression)", 0},
     {"boundary", "detachment_walls", CDEM_PTYPE_ENUM, P_OFF(detachment_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
-     "detachment: right wall moving, or both walls moving inward (each at the boundary speed)"},
+     "detachment: right wall moving, or both walls moving inward (each at the boundary speed)", 0},
     {"boundary", "detachment_sense", CDEM_PTYPE_ENUM, P_OFF(detachment_sense), 0, "", "shortening", 0, 0, 0, 0, detach_sense_words,
-     "detachment: the moving walls go inward (shortening) or outward (extension)"},
+     "detachment: the moving walls go inward (shortening) or outward (extension)", 0},
     {"boundary", "repose_walls", CDEM_PTYPE_ENUM, P_OFF(repose_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
-     "repose-collapse: right wall removed, or both, after equilibration"},
+     "repose-collapse: right wall removed, or both, after equilibration", 0},
     {"boundary", "confining_pressure", CDEM_PTYPE_DOUBLE, P_OFF(confining_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
-     "biaxial: confining pressure on the free edges (Pa in 3-D; 0 = uniaxial)"},
+     "biaxial: confining pressure on the free edges (Pa in 3-D; 0 = uniaxial)", 0},
+    {"boundary", "start", CDEM_PTYPE_DOUBLE, P_OFF(window_start), 0, "m", "0", 0, 1e9, 0, 0, NULL,
+     "the run's boundary displacement (the display interval's clock) before this boundary moves", 1},
+    {"boundary", "stop", CDEM_PTYPE_DOUBLE, P_OFF(window_stop), 0, "m", "0", 0, 1e9, 0, 0, NULL,
+     "the run's boundary displacement at which this boundary stops (0 = the end of the run)", 1},
 
     {"surface", "overburden_pressure", CDEM_PTYPE_DOUBLE, P_OFF(overburden_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
-     "vertical pressure on the top surface (0 = off)"},
+     "vertical pressure on the top surface (0 = off)", 0},
     {"surface", "erosion", CDEM_PTYPE_BOOL, P_OFF(erosion), 0, "", "off", 0, 1, 0, 0, NULL,
-     "remove elements above the erosion base level"},
+     "remove elements above the erosion base level", 0},
     {"surface", "erosion_base_level", CDEM_PTYPE_DOUBLE, P_OFF(erosion_base_level), 0, "", "1", 1, 10, 0, 0, NULL,
-     "erosion base level, multiple of the assembly height"},
+     "erosion base level, multiple of the assembly height", 0},
     {"surface", "sedimentation", CDEM_PTYPE_BOOL, P_OFF(sedimentation), 0, "", "off", 0, 1, 0, 0, NULL,
-     "syn-tectonic sedimentation below sea level (growth strata)"},
+     "syn-tectonic sedimentation below sea level (growth strata)", 0},
     {"surface", "sea_level_rise", CDEM_PTYPE_ENUM, P_OFF(sea_level_rise), 0, "", "null", 0, 0, 0, 0, sea_words,
-     "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0"},
+     "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0", 0},
     {"surface", "growth_sequence1_layers", CDEM_PTYPE_INT, P_OFF(growth_sequence1_layers), 0, "", "10", 1, 1000, 0, 0, NULL,
-     "growth layers coloured as growth sequence 1 (the rest are sequence 2)"},
+     "growth layers coloured as growth sequence 1 (the rest are sequence 2)", 0},
 
     {"salt", "layer", CDEM_PTYPE_ENUM, P_OFF(salt_layer), 0, "", "off", 0, 0, 0, 0, salt_layer_words,
-     "viscous salt: none (off), the lowest part of the assembly (basal) or an interval of the pre-growth layers (interval), fixed at assembly"},
+     "viscous salt: none (off), the lowest part of the assembly (basal) or an interval of the pre-growth layers (interval), fixed at assembly", 0},
     {"salt", "thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_thickness_percent), 0, "%", "25", 0, 100, 1, 1, NULL,
-     "basal: the salt's thickness, % of the span of element centres (it must leave a cover)"},
+     "basal: the salt's thickness, % of the span of element centres (it must leave a cover)", 0},
     {"salt", "interval_bottom_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_bottom_percent), 0, "%", "20", 0, 100, 0, 0, NULL,
-     "interval: the salt's base, % of the span of element centres above the lowest"},
+     "interval: the salt's base, % of the span of element centres above the lowest", 0},
     {"salt", "interval_top_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_top_percent), 0, "%", "40", 0, 100, 0, 0, NULL,
-     "interval: the salt's top, % of the span of element centres above the lowest"},
+     "interval: the salt's top, % of the span of element centres above the lowest", 0},
     {"salt", "viscosity", CDEM_PTYPE_DOUBLE, P_OFF(salt_viscosity), 0, "Pa s", "1e18", 1e15, 1e21, 0, 0, NULL,
-     "the salt's geological (Newtonian) viscosity; the model's is viscosity / time_scale"},
+     "the salt's geological (Newtonian) viscosity; the model's is viscosity / time_scale", 0},
     {"salt", "salt_density", CDEM_PTYPE_DOUBLE, P_OFF(salt_density), 0, "kg/m^3", "2200", 1000, 3500, 0, 0, NULL,
-     "the salt's density (halite 2160)"},
+     "the salt's density (halite 2160)", 0},
     {"salt", "rate", CDEM_PTYPE_DOUBLE, P_OFF(salt_rate), 0, "mm/yr", "1", 0.01, 100, 0, 0, NULL,
-     "the geological speed the boundary speed stands for: time_scale = boundary speed / rate"},
+     "the geological speed the boundary speed stands for: time_scale = boundary speed / rate", 0},
     {"salt", "time_scale", CDEM_PTYPE_DOUBLE, P_OFF(salt_time_scale), 0, "", "rate", 1, 1e16, 0, 0, from_rate_words,
-     "geological seconds per model second (modes without a moving boundary); rate = from salt.rate"},
+     "geological seconds per model second (modes without a moving boundary); rate = from salt.rate", 0},
     {"salt", "bulk_modulus", CDEM_PTYPE_DOUBLE, P_OFF(salt_bulk_modulus), 0, "Pa", "2.5e10", 1e8, 1e12, 0, 0, NULL,
      "the salt's bulk modulus K: pressure K (1/J - 1) for an area ratio J; halite's, about 25 GPa, "
-     "by default (the salt's area changes by p / K: 0.4 % under 4 km of cover)"},
+     "by default (the salt's area changes by p / K: 0.4 % under 4 km of cover)", 0},
     {"salt", "grid_spacing", CDEM_PTYPE_DOUBLE, P_OFF(salt_grid_spacing), 0, "mean radii", "4.5", 3, 8, 0, 0, NULL,
-     "node spacing of the grid that carries the salt's stress"},
+     "node spacing of the grid that carries the salt's stress", 0},
     {"salt", "reach", CDEM_PTYPE_DOUBLE, P_OFF(salt_reach), 0, "", "1.5", 1, 2, 0, 0, NULL,
-     "the salt's pair dashpots act up to reach x (r_i + r_j)"},
+     "the salt's pair dashpots act up to reach x (r_i + r_j)", 0},
     {"salt", "dashpot_fraction", CDEM_PTYPE_DOUBLE, P_OFF(salt_dashpot_fraction), 0, "", "0.1", 0, 1, 0, 0, NULL,
-     "the salt's pair dashpots (which damp the element motions the grid cannot see), as a fraction of a dashpot network of the salt's viscosity"},
+     "the salt's pair dashpots (which damp the element motions the grid cannot see), as a fraction of a dashpot network of the salt's viscosity", 0},
     {"salt", "cover_contact", CDEM_PTYPE_ENUM, P_OFF(salt_cover_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "no-slip: cover elements next to the salt join its grid (the salt sticks to them); free-slip: only the pair law"},
+     "no-slip: cover elements next to the salt join its grid (the salt sticks to them); free-slip: only the pair law", 0},
     {"salt", "base_contact", CDEM_PTYPE_ENUM, P_OFF(salt_base_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "the same for the base and the fault elements"},
+     "the same for the base and the fault elements", 0},
     {"salt", "wall_contact", CDEM_PTYPE_ENUM, P_OFF(salt_wall_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "the same for the lateral walls"},
+     "the same for the lateral walls", 0},
 
     {"output", "prefix", CDEM_PTYPE_STRING, P_OFF(prefix), sizeof(((cdem_params *)0)->prefix), "", "cdem", 0, 0, 0, 0, NULL,
-     "prefix of per-increment export files (cdem282.txt)"},
+     "prefix of per-increment export files (cdem282.txt)", 0},
     {"output", "total_strain_max", CDEM_PTYPE_DOUBLE, P_OFF(total_strain_max), 0, "", "2", 0.1, 5, 0, 0, NULL,
-     "colour-bar maximum for total strain"},
+     "colour-bar maximum for total strain", 0},
     {"output", "series_interval", CDEM_PTYPE_INT, P_OFF(series_interval), 0, "steps", "100", 1, 1000000, 0, 0, NULL,
-     "time steps between time-series samples"},
+     "time steps between time-series samples", 0},
     {"output", "checkpoint_interval", CDEM_PTYPE_INT, P_OFF(checkpoint_interval), 0, "increments", "10", 0, 1000000, 0, 0, NULL,
-     "display increments between checkpoints that cdem-run --resume continues from (0 = none)"},
+     "display increments between checkpoints that cdem-run --resume continues from (0 = none)", 0},
 };
 /* clang-format on */
 
@@ -637,6 +642,17 @@ static cdem_status fail_unknown_key(const char *where, const char *section, cons
                      section, key);
 }
 
+/* N of a section named [boundary.N] (a boundary actor's), 0 for another name, -1 for
+ * "boundary." followed by anything but a number. */
+static int actor_section(const char *name) {
+    if (strncmp(name, "boundary.", 9) != 0)
+        return 0;
+    const char *d = name + 9;
+    char *end = NULL;
+    const long n = isdigit((unsigned char)*d) ? strtol(d, &end, 10) : -1;
+    return (n < 0 || !end || *end) ? -1 : (n > 1000 ? 1000 : (int)n);
+}
+
 static int known_section(const char *name) {
     for (size_t i = 0; section_names[i]; i++)
         if (strcmp(section_names[i], name) == 0)
@@ -696,6 +712,86 @@ static int clean_value(const char *text, size_t len, char *buf, size_t n) {
 /* Value buffer: long enough for a path plus slack so "too long" can be reported. */
 #define VALUE_MAX (CDEM_PATH_MAX + 64)
 
+/* [boundary.N]: N must be 2..CDEM_BOUNDARY_ACTORS ([boundary] is the first actor). */
+static cdem_status check_actor_section(const char *section, const char *where, cdem_error *err) {
+    const int n = actor_section(section);
+    if (n == 0)
+        return CDEM_OK;
+    if (n < 2 || n > CDEM_BOUNDARY_ACTORS)
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "%s: section [%s]: a boundary actor's section is [boundary.2] to "
+                         "[boundary.%d] ([boundary] is the first)",
+                         where, section, CDEM_BOUNDARY_ACTORS);
+    return CDEM_OK;
+}
+
+/* The line of `key` in an actor's text ("key = value\n" lines), or NULL. */
+static char *actor_line(char *text, const char *key) {
+    const size_t kl = strlen(key);
+    for (char *line = text; line && *line;) {
+        if (strncmp(line, key, kl) == 0 && line[kl] == ' ')
+            return line;
+        char *eol = strchr(line, '\n');
+        line = eol ? eol + 1 : NULL;
+    }
+    return NULL;
+}
+
+/* Sets key = value for boundary actor n (2..): the value checked as the actor's own
+ * parameters take it, and kept in its lines in the written form. A first key of
+ * [boundary.(count + 1)] adds the actor; a later section is refused. replace: an override
+ * (-s) replaces the key's line; a file's second line for a key is refused. */
+static cdem_status assign_actor(cdem_params *work, int n, const char *key, const char *value,
+                                int replace, const char *where, cdem_error *err) {
+    CDEM_TRY(check_actor_section(n >= 2 && n <= CDEM_BOUNDARY_ACTORS ? "boundary.2" : "boundary.0",
+                                 where, err));
+    const cdem_param_def *d = cdem_params_find("boundary", key);
+    if (!d) {
+        char section[32];
+        snprintf(section, sizeof section, "boundary.%d", n);
+        return fail_unknown_key(where, section, key, err);
+    }
+    const int count = cdem_params_actor_count(work);
+    if (n > count + 1)
+        return CDEM_FAIL(err, CDEM_ERR_PARSE,
+                         "%s: [boundary.%d] %s: set a key of [boundary.%d] (at least its mode) "
+                         "first: the actors are numbered in order",
+                         where, n, key, count + 1);
+    char *text = work->actor_keys[n - 2];
+    if (n == count + 1)
+        text[0] = '\0';
+    char *old = actor_line(text, key);
+    if (old && !replace) {
+        return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [boundary.%d] %s: duplicate key; keep one",
+                         where, n, key);
+    }
+    if (old) { /* drop the old line */
+        char *eol = strchr(old, '\n');
+        memmove(old, eol ? eol + 1 : old + strlen(old), strlen(eol ? eol + 1 : "") + 1);
+    }
+    cdem_params saved = *work;
+    if (n == count + 1)
+        work->boundary_actors = n;
+    cdem_params actor;
+    cdem_status st = cdem_params_actor(work, n - 1, &actor, err);
+    if (st == CDEM_OK)
+        st = assign_value(&actor, d, value, where, err);
+    char formatted[VALUE_MAX];
+    if (st == CDEM_OK) {
+        cdem_params_format_value(&actor, d, formatted, sizeof formatted);
+        const size_t used = strlen(text), add = strlen(key) + strlen(formatted) + 4;
+        if (used + add >= CDEM_ACTOR_TEXT)
+            st = CDEM_FAIL(err, CDEM_ERR_PARSE,
+                           "%s: [boundary.%d] %s: the section's keys exceed %d characters", where,
+                           n, key, CDEM_ACTOR_TEXT);
+        else
+            snprintf(text + used, CDEM_ACTOR_TEXT - used, "%s = %s\n", key, formatted);
+    }
+    if (st != CDEM_OK)
+        *work = saved;
+    return st;
+}
+
 cdem_status cdem_params_parse_text(cdem_params *p, const char *text, const char *path,
                                    cdem_error *err) {
     if (!p || !text)
@@ -732,8 +828,9 @@ cdem_status cdem_params_parse_text(cdem_params *p, const char *text, const char 
                 return CDEM_FAIL(err, CDEM_ERR_PARSE,
                                  "%s: line is not 'key = value' or '[section]': %s", where, line);
             copy_trimmed(section, sizeof section, line + 1, (size_t)(close - line - 1));
-            if (!known_section(section))
+            if (!known_section(section) && actor_section(section) == 0)
                 return fail_unknown_section(where, section, err);
+            CDEM_TRY(check_actor_section(section, where, err));
             have_section = 1;
             continue;
         }
@@ -762,6 +859,11 @@ cdem_status cdem_params_parse_text(cdem_params *p, const char *text, const char 
                              "%s: %s: key before any [section]; start the file with a section "
                              "such as [assembly]",
                              where, key);
+        }
+        const int actor = actor_section(section);
+        if (actor > 0) { /* [boundary.N]: a key of the actor's own (assign_actor) */
+            CDEM_TRY(assign_actor(&work, actor, key, value, 0, where, err));
+            continue;
         }
         const cdem_param_def *d = cdem_params_find(section, key);
         if (!d)
@@ -867,6 +969,25 @@ cdem_status cdem_params_override(cdem_params *p, const char *assignment, cdem_er
     char section[64], key[64];
     copy_trimmed(section, sizeof section, name, (size_t)(dot - name));
     copy_trimmed(key, sizeof key, dot + 1, strlen(dot + 1));
+    if (strcmp(section, "boundary") == 0 && isdigit((unsigned char)key[0]) && strchr(key, '.')) {
+        /* boundary.N.key: a key of boundary actor N ([boundary.N]) */
+        const char *kdot = strchr(key, '.');
+        char actor_name[64], actor_key[64];
+        snprintf(actor_name, sizeof actor_name, "boundary.%.*s", (int)(kdot - key), key);
+        copy_trimmed(actor_key, sizeof actor_key, kdot + 1, strlen(kdot + 1));
+        const int n = actor_section(actor_name);
+        if (n < 0)
+            return fail_unknown_section(where, actor_name, err);
+        CDEM_TRY(check_actor_section(actor_name, where, err));
+        char value[VALUE_MAX];
+        copy_trimmed(value, sizeof value, eq + 1, strlen(eq + 1));
+        size_t vl = strlen(value);
+        if (vl >= 2 && value[0] == '"' && value[vl - 1] == '"') {
+            memmove(value, value + 1, vl - 2);
+            value[vl - 2] = '\0';
+        }
+        return assign_actor(p, n, actor_key, value, 1, where, err);
+    }
     if (!known_section(section))
         return fail_unknown_section(where, section, err);
     const cdem_param_def *d = cdem_params_find(section, key);
@@ -944,7 +1065,30 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
     }
 }
 
-void cdem_params_write(const cdem_params *p, FILE *out) {
+int cdem_params_recorded(const cdem_params *p, const cdem_param_def *d) {
+    if (!d->recorded_when_set)
+        return 1;
+    cdem_params def;
+    memset(&def, 0, sizeof def);
+    if (assign_value(&def, d, d->def, "defaults", NULL) != CDEM_OK)
+        return 1;
+    char a[VALUE_MAX + 4], b[VALUE_MAX + 4];
+    cdem_params_format_value(p, d, a, sizeof a);
+    cdem_params_format_value(&def, d, b, sizeof b);
+    return strcmp(a, b) != 0;
+}
+
+/* The sections [boundary.2] ... of p's actors after the first. */
+static void write_actors(const cdem_params *p, FILE *out) {
+    for (int j = 1; j < cdem_params_actor_count(p); j++)
+        fprintf(out,
+                "\n[boundary.%d]\n# boundary actor %d: these keys over [boundary]'s (start and "
+                "stop its own)\n%s",
+                j + 1, j + 1, p->actor_keys[j - 1]);
+}
+
+/* cdem_params_write (every key) or, with record, cdem_params_write_record. */
+static void write_params(const cdem_params *p, FILE *out, int record) {
     if (!p || !out)
         return;
     fprintf(out, "# cdem-c model parameters (complete; see docs/parameters.md)\n"
@@ -954,15 +1098,96 @@ void cdem_params_write(const cdem_params *p, FILE *out) {
     for (size_t i = 0; i < N_PARAMS; i++) {
         const cdem_param_def *d = &param_table[i];
         if (strcmp(d->section, cur) != 0) {
+            if (strcmp(cur, "boundary") == 0)
+                write_actors(p, out);
             fprintf(out, "\n[%s]\n", d->section);
             cur = d->section;
         }
+        if (record && !cdem_params_recorded(p, d))
+            continue;
         char allowed[256], value[VALUE_MAX + 4];
         describe_allowed(d, allowed, sizeof allowed);
         cdem_params_format_value(p, d, value, sizeof value);
         fprintf(out, "# %s (%s%s%s; default %s)\n%s = %s\n", d->help, d->unit,
                 d->unit[0] ? "; " : "", allowed, d->def[0] ? d->def : "empty", d->key, value);
     }
+    if (strcmp(cur, "boundary") == 0)
+        write_actors(p, out);
+}
+
+void cdem_params_write(const cdem_params *p, FILE *out) {
+    write_params(p, out, 0);
+}
+
+void cdem_params_write_record(const cdem_params *p, FILE *out) {
+    write_params(p, out, 1);
+}
+
+cdem_status cdem_params_set_actor_keys(cdem_params *p, int n, const char *lines, const char *where,
+                                       cdem_error *err) {
+    cdem_params work = *p;
+    for (const char *line = lines; *line;) {
+        const char *eol = strchr(line, '\n');
+        const size_t len = eol ? (size_t)(eol - line) : strlen(line);
+        const char *eq = memchr(line, '=', len);
+        if (len > 0) {
+            char key[64], value[VALUE_MAX];
+            if (!eq)
+                return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [boundary.%d]: not 'key = value': %.*s",
+                                 where, n, (int)len, line);
+            copy_trimmed(key, sizeof key, line, (size_t)(eq - line));
+            if (!clean_value(eq + 1, len - (size_t)(eq + 1 - line), value, sizeof value))
+                return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: [boundary.%d] %s: unterminated quote",
+                                 where, n, key);
+            CDEM_TRY(assign_actor(&work, n, key, value, 0, where, err));
+        }
+        line = eol ? eol + 1 : line + len;
+    }
+    *p = work;
+    return CDEM_OK;
+}
+
+int cdem_params_actor_count(const cdem_params *p) {
+    return p->boundary_actors < 1                      ? 1
+           : p->boundary_actors > CDEM_BOUNDARY_ACTORS ? CDEM_BOUNDARY_ACTORS
+                                                       : p->boundary_actors;
+}
+
+cdem_status cdem_params_actor(const cdem_params *p, int j, cdem_params *out, cdem_error *err) {
+    const int count = cdem_params_actor_count(p);
+    if (j < 0 || j >= count)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "boundary actor %d: the parameters have %d", j + 1,
+                         count);
+    if (out != p)
+        *out = *p;
+    out->boundary_actors = 1;
+    memset(out->actor_keys, 0, sizeof out->actor_keys);
+    if (j == 0)
+        return CDEM_OK;
+    /* the window is the actor's own: start and stop from its section, else their defaults */
+    for (size_t i = 0; i < N_PARAMS; i++)
+        if (param_table[i].recorded_when_set && strcmp(param_table[i].section, "boundary") == 0)
+            CDEM_TRY(assign_value(out, &param_table[i], param_table[i].def, "defaults", err));
+    char where[32];
+    snprintf(where, sizeof where, "[boundary.%d]", j + 1);
+    for (const char *line = p->actor_keys[j - 1]; *line;) {
+        const char *eol = strchr(line, '\n');
+        const size_t len = eol ? (size_t)(eol - line) : strlen(line);
+        const char *eq = memchr(line, '=', len);
+        if (!eq)
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: a line is not 'key = value': %.*s", where,
+                             (int)len, line);
+        char key[64], value[VALUE_MAX];
+        copy_trimmed(key, sizeof key, line, (size_t)(eq - line));
+        if (!clean_value(eq + 1, len - (size_t)(eq + 1 - line), value, sizeof value))
+            return CDEM_FAIL(err, CDEM_ERR_PARSE, "%s: %s: unterminated quote", where, key);
+        const cdem_param_def *d = cdem_params_find("boundary", key);
+        if (!d)
+            return fail_unknown_key(where, "boundary", key, err);
+        CDEM_TRY(assign_value(out, d, value, where, err));
+        line = eol ? eol + 1 : line + len;
+    }
+    return CDEM_OK;
 }
 
 /* Escapes '|' for a markdown table cell. */

@@ -19,6 +19,13 @@
 
 #define CDEM_PATH_MAX 1024
 
+/* Boundary actors (docs/solver.md, "Boundaries on a timeline"): [boundary] is the first, and
+ * [boundary.2] ... [boundary.8] add one each, stepped in order, each a mode with its own keys
+ * and its own window of the run's boundary displacement (start, stop). */
+#define CDEM_BOUNDARY_ACTORS 8
+/* The text an actor's section may hold: its "key = value" lines. */
+#define CDEM_ACTOR_TEXT 2048
+
 typedef enum { CDEM_MATERIAL_GRANULAR = 0, CDEM_MATERIAL_BONDED = 1 } cdem_material_model;
 
 /* Granular contact laws: how the cohesion C0 enters the shear strength of a contact, one
@@ -168,6 +175,14 @@ typedef struct {
     cdem_detachment_sense detachment_sense; /* walls inward (shortening) or outward */
     cdem_walls_choice repose_walls;         /* right wall removed, or both */
     double confining_pressure;              /* biaxial: N/m on the free edges, >= 0 */
+    double window_start; /* m of the run's boundary displacement before the actor moves, >= 0 */
+    double window_stop;  /* m of it at which the actor stops; 0: the end of the run */
+
+    /* [boundary.N], N = 2..boundary_actors: the actors after the first, each the lines
+     * "key = value" of the [boundary] keys its section sets (cdem_params_actor: the others are
+     * [boundary]'s, start and stop their defaults) */
+    int boundary_actors; /* actors in all ([boundary] counts): 1 (0 reads as 1) to 8 */
+    char actor_keys[CDEM_BOUNDARY_ACTORS - 1][CDEM_ACTOR_TEXT];
 
     /* [surface] */
     double overburden_pressure;         /* N/m on the top surface; 0 = off */
@@ -220,6 +235,9 @@ typedef struct {
     int max_exclusive;          /* 1: value must be < max */
     const char *const *choices; /* ENUM: NULL-terminated words */
     const char *help;           /* one line */
+    int recorded_when_set;      /* 1: a run file's parameter record holds it only when it
+                                   differs from its default (keys added since, so that the
+                                   records of runs that leave them alone stay as they were) */
 } cdem_param_def;
 
 /* The table, in file order. */
@@ -280,6 +298,25 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
 
 /* Writes a complete, commented parameter file with the values of p. */
 void cdem_params_write(const cdem_params *p, FILE *out);
+/* As cdem_params_write, for a run file's parameter record: the keys recorded only when set
+ * (cdem_param_def.recorded_when_set) are left out at their default. The text reads back to
+ * the same values. */
+void cdem_params_write_record(const cdem_params *p, FILE *out);
+/* 0 when the record leaves the key out (recorded_when_set and at its default), else 1. */
+int cdem_params_recorded(const cdem_params *p, const cdem_param_def *d);
+
+/* Sets boundary actor n's keys (2 <= n <= CDEM_BOUNDARY_ACTORS, actors 2..n-1 set first) from
+ * their "key = value" lines, as its [boundary.N] section would (a file's record of them);
+ * `where` names the source in messages. */
+cdem_status cdem_params_set_actor_keys(cdem_params *p, int n, const char *lines, const char *where,
+                                       cdem_error *err);
+
+/* The number of boundary actors: 1 + the [boundary.N] sections. */
+int cdem_params_actor_count(const cdem_params *p);
+/* The parameters boundary actor j (0-based; 0 is [boundary]) runs with: p's, with
+ * [boundary.(j+1)]'s keys over [boundary]'s, start and stop from its own section only (their
+ * defaults otherwise); out holds one actor. CDEM_ERR_RANGE for a j that is no actor of p. */
+cdem_status cdem_params_actor(const cdem_params *p, int j, cdem_params *out, cdem_error *err);
 
 /* Writes the parameter table as a markdown table (section, key, type, default, unit,
  * range/values, help) for docs/parameters.md. Added for `cdem-run --params-markdown`. */

@@ -278,7 +278,7 @@ static char *stored_params_text(const cdem_params *p, const cli_args *a, char *f
     for (int i = 0; i < a->n_overrides; i++)
         fprintf(f, " -s %s", a->overrides[i]);
     fputc('\n', f);
-    cdem_params_write(p, f);
+    cdem_params_write_record(p, f);
     fclose(f);
     return buf;
 }

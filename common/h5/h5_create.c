@@ -21,17 +21,24 @@
 /* /parameters: a compound table (name, value, unit as fixed-length strings, each as wide
  * as its longest entry) plus one string attribute per parameter. */
 static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cdem_error *err) {
-    size_t count = 0;
-    const cdem_param_def *table = cdem_params_table(&count);
+    size_t all = 0, count = 0;
+    const cdem_param_def *every = cdem_params_table(&all);
+    /* the rows of the record: a key recorded only when set is left out at its default */
+    const cdem_param_def **rowdef = calloc(all ? all : 1, sizeof *rowdef);
+    if (!rowdef)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory storing %zu parameters", all);
+    for (size_t i = 0; i < all; i++)
+        if (cdem_params_recorded(p, &every[i]))
+            rowdef[count++] = &every[i];
     enum { NAME_MAX_ = 128, VALUE_MAX_ = 2 * CDEM_PATH_MAX + 64 };
     char *names = calloc(count ? count : 1, NAME_MAX_);
     char *values = calloc(count ? count : 1, VALUE_MAX_);
     size_t wn = 1, wv = 1, wu = 1;
     for (size_t i = 0; names && values && i < count; i++) {
         char *name = names + i * NAME_MAX_, *value = values + i * VALUE_MAX_;
-        snprintf(name, NAME_MAX_, "%s.%s", table[i].section, table[i].key);
-        cdem_params_format_value(p, &table[i], value, VALUE_MAX_);
-        size_t lu = strlen(table[i].unit ? table[i].unit : "");
+        snprintf(name, NAME_MAX_, "%s.%s", rowdef[i]->section, rowdef[i]->key);
+        cdem_params_format_value(p, rowdef[i], value, VALUE_MAX_);
+        size_t lu = strlen(rowdef[i]->unit ? rowdef[i]->unit : "");
         wn = strlen(name) + 1 > wn ? strlen(name) + 1 : wn;
         wv = strlen(value) + 1 > wv ? strlen(value) + 1 : wv;
         wu = lu + 1 > wu ? lu + 1 : wu;
@@ -41,13 +48,14 @@ static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cde
     if (!rows) {
         free(names);
         free(values);
+        free(rowdef);
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory storing %zu parameters", count);
     }
     for (size_t i = 0; i < count; i++) {
         memcpy(rows + i * row, names + i * NAME_MAX_, strlen(names + i * NAME_MAX_));
         memcpy(rows + i * row + wn, values + i * VALUE_MAX_, strlen(values + i * VALUE_MAX_));
-        if (table[i].unit)
-            memcpy(rows + i * row + wn + wv, table[i].unit, strlen(table[i].unit));
+        if (rowdef[i]->unit)
+            memcpy(rows + i * row + wn + wv, rowdef[i]->unit, strlen(rowdef[i]->unit));
     }
     cdem_status st = CDEM_OK;
     hid_t tn = h5i_fixed_string_type(wn - 1), tv = h5i_fixed_string_type(wv - 1);
@@ -64,6 +72,15 @@ static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cde
         if (h5i_put_str_attr(ds, names + i * NAME_MAX_, values + i * VALUE_MAX_) < 0)
             st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot write attribute /parameters %s = %s", w->path,
                         names + i * NAME_MAX_, values + i * VALUE_MAX_);
+    /* the boundary actors after the first: one attribute "boundary.N" each, its section's
+     * "key = value" lines (cdem_params_set_actor_keys reads them back) */
+    for (int j = 1; st == CDEM_OK && j < cdem_params_actor_count(p); j++) {
+        char name[32];
+        snprintf(name, sizeof name, "boundary.%d", j + 1);
+        if (h5i_put_str_attr(ds, name, p->actor_keys[j - 1]) < 0)
+            st = H5FAIL(err, CDEM_ERR_IO, "%s: cannot write attribute /parameters %s", w->path,
+                        name);
+    }
     if (ds >= 0)
         H5Dclose(ds);
     H5Pclose(dcpl);
@@ -75,6 +92,7 @@ static cdem_status write_parameters(cdem_h5_writer *w, const cdem_params *p, cde
     free(rows);
     free(names);
     free(values);
+    free(rowdef);
     return st;
 }
 

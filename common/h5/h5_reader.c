@@ -566,6 +566,24 @@ cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_
         }
         free(value);
     }
+    /* the boundary actors after the first (h5_create.c): boundary.2, boundary.3, ... */
+    for (int n = 2; n <= CDEM_BOUNDARY_ACTORS && st == CDEM_OK; n++) {
+        char key[32];
+        snprintf(key, sizeof key, "boundary.%d", n);
+        char *value = NULL;
+        const int rc = h5i_get_str_attr(ds, key, &value);
+        if (rc < 0)
+            st = H5FAIL(err, CDEM_ERR_FORMAT,
+                        "%s: attribute /parameters %s is not a readable string", r->path, key);
+        else if (rc == 0) {
+            char where[CDEM_PATH_MAX + 64];
+            snprintf(where, sizeof where, "%s: stored parameters", r->path);
+            st = cdem_params_set_actor_keys(p, n, value, where, err);
+        }
+        free(value);
+        if (rc > 0)
+            break;
+    }
     H5Dclose(ds);
     return st;
 }

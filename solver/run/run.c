@@ -176,7 +176,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     FILE *f = open_memstream(&r->ckpt.params_eff, &len);
     if (!f)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for the parameter text");
-    cdem_params_write(p, f);
+    cdem_params_write_record(p, f);
     fclose(f);
     r->prog.t_start = r->prog.t_last_log = r->prog.t_mark = run_now();
     r->last_written_step = -1;
