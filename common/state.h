@@ -29,7 +29,13 @@ enum {
     CDEM_FLAG_SURFACE = 1u << 8,      /* top-surface element (overburden acts on it) */
     CDEM_FLAG_BASE = 1u << 9,         /* wall element of the base row (material.base_*) */
     CDEM_FLAG_SALT = 1u << 10,        /* a viscous salt element (salt.layer; solver/step/salt.h) */
+    /* bits 16..22: the element moves with boundary actor 2..8 ([boundary.N]; the first actor's
+     * elements carry CDEM_FLAG_MOVING), as CDEM_FLAG_ACTOR_MOVING(N) */
+    CDEM_FLAG_ACTORS_MOVING = 0x7Fu << 16,
 };
+
+/* The flag of the elements boundary actor n (2..8) moves. */
+#define CDEM_FLAG_ACTOR_MOVING(n) (1u << (14 + (n)))
 
 /* Elements that are integrated by Newton's law: neither wall, fault nor footwall display. */
 #define CDEM_FLAGS_BOUNDARY                                                                        \

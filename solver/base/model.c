@@ -43,6 +43,7 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_model_derive: NULL argument");
     memset(m, 0, sizeof *m);
     m->mode = mode ? *mode : cdem_model_mode_default();
+    m->moving_flag = CDEM_FLAG_MOVING;
     if (!(fabs(m->mode.gravity_tilt) < 90.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "cannot derive the model: the mode tilts gravity by %g degrees: must be "

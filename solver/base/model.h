@@ -16,6 +16,9 @@
 #define CDEM_MODEL_H
 
 #include "params.h"
+#include "state.h"
+
+#include <stdint.h>
 
 #define CDEM_NUM_RADII        4
 #define CDEM_PREGROWTH_LAYERS 24
@@ -123,6 +126,9 @@ typedef struct {
     long settling_steps;           /* steps of settling after each sediment event */
     double sea_level_factor;       /* 0, 0.25, 0.5, 0.75, 1.0 */
     cdem_model_mode mode;          /* what the boundary mode decided (its derive hook) */
+    uint32_t moving_flag;          /* the flag of the elements the boundary actor moves:
+                                      CDEM_FLAG_MOVING (the run's model, its first actor), else
+                                      CDEM_FLAG_ACTOR_MOVING(N) (bc.h, cdem_bc_moving_flag) */
     cdem_salt_model salt;          /* the salt's constants (all 0 without salt) */
 } cdem_model;
 

@@ -21,7 +21,20 @@
  *   walls; the solver removes them through the escape path, histories of the rest kept);
  *   confined (the solver loads the free side edges with boundary.confining_pressure);
  *   measure; save/restore (checkpoints).
- * Ownership: cdem_bc owns its context. Thread safety: one cdem_bc per run. Units: m, s. */
+ *
+ * Boundaries compose (docs/solver.md, "Boundaries on a timeline"). A run holds a list of
+ * boundary actors: [boundary] is the first, [boundary.2] ... [boundary.8] (params.h,
+ * cdem_params_actor) add more, each a mode instance with its own parameters and its own window
+ * of the run's deformation steps (start, stop: metres of the run's boundary displacement),
+ * stepped in order. An actor's mode sees deformation steps counted from its window's start,
+ * and a model whose deformation is its window (cdem_bc_actor_model): its inversion and its
+ * ramps are its window's. Each actor's elements carry its own moving flag (the model's
+ * moving_flag, cdem_bc_moving_flag), so that actors never take each other's elements; a mode
+ * that can be one of several sets `composes` and `adopt` (the other actors' elements that
+ * ride on its block). When an actor's window ends its elements stop (their velocity is set to
+ * 0). A run of one actor without a window goes through exactly the code paths of a run before
+ * actors existed (the refactor guard, scripts/refactor_guard.sh).
+ * Ownership: cdem_bc owns its contexts. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
 
@@ -83,6 +96,13 @@ typedef struct {
      * mode whose frame turns (a tilting margin) sets it here each step; it holds through
      * the steps that do not call the mode (sediment settling), and checkpoints keep it */
     void (*gravity)(const void *ctx, long k, double g, double *gx, double *gy);
+    /* 1: the mode can be one of several boundary actors (it moves only the elements that
+     * carry its model's moving_flag and has an adopt hook); 0: it runs alone */
+    int composes;
+    /* may be NULL; a run of several actors, after every actor's init: flags with the mode's
+     * moving flag the other actors' boundary elements that ride on its moving block (e.g. a
+     * later fault's ramp in a planar fault's hanging wall) */
+    void (*adopt)(void *ctx, cdem_state *s);
     /* Before the run, from the parameters alone (cdem_run_validate, cdem_bc_derive_model, the
      * summary), in this order in the parameter check: */
     /* may be NULL: the mode's own rules, one cdem_rule_add each (the message names the mode,
@@ -100,13 +120,41 @@ typedef struct {
     void (*describe)(const cdem_params *p, const cdem_model *m, FILE *out);
 } cdem_bc_ops;
 
-/* A mode instance: its ops and its private context. */
+/* A boundary actor after the first: its mode instance, parameters, model and window. */
 typedef struct {
-    const cdem_bc_ops *ops;  /* NULL before init */
-    const char *name;        /* the mode's word (common/modes.def), for messages */
-    void *ctx;               /* calloc'd state_size bytes */
+    const cdem_bc_ops *ops;
+    const char *name; /* the mode's word */
+    void *ctx;        /* calloc'd state_size bytes */
+    cdem_params *p;   /* its parameters (cdem_params_actor), owned */
+    cdem_model m;     /* cdem_bc_actor_model */
+    long k_start;     /* deformation steps before it moves */
+    long k_stop;      /* its last deformation step (0: the run's last) */
+} cdem_bc_actor;
+
+/* The boundary of a run: its first actor (the mode of [boundary]) and the actors after it. */
+typedef struct {
+    const cdem_bc_ops *ops;  /* the first actor's; NULL before init */
+    const char *name;        /* the first actor's word (common/modes.def), for messages */
+    void *ctx;               /* the first actor's context, calloc'd state_size bytes */
     double lateral_pressure; /* N/m: boundary.confining_pressure when ops->confined, else 0 */
+    long k_start, k_stop;    /* the first actor's window (0, 0 without one: to the end) */
+    cdem_model m_first;      /* the first actor's model (the run's, without a window) */
+    int n_more;              /* actors after the first */
+    cdem_bc_actor *more;     /* owned, n_more of them */
+    long k_now;              /* the deformation step being applied (the split moves read it) */
 } cdem_bc;
+
+/* The flag of the elements the actor whose model is m moves (a model made by hand, without a
+ * moving_flag, is the first actor's: CDEM_FLAG_MOVING). */
+static inline uint32_t cdem_bc_moving_flag(const cdem_model *m) {
+    return m->moving_flag ? m->moving_flag : (uint32_t)CDEM_FLAG_MOVING;
+}
+
+/* The model boundary actor j (0-based) of p runs with: run_model's, with its moving flag and,
+ * when it has a window, the window as its deformation (total_steps, total_displacement), and
+ * its window in deformation steps (k_start < k <= k_stop; k_stop 0: to the run's end). */
+void cdem_bc_actor_model(const cdem_params *pj, int j, const cdem_model *run_model, cdem_model *out,
+                         long *k_start, long *k_stop);
 
 /* The ops of a registered mode (every row of common/modes.def has them); CDEM_ERR_RANGE
  * naming the modes of parameter files for a value that is no mode. */
@@ -127,7 +175,10 @@ void cdem_bc_describe(const cdem_params *p, const cdem_model *m, FILE *out);
 void cdem_bc_describe_fault(const cdem_params *p, const cdem_model *m, FILE *out);
 void cdem_bc_describe_inversion(const cdem_params *p, const cdem_model *m, FILE *out);
 
-/* Finds the mode of p->mode, allocates its context and runs its init on s. */
+/* Finds the mode of every actor of p (p->mode, then [boundary.N]'s), allocates their
+ * contexts and runs their inits on s in order; with several actors, then their adopt hooks,
+ * and refuses (CDEM_ERR_CONFLICT, naming both sections) two actors whose windows overlap and
+ * who would move one element both. */
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          cdem_error *err);
 /* k >= 1: the mode's apply (deformation step k); k <= 0: an equilibration step, the mode's
@@ -143,6 +194,8 @@ int cdem_bc_apply_is_boundary_only(const cdem_bc *bc, long k);
  * cdem_bc_apply: the same bits. */
 typedef void (*cdem_bc_move_fn)(const void *ctx, cdem_state *s, long lo, long hi);
 cdem_bc_move_fn cdem_bc_step_move_of(const cdem_bc *bc, long k);
+/* The context the function of cdem_bc_step_move_of is called with. */
+const void *cdem_bc_step_move_ctx(const cdem_bc *bc);
 /* The once-only half of step k's apply (ops->step_begin; the same k, du, dt as
  * cdem_bc_apply). Only when cdem_bc_step_move_of returned a function. */
 cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_error *err);
@@ -151,6 +204,7 @@ cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_e
 int cdem_bc_gravity(const cdem_bc *bc, long k, double g, double *gx, double *gy);
 /* 1 when the mode moves boundaries during equilibration (ops->moves_in_equilibration). */
 int cdem_bc_moves_in_equilibration(const cdem_bc *bc);
+/* m: the first actor's net displacement, plus those of the actors after it. */
 double cdem_bc_net_displacement(const cdem_bc *bc);
 /* Runs the mode's begin_deformation hook (none: *n_remove = 0, keep untouched). */
 cdem_status cdem_bc_begin_deformation(cdem_bc *bc, const cdem_state *s, unsigned char *keep,

@@ -11,7 +11,11 @@
  * whole displacement: a fixed footwall ramp (present when the motion has a normal part) and
  * a hanging-wall ramp moving with the block (present when it has a reverse part), which
  * becomes the exposed fault face as the block rises. Ramps and walls never interact with
- * each other (boundary-boundary pairs are skipped). */
+ * each other (boundary-boundary pairs are skipped).
+ * One of several boundary actors (bc.h): its block's elements carry its model's moving flag,
+ * and its adopt hook adds the other actors' fault ramps that lie in its hanging wall (on the
+ * hanging-wall side of its plane), so that a later fault's ramp rides down with this block,
+ * and this block's ramps with a later fault's hanging wall. */
 #include "bc.h"
 #include "checkpoint.h"
 #include "summary_line.h"
@@ -34,6 +38,8 @@ typedef struct {
     long n_ramp_moving;  /* moving hanging-wall ramp elements added */
     double ramp_length;  /* m, length of each ramp along the plane */
     double step_ux, step_uy, step_vx, step_vy; /* this step's move and velocity (step_begin) */
+    uint32_t moving;                           /* the flag of its block (cdem_bc_moving_flag) */
+    int32_t ramp_id_lo, ramp_id_hi;            /* ids of its own ramps: [lo, hi) */
 } planar_ctx;
 
 static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -80,18 +86,20 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     const double sgn = p->fault_sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0;
     c->dir_x = sgn * cos(d);
     c->dir_y = -sgn * sin(d);
+    c->moving = cdem_bc_moving_flag(m);
     /* the hanging-wall block: base right of x_f plus the right lateral wall */
     const double xmid = 0.5 * (xmin_wall + xmax_wall);
     for (size_t i = 0; i < s->n; i++) {
-        s->flags[i] &= ~(uint32_t)CDEM_FLAG_MOVING;
+        s->flags[i] &= ~c->moving;
         if (!(s->flags[i] & CDEM_FLAG_WALL))
             continue;
         const int is_base = s->y[i] <= ymin + tol;
         if ((is_base && s->x[i] > c->x_fault) || (!is_base && s->x[i] > xmid)) {
-            s->flags[i] |= CDEM_FLAG_MOVING;
+            s->flags[i] |= c->moving;
             c->n_moving++;
         }
     }
+    c->ramp_id_lo = s->next_id;
     /* ramps along the plane below the base */
     const int has_normal = p->fault_sense == CDEM_SENSE_NORMAL || c->inversion;
     const int has_reverse = p->fault_sense == CDEM_SENSE_REVERSE || c->inversion;
@@ -100,7 +108,7 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     for (int which = 0; which < 2; which++) {
         if ((which == 0 && !has_normal) || (which == 1 && !has_reverse))
             continue;
-        const uint32_t fl = CDEM_FLAG_FAULT | (which == 1 ? (uint32_t)CDEM_FLAG_MOVING : 0u);
+        const uint32_t fl = CDEM_FLAG_FAULT | (which == 1 ? c->moving : 0u);
         for (long k = 1; k <= nramp; k++) {
             const double sd = (double)k * rbase;
             const double mass = p->density * M_PI * rbase * rbase;
@@ -114,7 +122,25 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
             }
         }
     }
+    c->ramp_id_hi = s->next_id;
     return CDEM_OK;
+}
+
+/* The other actors' fault ramps on the hanging-wall side of the plane join the block: the
+ * plane through (x_f, y_b) dipping toward +x leaves the hanging wall where
+ * (x - x_f) sin d - (y_b - y) cos d > 0. */
+static void planar_adopt(void *vctx, cdem_state *s) {
+    planar_ctx *c = vctx;
+    const double d = c->dip_deg * M_PI / 180.0, sd = sin(d), cd = cos(d);
+    for (size_t i = 0; i < s->n; i++) {
+        if (!(s->flags[i] & CDEM_FLAG_FAULT) || (s->flags[i] & c->moving) ||
+            (s->id[i] >= c->ramp_id_lo && s->id[i] < c->ramp_id_hi))
+            continue;
+        if ((s->x[i] - c->x_fault) * sd - (c->y_base - s->y[i]) * cd > 0.0) {
+            s->flags[i] |= c->moving;
+            c->n_moving++;
+        }
+    }
 }
 
 static cdem_status planar_step_begin(void *vctx, long k, double du, double dt, cdem_error *err) {
@@ -136,8 +162,9 @@ static void planar_step_move(const void *vctx, cdem_state *s, long lo, long hi) 
     const double ux = c->step_ux, uy = c->step_uy, vx = c->step_vx, vy = c->step_vy;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
+    const uint32_t moving = c->moving;
     for (long i = lo; i < hi; i++) {
-        if (fl[i] & CDEM_FLAG_MOVING) {
+        if (fl[i] & moving) {
             x[i] += ux;
             y[i] += uy;
             vxa[i] = vx;
@@ -207,6 +234,8 @@ static const cdem_bc_ops planar_ops = {
     .inverts = 1,                     /* boundary.inversion reverses the block's motion */
     .derive = NULL,                   /* the defaults: gravity, one moving block */
     .describe = planar_describe,      /* sense, location, dip, inversion */
+    .composes = 1,                    /* one of several actors: its own moving flag */
+    .adopt = planar_adopt,            /* the other actors' ramps in its hanging wall */
 };
 
 const cdem_bc_ops *const cdem_bc_planar_fault = &planar_ops;

@@ -302,7 +302,7 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
     /* the rebuild test (cdem_neighbour_needs_rebuild) is made inside the force pass */
     if (list_current &&
         forces_and_kick(it, s, PASS_KICK | PASS_CHECK_MOVED | (drift_in_pass ? PASS_DRIFT : 0u),
-                        move, move ? bc->ctx : NULL) == 0)
+                        move, move ? cdem_bc_step_move_ctx(bc) : NULL) == 0)
         return CDEM_OK;
     CDEM_TRY(check_finite(it, s, err));
     CDEM_TRY(rebuild(it, s, err));
