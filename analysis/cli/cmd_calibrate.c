@@ -15,6 +15,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -407,17 +408,14 @@ static cdem_status measure(const cdem_calib_run *runs, size_t n, cal_measure *ou
     out->phi_err = fit.friction_err * 180 / M_PI;
     out->coh = fit.cohesion / 1e6;
     out->coh_err = fit.cohesion_err / 1e6;
-    double sum = 0, sum2 = 0;
+    double ucs[CDEM_PLOT_MAX_FILES]; /* the peaks of the 0 MPa tests, MPa */
     size_t m = 0;
     for (size_t i = 0; i < n; i++)
-        if (s3[i] == 0) {
-            sum += q[i] / 1e6;
-            sum2 += q[i] / 1e6 * q[i] / 1e6;
-            m++;
-        }
-    out->ucs = m ? sum / (double)m : NAN;
-    out->ucs_err =
-        m > 1 ? sqrt(fmax(0, (sum2 - sum * sum / (double)m) / (double)(m - 1)) / (double)m) : NAN;
+        if (s3[i] == 0)
+            ucs[m++] = q[i] / 1e6;
+    out->ucs = m ? gsl_stats_mean(ucs, 1, m) : NAN;
+    /* the standard error of the mean: the standard deviation (divided by m - 1) over sqrt(m) */
+    out->ucs_err = m > 1 ? gsl_stats_sd_m(ucs, 1, m, out->ucs) / sqrt((double)m) : NAN;
     out->n_runs = n;
     cdem_mohr_runs_free(&tests);
     return CDEM_OK;
