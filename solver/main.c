@@ -406,6 +406,172 @@ static int resume(const cli_args *a, cdem_error *err) {
     return st == CDEM_ERR_INTERRUPTED ? EXIT_INTERRUPTED : EXIT_ERROR;
 }
 
+/* --help, --version and --params-markdown: the texts that need no model. Returns 1 when
+ * one of them was asked for (and printed), else 0. */
+static int print_info(const cli_args *a) {
+    if (a->help) {
+        cdem_cli_help_print(stdout, &run_help);
+        return 1;
+    }
+    if (a->version) {
+        printf("cdem-run %s\n", CDEM_VERSION);
+        return 1;
+    }
+    if (a->params_markdown) {
+        cdem_params_write_markdown(stdout);
+        return 1;
+    }
+    return 0;
+}
+
+/* The effective parameters into p: the defaults, the model file (or "-": standard input)
+ * and the -s overrides in command-line order. *file_text gets the file's text (NULL without
+ * a file; the caller frees it, also after a failure). */
+static cdem_status load_params(const cli_args *a, cdem_params *p, char **file_text,
+                               cdem_error *err) {
+    cdem_params_defaults(p);
+    if (a->model_path && !strcmp(a->model_path, "-")) {
+        /* "-": the parameter file on standard input (generated or piped parameters) */
+        CDEM_TRY(read_stdin(file_text, err));
+        CDEM_TRY(cdem_params_parse_text(p, *file_text, "standard input", err));
+    } else if (a->model_path) {
+        CDEM_TRY(cdem_params_load(p, a->model_path, file_text, err));
+    }
+    for (int i = 0; i < a->n_overrides; i++)
+        CDEM_TRY(cdem_params_override(p, a->overrides[i], err));
+    return CDEM_OK;
+}
+
+/* The model summary on standard output, its element count that of the packing built here. */
+static cdem_status print_summary(const cdem_params *p, const cdem_model *m, cdem_error *err) {
+    long n_int = 0, n_wall = 0;
+    int estimated = 0;
+    cdem_error cerr;
+    cdem_error_clear(&cerr);
+    if (cdem_run_count_elements(p, &n_int, &n_wall, &cerr) != CDEM_OK) {
+        /* The summary checks everything the run checks (issue 35, item 6: a missing,
+         * folder or invalid fault file gave a summary and exit 0, then the run refused
+         * it): an error of the inputs fails it as it would fail the run. Only the room
+         * to build the packing here is not the run's problem: then the count is the
+         * estimate. */
+        if (cerr.code != CDEM_ERR_NOMEM) {
+            *err = cerr;
+            return cerr.code;
+        }
+        n_int = cdem_model_estimate_elements(p);
+        n_wall = 0;
+        estimated = 1;
+    }
+    char *summary = NULL;
+    cdem_status st = cdem_summary_text(p, m, n_int, n_wall, estimated, &summary, err);
+    if (st == CDEM_OK) {
+        fputs(summary, stdout);
+        fflush(stdout);
+    }
+    free(summary);
+    return st;
+}
+
+/* Simulates p into out_path (NULL: no memory was left for its name). Takes file_text (the
+ * model file's text, or NULL), which becomes the stored parameter text or is freed. Returns
+ * the exit code; the messages are printed. */
+static int simulate(const cli_args *a, const cdem_params *p, const char *out_path, char *file_text,
+                    cdem_error *err) {
+    char *params_text = stored_params_text(p, a, file_text);
+    if (!out_path || !params_text) {
+        free(params_text);
+        fprintf(stderr, "cdem-run: out of memory\n");
+        return EXIT_ERROR;
+    }
+
+    install_handlers();
+
+    cdem_run_options opt = {
+        .output_path = out_path,
+        .params_text = params_text,
+        .quiet = a->quiet,
+        .progress_is_tty = isatty(STDERR_FILENO),
+        .log = stderr,
+        .stop_requested = &stop_requested,
+        .max_steps = a->max_steps,
+        .par_min = a->par_min,
+        .ignore_free_space = a->ignore_free_space,
+        .replace = a->force ? CDEM_H5_REPLACE_CDEM : CDEM_H5_REPLACE_NEVER,
+        .no_fsync = a->no_fsync,
+    };
+    cdem_status st = cdem_run(p, &opt, err);
+    free(params_text);
+    if (st == CDEM_OK)
+        return EXIT_OK;
+    if (st == CDEM_ERR_INTERRUPTED) {
+        print_error(err->msg[0] ? err->msg : "interrupted");
+        return EXIT_INTERRUPTED;
+    }
+    print_error(err->msg);
+    return EXIT_ERROR;
+}
+
+/* A model: its parameters, then --print-defaults, or the checks, the summary and (unless
+ * --summary or --dry-run) the simulation. Returns the exit code; the messages are printed. */
+static int run_model(const cli_args *a, cdem_error *err) {
+    cdem_params p;
+    char *file_text = NULL;
+    char *out_path = NULL;
+    int rc = EXIT_ERROR;
+
+    if (load_params(a, &p, &file_text, err) != CDEM_OK)
+        goto fail;
+    if (a->print_defaults) {
+        cdem_params_write(&p, stdout);
+        rc = EXIT_OK;
+        goto done;
+    }
+    if (cdem_run_validate(&p, err) != CDEM_OK) {
+        fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
+                !a->model_path               ? ""
+                : strcmp(a->model_path, "-") ? a->model_path
+                                             : "standard input",
+                a->model_path ? ": " : "");
+        goto fail;
+    }
+    cdem_model m;
+    if (cdem_bc_derive_model(&p, &m, err) != CDEM_OK || cdem_run_check_memory(&p, err) != CDEM_OK)
+        goto fail;
+    int running = !a->summary_only && !a->dry_run;
+    if (running) {
+        out_path = a->output_path ? strdup(a->output_path) : default_output(a->model_path);
+        if (!out_path) {
+            fprintf(stderr, "cdem-run: out of memory\n");
+            goto done;
+        }
+        rc = check_output(a, &m, out_path, err);
+        if (rc != EXIT_OK)
+            goto done;
+        rc = EXIT_ERROR;
+    }
+
+    int want_summary = a->summary_only || a->dry_run || !a->quiet;
+    if (want_summary && print_summary(&p, &m, err) != CDEM_OK)
+        goto fail;
+    if (a->summary_only || a->dry_run) {
+        if (a->dry_run)
+            printf("\ndry run: nothing simulated\n");
+        rc = EXIT_OK;
+        goto done;
+    }
+    rc = simulate(a, &p, out_path, file_text, err);
+    file_text = NULL; /* taken by simulate */
+    goto done;
+
+fail:
+    print_error(err->msg);
+    rc = EXIT_ERROR;
+done:
+    free(out_path);
+    free(file_text);
+    return rc;
+}
+
 int main(int argc, char **argv) {
     cdem_threads_settle_wait_policy(argv);
     cli_args a;
@@ -416,158 +582,15 @@ int main(int argc, char **argv) {
         return EXIT_ERROR;
     }
     int rc = parse_args(argc, argv, &a);
-    if (rc != EXIT_OK) {
-        free(a.overrides);
-        return rc;
-    }
+    if (rc == EXIT_OK) {
 #ifdef _OPENMP
-    if (a.threads > 0)
-        omp_set_num_threads(a.threads);
+        if (a.threads > 0)
+            omp_set_num_threads(a.threads);
 #endif
-    if (a.help) {
-        cdem_cli_help_print(stdout, &run_help);
-        free(a.overrides);
-        return EXIT_OK;
+        cdem_error err;
+        cdem_error_clear(&err);
+        rc = print_info(&a) ? EXIT_OK : a.resume_path ? resume(&a, &err) : run_model(&a, &err);
     }
-    if (a.version) {
-        printf("cdem-run %s\n", CDEM_VERSION);
-        free(a.overrides);
-        return EXIT_OK;
-    }
-    if (a.params_markdown) {
-        cdem_params_write_markdown(stdout);
-        free(a.overrides);
-        return EXIT_OK;
-    }
-
-    cdem_error err;
-    cdem_error_clear(&err);
-    if (a.resume_path) {
-        rc = resume(&a, &err);
-        free(a.overrides);
-        return rc;
-    }
-    cdem_params p;
-    cdem_params_defaults(&p);
-    char *file_text = NULL;
-    char *out_path = NULL;
-    char *summary = NULL;
-    rc = EXIT_ERROR;
-
-    if (a.model_path && !strcmp(a.model_path, "-")) {
-        /* "-": the parameter file on standard input (generated or piped parameters) */
-        if (read_stdin(&file_text, &err) != CDEM_OK ||
-            cdem_params_parse_text(&p, file_text, "standard input", &err) != CDEM_OK)
-            goto fail;
-    } else if (a.model_path && cdem_params_load(&p, a.model_path, &file_text, &err) != CDEM_OK) {
-        goto fail;
-    }
-    for (int i = 0; i < a.n_overrides; i++)
-        if (cdem_params_override(&p, a.overrides[i], &err) != CDEM_OK)
-            goto fail;
-    if (a.print_defaults) {
-        cdem_params_write(&p, stdout);
-        rc = EXIT_OK;
-        goto done;
-    }
-    if (cdem_run_validate(&p, &err) != CDEM_OK) {
-        fprintf(stderr, "cdem-run: %s%sthe parameters cannot be used as they are:\n",
-                !a.model_path               ? ""
-                : strcmp(a.model_path, "-") ? a.model_path
-                                            : "standard input",
-                a.model_path ? ": " : "");
-        goto fail;
-    }
-    cdem_model m;
-    if (cdem_bc_derive_model(&p, &m, &err) != CDEM_OK || cdem_run_check_memory(&p, &err) != CDEM_OK)
-        goto fail;
-    int running = !a.summary_only && !a.dry_run;
-    if (running) {
-        out_path = a.output_path ? strdup(a.output_path) : default_output(a.model_path);
-        if (!out_path) {
-            fprintf(stderr, "cdem-run: out of memory\n");
-            goto done;
-        }
-        rc = check_output(&a, &m, out_path, &err);
-        if (rc != EXIT_OK)
-            goto done;
-        rc = EXIT_ERROR;
-    }
-
-    int want_summary = a.summary_only || a.dry_run || !a.quiet;
-    if (want_summary) {
-        long n_int = 0, n_wall = 0;
-        int estimated = 0;
-        cdem_error cerr;
-        cdem_error_clear(&cerr);
-        if (cdem_run_count_elements(&p, &n_int, &n_wall, &cerr) != CDEM_OK) {
-            /* The summary checks everything the run checks (issue 35, item 6: a missing,
-             * folder or invalid fault file gave a summary and exit 0, then the run refused
-             * it): an error of the inputs fails it as it would fail the run. Only the room
-             * to build the packing here is not the run's problem: then the count is the
-             * estimate. */
-            if (cerr.code != CDEM_ERR_NOMEM) {
-                err = cerr;
-                goto fail;
-            }
-            n_int = cdem_model_estimate_elements(&p);
-            n_wall = 0;
-            estimated = 1;
-        }
-        if (cdem_summary_text(&p, &m, n_int, n_wall, estimated, &summary, &err) != CDEM_OK)
-            goto fail;
-        fputs(summary, stdout);
-        fflush(stdout);
-    }
-    if (a.summary_only || a.dry_run) {
-        if (a.dry_run)
-            printf("\ndry run: nothing simulated\n");
-        rc = EXIT_OK;
-        goto done;
-    }
-
-    char *params_text = stored_params_text(&p, &a, file_text);
-    file_text = NULL; /* owned by params_text now (or freed) */
-    if (!out_path || !params_text) {
-        free(params_text);
-        fprintf(stderr, "cdem-run: out of memory\n");
-        goto done;
-    }
-
-    install_handlers();
-
-    cdem_run_options opt = {
-        .output_path = out_path,
-        .params_text = params_text,
-        .quiet = a.quiet,
-        .progress_is_tty = isatty(STDERR_FILENO),
-        .log = stderr,
-        .stop_requested = &stop_requested,
-        .max_steps = a.max_steps,
-        .par_min = a.par_min,
-        .ignore_free_space = a.ignore_free_space,
-        .replace = a.force ? CDEM_H5_REPLACE_CDEM : CDEM_H5_REPLACE_NEVER,
-        .no_fsync = a.no_fsync,
-    };
-    cdem_status st = cdem_run(&p, &opt, &err);
-    free(params_text);
-    if (st == CDEM_OK) {
-        rc = EXIT_OK;
-    } else if (st == CDEM_ERR_INTERRUPTED) {
-        print_error(err.msg[0] ? err.msg : "interrupted");
-        rc = EXIT_INTERRUPTED;
-    } else {
-        goto fail;
-    }
-    goto done;
-
-fail:
-    print_error(err.msg);
-    rc = EXIT_ERROR;
-done:
-    free(summary);
-    free(out_path);
-    free(file_text);
     free(a.overrides);
     return rc;
 }

@@ -15,6 +15,7 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -387,29 +388,36 @@ typedef struct {
  * the 0 MPa tests (its standard error over the seeds). */
 static cdem_status measure(const cdem_calib_run *runs, size_t n, cal_measure *out,
                            cdem_error *err) {
+    if (n > CDEM_PLOT_MAX_FILES)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%zu runs: at most %d at once", n,
+                         CDEM_PLOT_MAX_FILES);
     const char *files[CDEM_PLOT_MAX_FILES];
-    double s3[CDEM_PLOT_MAX_FILES], q[CDEM_PLOT_MAX_FILES];
     for (size_t i = 0; i < n; i++)
         files[i] = runs[i].path;
-    CDEM_TRY(cdem_cmd_mohr_peaks(files, n, s3, q, err));
+    cdem_mohr_runs tests;
     cdem_mohr_fit fit;
-    CDEM_TRY(cdem_mohr_fit_envelope(s3, q, n, &fit, err));
+    cdem_status st = cdem_mohr_read_runs(files, n, &tests, err);
+    if (st == CDEM_OK)
+        st = cdem_mohr_fit_envelope(tests.sigma3, tests.q, n, &fit, err);
+    if (st != CDEM_OK) {
+        cdem_mohr_runs_free(&tests);
+        return st;
+    }
+    const double *s3 = tests.sigma3, *q = tests.q;
     out->phi = fit.friction * 180 / M_PI;
     out->phi_err = fit.friction_err * 180 / M_PI;
     out->coh = fit.cohesion / 1e6;
     out->coh_err = fit.cohesion_err / 1e6;
-    double sum = 0, sum2 = 0;
+    double ucs[CDEM_PLOT_MAX_FILES]; /* the peaks of the 0 MPa tests, MPa */
     size_t m = 0;
     for (size_t i = 0; i < n; i++)
-        if (s3[i] == 0) {
-            sum += q[i] / 1e6;
-            sum2 += q[i] / 1e6 * q[i] / 1e6;
-            m++;
-        }
-    out->ucs = m ? sum / (double)m : NAN;
-    out->ucs_err =
-        m > 1 ? sqrt(fmax(0, (sum2 - sum * sum / (double)m) / (double)(m - 1)) / (double)m) : NAN;
+        if (s3[i] == 0)
+            ucs[m++] = q[i] / 1e6;
+    out->ucs = m ? gsl_stats_mean(ucs, 1, m) : NAN;
+    /* the standard error of the mean: the standard deviation (divided by m - 1) over sqrt(m) */
+    out->ucs_err = m > 1 ? gsl_stats_sd_m(ucs, 1, m, out->ucs) / sqrt((double)m) : NAN;
     out->n_runs = n;
+    cdem_mohr_runs_free(&tests);
     return CDEM_OK;
 }
 

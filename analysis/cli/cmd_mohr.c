@@ -1,4 +1,5 @@
-/* cmd_mohr: `cdem-strain mohr`; its help (below) says what it does. */
+/* cmd_mohr: `cdem-strain mohr`; its help (below) says what it does. The tests are read and
+ * fitted by mohr.h; this file parses, prints and draws. */
 #include "cmd_plot.h"
 #include "cmd_support.h"
 #include "commands.h"
@@ -34,73 +35,9 @@ static const cdem_cli_help help = {
 
 #define MOHR_CIRCLE_POINTS 181
 
-/* Curves and peak values of the biaxial runs (owned arrays). */
-typedef struct {
-    double *sigma3, *q;                  /* per test, N/m */
-    double *strain[CDEM_PLOT_MAX_FILES]; /* axial strain per sample, per run */
-    double *stress[CDEM_PLOT_MAX_FILES]; /* differential stress per sample (MPa), per run */
-    size_t n_samples[CDEM_PLOT_MAX_FILES];
-    size_t n; /* tests */
-} mohr_data;
-
-static void mohr_data_free(mohr_data *d) {
-    free(d->sigma3);
-    free(d->q);
-    for (size_t i = 0; i < CDEM_PLOT_MAX_FILES; i++) {
-        free(d->strain[i]);
-        free(d->stress[i]);
-    }
-}
-
-static cdem_status mohr_read_runs(const cdem_plot_args *a, mohr_data *d, cdem_error *err) {
-    d->sigma3 = malloc(a->n_files * sizeof(double));
-    d->q = malloc(a->n_files * sizeof(double));
-    if (!d->sigma3 || !d->q)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu runs", a->n_files);
-    for (size_t i = 0; i < a->n_files; i++) {
-        cdem_h5_reader *r;
-        CDEM_TRY(cdem_h5_reader_open(a->files[i], &r, err));
-        cdem_params p;
-        cdem_series_sample *smp = NULL;
-        size_t n = 0;
-        cdem_status st = cdem_h5_reader_params(r, &p, err);
-        if (st == CDEM_OK)
-            st = cdem_h5_reader_read_series(r, &smp, &n, err);
-        cdem_h5_reader_close(r);
-        if (st == CDEM_OK && p.mode != CDEM_MODE_BIAXIAL)
-            st = CDEM_FAIL(err, CDEM_ERR_INVALID,
-                           "%s is a '%s' run; mohr needs biaxial test runs (boundary.mode = "
-                           "biaxial)",
-                           a->files[i], cdem_mode_name(p.mode));
-        if (st == CDEM_OK && n == 0)
-            st = CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s has no time-series samples", a->files[i]);
-        if (st == CDEM_OK) {
-            d->strain[i] = malloc(n * sizeof(double));
-            d->stress[i] = malloc(n * sizeof(double));
-            if (!d->strain[i] || !d->stress[i])
-                st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu samples", n);
-        }
-        if (st == CDEM_OK) {
-            double peak = -INFINITY;
-            for (size_t k = 0; k < n; k++) {
-                d->strain[i][k] = smp[k].axial_strain;
-                d->stress[i][k] = smp[k].differential_stress / 1e6;
-                if (isfinite(smp[k].differential_stress))
-                    peak = fmax(peak, smp[k].differential_stress);
-            }
-            d->n_samples[i] = n;
-            d->sigma3[i] = p.confining_pressure;
-            d->q[i] = peak;
-        }
-        free(smp);
-        if (st != CDEM_OK)
-            return st;
-    }
-    d->n = a->n_files;
-    return CDEM_OK;
-}
-
-static cdem_status mohr_figure(const cdem_plot_args *a, const mohr_data *d,
+/* The picture: the stress-strain curves of the runs (none with --data) and the Mohr circles
+ * of the tests with the envelope. */
+static cdem_status mohr_figure(const cdem_plot_args *a, const cdem_mohr_runs *d,
                                const cdem_mohr_fit *fit, cdem_error *err) {
     size_t nt = d->n, runs = a->n_files;
     cdem_plot_series ser[CDEM_PLOT_MAX_FILES + 2];
@@ -177,10 +114,10 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
     if (!a.data && a.n_files < 2)
         return cdem_cmd_usage(&help, "need at least 2 biaxial runs (or --data FILE)");
     cdem_error err;
-    mohr_data d;
+    cdem_mohr_runs d;
     memset(&d, 0, sizeof d);
     cdem_status st = a.data ? cdem_mohr_read_table(a.data, &d.sigma3, &d.q, &d.n, &err)
-                            : mohr_read_runs(&a, &d, &err);
+                            : cdem_mohr_read_runs(a.files, a.n_files, &d, &err);
     cdem_mohr_fit fit;
     if (st == CDEM_OK)
         st = cdem_mohr_fit_envelope(d.sigma3, d.q, d.n, &fit, &err);
@@ -199,28 +136,8 @@ int cdem_cmd_plot_mohr(int argc, char **argv) {
     }
     if (st == CDEM_OK && a.out)
         st = mohr_figure(&a, &d, &fit, &err);
-    mohr_data_free(&d);
+    cdem_mohr_runs_free(&d);
     return st == CDEM_OK ? 0 : cdem_cmd_fail(a.cmd, NULL, &err);
-}
-
-/* The peaks of runs given by name (cdem-strain calibrate): sigma3 and q of each, N/m. */
-cdem_status cdem_cmd_mohr_peaks(const char *const *files, size_t n, double *sigma3, double *q,
-                                cdem_error *err) {
-    if (n > CDEM_PLOT_MAX_FILES)
-        return CDEM_FAIL(err, CDEM_ERR_RANGE, "%zu runs: at most %d at once", n,
-                         CDEM_PLOT_MAX_FILES);
-    cdem_plot_args a = {.cmd = "mohr", .help = &help, .n_files = n};
-    for (size_t i = 0; i < n; i++)
-        a.files[i] = files[i];
-    mohr_data d;
-    memset(&d, 0, sizeof d);
-    cdem_status st = mohr_read_runs(&a, &d, err);
-    for (size_t i = 0; st == CDEM_OK && i < n; i++) {
-        sigma3[i] = d.sigma3[i];
-        q[i] = d.q[i];
-    }
-    mohr_data_free(&d);
-    return st;
 }
 
 /* mohr's picture of runs given by name, with the envelope fitted to all of them
@@ -233,15 +150,14 @@ cdem_status cdem_cmd_mohr_picture(const char *const *files, size_t n, const char
     cdem_plot_args a = {.cmd = "mohr", .help = &help, .n_files = n, .out = out};
     for (size_t i = 0; i < n; i++)
         a.files[i] = files[i];
-    mohr_data d;
-    memset(&d, 0, sizeof d);
+    cdem_mohr_runs d;
     cdem_mohr_fit fit;
-    cdem_status st = mohr_read_runs(&a, &d, err);
+    cdem_status st = cdem_mohr_read_runs(files, n, &d, err);
     if (st == CDEM_OK)
         st = cdem_mohr_fit_envelope(d.sigma3, d.q, d.n, &fit, err);
     if (st == CDEM_OK)
         st = mohr_figure(&a, &d, &fit, err);
-    mohr_data_free(&d);
+    cdem_mohr_runs_free(&d);
     return st;
 }
 

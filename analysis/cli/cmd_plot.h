@@ -72,12 +72,9 @@ int cdem_cmd_plot_parse_one(int argc, char **argv, cdem_plot_args *a);
 cdem_status cdem_cmd_plot_open_increment(const cdem_plot_args *a, cdem_h5_reader **r, cdem_state *s,
                                          cdem_increment_info *info, cdem_error *err);
 
-/* mohr's reading and picture for cdem-strain calibrate (cmd_mohr.c): the peak differential
- * stress q and confining pressure sigma3 (N/m) of each of n <= CDEM_PLOT_MAX_FILES biaxial
- * runs; the stress-strain curves and Mohr circles of the runs with the envelope fitted to
- * all of them, into out (.png, .pdf, .svg). */
-cdem_status cdem_cmd_mohr_peaks(const char *const *files, size_t n, double *sigma3, double *q,
-                                cdem_error *err);
+/* mohr's picture for cdem-strain calibrate (cmd_mohr.c): the stress-strain curves and Mohr
+ * circles of n <= CDEM_PLOT_MAX_FILES biaxial runs with the envelope fitted to all of them,
+ * into out (.png, .pdf, .svg). (Their peaks: cdem_mohr_read_runs, mohr.h.) */
 cdem_status cdem_cmd_mohr_picture(const char *const *files, size_t n, const char *out,
                                   cdem_error *err);
 

@@ -47,15 +47,25 @@ static cdem_status alloc_axes(cdem_axes *a, size_t n, cdem_error *err) {
     return CDEM_OK;
 }
 
-/* Shared driver: stress = 0 for strain axes (ref required), 1 for stress axes. */
-static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double spacing,
-                            int stress, cdem_axes *out, cdem_error *err) {
-    memset(out, 0, sizeof *out);
+/* The node grid of an axes computation: nx x ny nodes at (xmin + i spacing,
+ * ymin + j spacing), numbered row by row. */
+typedef struct {
+    double xmin, ymin, spacing;
+    double rmax; /* the largest radius: a node's nearest element must be this near */
+    size_t nx, ny;
+} axes_grid;
+
+/* The node grid over cur's bounding box (spacing <= 0: 2 x the largest radius); g->nx = 0
+ * when there is nothing to fit (no elements, no finite position, no usable spacing). Refuses
+ * an absurd extent (never thrash). */
+static cdem_status axes_grid_of(const cdem_state *cur, double spacing, axes_grid *g,
+                                cdem_error *err) {
+    memset(g, 0, sizeof *g);
     const double rmax = cdem_strain_max_radius(cur);
     if (!(spacing > 0.0))
         spacing = 2.0 * rmax;
     if (!(spacing > 0.0) || !isfinite(spacing) || cur->n == 0)
-        return alloc_axes(out, 0, err);
+        return CDEM_OK;
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
     for (size_t i = 0; i < cur->n; i++) {
         if (!isfinite(cur->x[i]) || !isfinite(cur->y[i]))
@@ -66,14 +76,140 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
         ymax = fmax(ymax, cur->y[i]);
     }
     if (!(xmax >= xmin))
-        return alloc_axes(out, 0, err);
+        return CDEM_OK;
     const double span_x = floor((xmax - xmin) / spacing) + 1,
                  span_y = floor((ymax - ymin) / spacing) + 1;
     if (span_x * span_y > 4.0 * (double)cur->n + 1e4) /* absurd extent: refuse, never thrash */
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "axes: grid of %.0f x %.0f nodes at spacing %g m is too large", span_x,
                          span_y, spacing);
-    const size_t nx = (size_t)span_x, ny = (size_t)span_y, nn = nx * ny;
+    *g = (axes_grid){.xmin = xmin,
+                     .ymin = ymin,
+                     .spacing = spacing,
+                     .rmax = rmax,
+                     .nx = (size_t)span_x,
+                     .ny = (size_t)span_y};
+    return CDEM_OK;
+}
+
+/* What the per-node fits read. */
+typedef struct {
+    const cdem_state *cur;
+    const double *ref_x, *ref_y;  /* strain axes: reference position of each element of cur
+                                     (NaN when absent from the reference) */
+    const cdem_grid_index *index; /* cur's elements binned at the grid spacing */
+    int stress;                   /* 1 stress axes, 0 strain axes */
+} axes_input;
+
+/* The axes at node (px, py): the direction of S1 (or sigma1) into *angle1 and the maximum
+ * shear into *value; 0 when the node is left out (axes.h: no non-wall element nearest
+ * within the largest radius, no element to fit, or an undefined or isotropic fit). */
+static int node_axes(const axes_input *in, const axes_grid *g, double px, double py, double *angle1,
+                     double *value) {
+    const cdem_state *cur = in->cur;
+    const cdem_grid_index *index = in->index;
+    const double *ux = in->ref_x, *uy = in->ref_y;
+    const double spacing = g->spacing, rmax = g->rmax;
+    cdem_grid_box box;
+    if (!cdem_grid_index_range(index, px, py, spacing, &box))
+        return 0;
+    double X[64], Y[64], U[64], V[64];
+    size_t m = 0, nearest = SIZE_MAX;
+    double dnear = INFINITY, s_xx = 0, s_yy = 0, s_xy = 0, mx = 0, my = 0;
+    for (size_t cy = box.y_lo; cy <= box.y_hi; cy++)
+        for (size_t cx = box.x_lo; cx <= box.x_hi; cx++) {
+            const size_t c = cy * index->grid.nx + cx;
+            for (int32_t q = index->start[c]; q < index->start[c + 1]; q++) {
+                const size_t j = (size_t)index->items[q];
+                const double dx = cur->x[j] - px, dy = cur->y[j] - py, d2 = dx * dx + dy * dy;
+                if (d2 > spacing * spacing)
+                    continue;
+                if (d2 < dnear) {
+                    dnear = d2;
+                    nearest = j;
+                }
+                if (cur->flags[j] & CDEM_FLAGS_BOUNDARY)
+                    continue;
+                if (in->stress) {
+                    s_xx += cur->sxx[j];
+                    s_yy += cur->syy[j];
+                    s_xy += cur->sxy[j];
+                    m++;
+                } else if (isfinite(ux[j]) && m < 64) {
+                    X[m] = ux[j];
+                    Y[m] = uy[j];
+                    U[m] = cur->x[j] - ux[j];
+                    V[m] = cur->y[j] - uy[j];
+                    mx += X[m];
+                    my += Y[m];
+                    m++;
+                }
+            }
+        }
+    if (nearest == SIZE_MAX || (cur->flags[nearest] & CDEM_FLAGS_BOUNDARY) || dnear > rmax * rmax ||
+        m == 0)
+        return 0;
+    double a1, val;
+    if (in->stress) {
+        cdem_stress_principal p;
+        cdem_stress_principal_from(s_xx / (double)m, s_yy / (double)m, s_xy / (double)m, &p);
+        a1 = p.angle1;
+        val = p.max_shear;
+    } else {
+        mx /= (double)m;
+        my /= (double)m;
+        for (size_t q = 0; q < m; q++) {
+            X[q] -= mx;
+            Y[q] -= my;
+        }
+        double grad[4];
+        if (!cdem_strain_fit(m, X, Y, U, V, grad, NULL))
+            return 0;
+        cdem_strain_measures sm;
+        cdem_strain_measures_from_gradient(grad, &sm);
+        a1 = sm.angle1;
+        val = sm.max_shear;
+    }
+    if (!isfinite(a1))
+        return 0;
+    *angle1 = a1;
+    *value = val;
+    return 1;
+}
+
+/* The nodes k of all with keep[k] set, in node order, into out (allocated here). */
+static cdem_status kept_nodes(const cdem_axes *all, const unsigned char *keep, size_t nn,
+                              double spacing, cdem_axes *out, cdem_error *err) {
+    size_t kept = 0;
+    for (size_t k = 0; k < nn; k++)
+        kept += keep[k];
+    CDEM_TRY(alloc_axes(out, kept, err));
+    out->spacing = spacing;
+    for (size_t k = 0; k < nn; k++) {
+        if (!keep[k])
+            continue;
+        size_t j = out->n++;
+        out->x[j] = all->x[k];
+        out->y[j] = all->y[k];
+        out->angle1[j] = all->angle1[k];
+        out->angle3[j] = all->angle3[k];
+        out->shear_a[j] = all->shear_a[k];
+        out->shear_b[j] = all->shear_b[k];
+        out->value[j] = all->value[k];
+    }
+    return CDEM_OK;
+}
+
+/* Shared driver: stress = 0 for strain axes (ref required), 1 for stress axes. The nodes
+ * are fitted in parallel, each into its own slot of `all`; kept_nodes then compacts them. */
+static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double spacing,
+                            int stress, cdem_axes *out, cdem_error *err) {
+    memset(out, 0, sizeof *out);
+    axes_grid g;
+    CDEM_TRY(axes_grid_of(cur, spacing, &g, err));
+    if (g.nx == 0)
+        return alloc_axes(out, 0, err);
+    const size_t nx = g.nx, nn = g.nx * g.ny;
 
     cdem_id_map ref_map = {0};
     double *ux = NULL, *uy = NULL;
@@ -101,75 +237,18 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
             uy[i] = r == SIZE_MAX ? NAN : ref->y[r];
         }
     }
-    st = cdem_grid_index_build(&grid, cur->x, cur->y, cur->n, NULL, spacing, err);
+    st = cdem_grid_index_build(&grid, cur->x, cur->y, cur->n, NULL, g.spacing, err);
     if (st != CDEM_OK)
         goto done;
+    const axes_input in = {.cur = cur, .ref_x = ux, .ref_y = uy, .index = &grid, .stress = stress};
     const long nnl = (long)nn;
 #pragma omp parallel for schedule(static)
     for (long kk = 0; kk < nnl; kk++) {
         const size_t k = (size_t)kk;
-        const double px = xmin + (double)(k % nx) * spacing, py = ymin + (double)(k / nx) * spacing;
-        cdem_grid_box box;
-        if (!cdem_grid_index_range(&grid, px, py, spacing, &box))
-            continue;
-        double X[64], Y[64], U[64], V[64];
-        size_t m = 0, nearest = SIZE_MAX;
-        double dnear = INFINITY, s_xx = 0, s_yy = 0, s_xy = 0, mx = 0, my = 0;
-        for (size_t cy = box.y_lo; cy <= box.y_hi; cy++)
-            for (size_t cx = box.x_lo; cx <= box.x_hi; cx++) {
-                const size_t c = cy * grid.grid.nx + cx;
-                for (int32_t q = grid.start[c]; q < grid.start[c + 1]; q++) {
-                    const size_t j = (size_t)grid.items[q];
-                    const double dx = cur->x[j] - px, dy = cur->y[j] - py, d2 = dx * dx + dy * dy;
-                    if (d2 > spacing * spacing)
-                        continue;
-                    if (d2 < dnear) {
-                        dnear = d2;
-                        nearest = j;
-                    }
-                    if (cur->flags[j] & CDEM_FLAGS_BOUNDARY)
-                        continue;
-                    if (stress) {
-                        s_xx += cur->sxx[j];
-                        s_yy += cur->syy[j];
-                        s_xy += cur->sxy[j];
-                        m++;
-                    } else if (isfinite(ux[j]) && m < 64) {
-                        X[m] = ux[j];
-                        Y[m] = uy[j];
-                        U[m] = cur->x[j] - ux[j];
-                        V[m] = cur->y[j] - uy[j];
-                        mx += X[m];
-                        my += Y[m];
-                        m++;
-                    }
-                }
-            }
-        if (nearest == SIZE_MAX || (cur->flags[nearest] & CDEM_FLAGS_BOUNDARY) ||
-            dnear > rmax * rmax || m == 0)
-            continue;
+        const double px = g.xmin + (double)(k % nx) * g.spacing,
+                     py = g.ymin + (double)(k / nx) * g.spacing;
         double a1, val;
-        if (stress) {
-            cdem_stress_principal p;
-            cdem_stress_principal_from(s_xx / (double)m, s_yy / (double)m, s_xy / (double)m, &p);
-            a1 = p.angle1;
-            val = p.max_shear;
-        } else {
-            mx /= (double)m;
-            my /= (double)m;
-            for (size_t q = 0; q < m; q++) {
-                X[q] -= mx;
-                Y[q] -= my;
-            }
-            double g[4];
-            if (!cdem_strain_fit(m, X, Y, U, V, g, NULL))
-                continue;
-            cdem_strain_measures sm;
-            cdem_strain_measures_from_gradient(g, &sm);
-            a1 = sm.angle1;
-            val = sm.max_shear;
-        }
-        if (!isfinite(a1))
+        if (!node_axes(&in, &g, px, py, &a1, &val))
             continue;
         keep[k] = 1;
         all.x[k] = px;
@@ -180,25 +259,7 @@ static cdem_status axes_run(const cdem_state *ref, const cdem_state *cur, double
         all.shear_b[k] = wrap(a1 - 45.0);
         all.value[k] = val;
     }
-    size_t kept = 0;
-    for (size_t k = 0; k < nn; k++)
-        kept += keep[k];
-    st = alloc_axes(out, kept, err);
-    if (st != CDEM_OK)
-        goto done;
-    out->spacing = spacing;
-    for (size_t k = 0; k < nn; k++) {
-        if (!keep[k])
-            continue;
-        size_t j = out->n++;
-        out->x[j] = all.x[k];
-        out->y[j] = all.y[k];
-        out->angle1[j] = all.angle1[k];
-        out->angle3[j] = all.angle3[k];
-        out->shear_a[j] = all.shear_a[k];
-        out->shear_b[j] = all.shear_b[k];
-        out->value[j] = all.value[k];
-    }
+    st = kept_nodes(&all, keep, nn, g.spacing, out, err);
 done:
     cdem_axes_free(&all);
     free(keep);

@@ -4,6 +4,9 @@
  *   var C = dC/da^2 var a + 2 dC/da dC/db cov(a, b) + dC/db^2 var b. */
 #include "mohr.h"
 
+#include "h5format.h"
+#include "params.h"
+
 #include <errno.h>
 #include <gsl/gsl_fit.h>
 #include <math.h>
@@ -141,4 +144,77 @@ cdem_status cdem_mohr_read_table(const char *path, double **sigma3, double **q, 
         *n = 0;
     }
     return st;
+}
+
+void cdem_mohr_runs_free(cdem_mohr_runs *r) {
+    if (!r)
+        return;
+    for (size_t i = 0; i < r->n; i++) {
+        if (r->strain)
+            free(r->strain[i]);
+        if (r->stress)
+            free(r->stress[i]);
+    }
+    free(r->strain);
+    free(r->stress);
+    free(r->n_samples);
+    free(r->sigma3);
+    free(r->q);
+    memset(r, 0, sizeof *r);
+}
+
+/* Run i of files into d: its confining pressure, its curve and the peak of the curve. */
+static cdem_status read_run(const char *path, size_t i, cdem_mohr_runs *d, cdem_error *err) {
+    cdem_h5_reader *r;
+    CDEM_TRY(cdem_h5_reader_open(path, &r, err));
+    cdem_params p;
+    cdem_series_sample *smp = NULL;
+    size_t n = 0;
+    cdem_status st = cdem_h5_reader_params(r, &p, err);
+    if (st == CDEM_OK)
+        st = cdem_h5_reader_read_series(r, &smp, &n, err);
+    cdem_h5_reader_close(r);
+    if (st == CDEM_OK && p.mode != CDEM_MODE_BIAXIAL)
+        st = CDEM_FAIL(err, CDEM_ERR_INVALID,
+                       "%s is a '%s' run; mohr needs biaxial test runs (boundary.mode = "
+                       "biaxial)",
+                       path, cdem_mode_name(p.mode));
+    if (st == CDEM_OK && n == 0)
+        st = CDEM_FAIL(err, CDEM_ERR_NOTFOUND, "%s has no time-series samples", path);
+    if (st == CDEM_OK) {
+        d->strain[i] = malloc(n * sizeof(double));
+        d->stress[i] = malloc(n * sizeof(double));
+        if (!d->strain[i] || !d->stress[i])
+            st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu samples", n);
+    }
+    if (st == CDEM_OK) {
+        double peak = -INFINITY;
+        for (size_t k = 0; k < n; k++) {
+            d->strain[i][k] = smp[k].axial_strain;
+            d->stress[i][k] = smp[k].differential_stress / 1e6;
+            if (isfinite(smp[k].differential_stress))
+                peak = fmax(peak, smp[k].differential_stress);
+        }
+        d->n_samples[i] = n;
+        d->sigma3[i] = p.confining_pressure;
+        d->q[i] = peak;
+    }
+    free(smp);
+    return st;
+}
+
+cdem_status cdem_mohr_read_runs(const char *const *files, size_t n, cdem_mohr_runs *out,
+                                cdem_error *err) {
+    memset(out, 0, sizeof *out);
+    out->sigma3 = malloc(n * sizeof(double));
+    out->q = malloc(n * sizeof(double));
+    out->strain = calloc(n ? n : 1, sizeof *out->strain);
+    out->stress = calloc(n ? n : 1, sizeof *out->stress);
+    out->n_samples = calloc(n ? n : 1, sizeof *out->n_samples);
+    if (!out->sigma3 || !out->q || !out->strain || !out->stress || !out->n_samples)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "no memory for %zu runs", n);
+    out->n = n;
+    for (size_t i = 0; i < n; i++)
+        CDEM_TRY(read_run(files[i], i, out, err));
+    return CDEM_OK;
 }

@@ -8,8 +8,12 @@
  *   phi = asin((b - 1)/(b + 1)),  C = a / (2 sqrt(b)),
  * and the standard errors follow by linear error propagation (docs/rendering.md,
  * "Mohr-Coulomb fit"). With exactly 2 tests the line is exact and the errors are NaN.
- * Ownership: caller owns arrays. Thread safety: pure functions. Units: stresses N/m (the
- * 2-D model's force per unit length), phi in radians. */
+ * The tests come from biaxial run files (cdem_mohr_read_runs: sigma3 is the run's
+ * boundary.confining_pressure, q the largest differential stress of its time series; the
+ * series are kept for the stress-strain curves of the pictures) or from a text table.
+ * Ownership: caller owns arrays; cdem_mohr_runs owns its arrays (cdem_mohr_runs_free).
+ * Thread safety: pure functions but for the readers (one file each, nothing shared).
+ * Units: stresses N/m (the 2-D model's force per unit length), phi in radians. */
 #ifndef CDEM_MOHR_H
 #define CDEM_MOHR_H
 
@@ -34,6 +38,23 @@ typedef struct {
  * friction angle). */
 cdem_status cdem_mohr_fit_envelope(const double *sigma3, const double *q, size_t n,
                                    cdem_mohr_fit *fit, cdem_error *err);
+
+/* The biaxial tests of n run files (cdem_mohr_read_runs). */
+typedef struct {
+    size_t n;           /* runs */
+    double *sigma3, *q; /* per run: confining pressure and peak differential stress, N/m */
+    double **strain;    /* per run: axial strain of each time-series sample */
+    double **stress;    /* per run: differential stress of each sample, MPa */
+    size_t *n_samples;  /* per run: time-series samples */
+} cdem_mohr_runs;
+
+/* Reads the runs files[0..n): each must be a biaxial run (boundary.mode = biaxial) with
+ * time-series samples; fails naming the file otherwise (or when it cannot be read). q is
+ * the largest finite differential stress of the series (-inf when none is finite: the fit
+ * refuses it). out is freed by cdem_mohr_runs_free, also after a failure. */
+cdem_status cdem_mohr_read_runs(const char *const *files, size_t n, cdem_mohr_runs *out,
+                                cdem_error *err);
+void cdem_mohr_runs_free(cdem_mohr_runs *r);
 
 /* Reads a text table of tests: two whitespace-separated columns sigma3 q (N/m) per line,
  * '#' comments and blank lines ignored. *sigma3 and *q are malloc'd (caller frees). */

@@ -458,10 +458,9 @@ static cdem_status build_csr(cdem_neighbour *nb, size_t n, cdem_error *err) {
     return CDEM_OK;
 }
 
-cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
-                                 int resort, cdem_error *err) {
-    CDEM_TRY(save_carry(nb, s, err));
-    CDEM_TRY(reserve_elements(nb, s->n + 1, err));
+/* (2) Drops the removed elements (keep[i] == 0; keep NULL: none) from the state; oldmap
+ * maps each index before the drop to the index after it (SIZE_MAX: removed). */
+static void drop_removed(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep) {
     const size_t n_old = s->n;
     if (keep) {
         cdem_state_compact(s, keep, nb->oldmap);
@@ -469,8 +468,14 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
         for (size_t i = 0; i < n_old; i++)
             nb->oldmap[i] = i;
     }
-    const size_t n = s->n;
+}
 
+/* (4, the cells) The cell grid of the elements into *g and the cell of each element into cell_of:
+ * cells of at least the largest reach + skin, so every partner is in the 3 x 3 block.
+ * Fails with CDEM_ERR_NUMERIC naming the element when a position is not finite. */
+static cdem_status bin_elements(cdem_neighbour *nb, const cdem_state *s, cdem_grid *g,
+                                cdem_error *err) {
+    const size_t n = s->n;
     /* bounding box, largest radius, finiteness (threaded: minima and maxima do not depend on
      * the order, but for the sign of a zero, which moves no element to another cell) */
     double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY, rmax = 0.0;
@@ -500,11 +505,9 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     if (n == 0) {
         xmin = xmax = ymin = ymax = 0.0;
     }
-    /* cells of at least the largest reach + skin: every partner is in the 3 x 3 block */
-    cdem_grid g;
-    cdem_grid_fit(&g, xmin, xmax, ymin, ymax, 2.0 * rmax * nb->reach_factor + nb->skin,
+    cdem_grid_fit(g, xmin, xmax, ymin, ymax, 2.0 * rmax * nb->reach_factor + nb->skin,
                   4.0 * (double)n + 64.0);
-    const size_t ncells = g.nx * g.ny;
+    const size_t ncells = g->nx * g->ny;
     if (2 * ncells + 1 > nb->ccap) {
         size_t c = next_cap(nb->ccap, 2 * ncells + 1);
         CDEM_TRY(grow((void **)&nb->cell_start, sizeof(int32_t), c, err));
@@ -513,47 +516,56 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     int32_t *restrict cell_of = nb->cell_of;
 #pragma omp parallel for schedule(static) if ((long)n > nb->par_min)
     for (long i = 0; i < (long)n; i++)
-        cell_of[i] = (int32_t)cdem_grid_cell(&g, px[i], py[i]);
-    int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
-    if (do_sort && n > 1) {
-        /* stable counting sort by cell, walls among the free elements of their cells, the
-         * cells taken along the grid's short side first: column by column in a model wider
-         * than high (row by row in a higher one). The force pass cuts the elements into
-         * index ranges, one per thread, so the cut between two chunks then runs across the
-         * short side, and the walls of each side belong to its chunk: the fewest pairs
-         * across the cut, whose cache lines the two cores must exchange every step
-         * (docs/performance.md, "Element order"). New index k holds old index perm[k]. The
-         * keys live in scratch, the sorted indices in cell_items (both free here). */
-        int32_t *key = (int32_t *)nb->scratch;
-        const int columns = g.nx > g.ny;
-        for (size_t i = 0; i < n; i++) {
-            const size_t c = (size_t)nb->cell_of[i];
-            key[i] = (int32_t)(columns ? (c % g.nx) * g.ny + c / g.nx : c);
-        }
-        cdem_grid_sort(key, n, ncells, nb->cell_start, nb->cell_items);
-        size_t *perm = nb->perm;
-        for (size_t k = 0; k < n; k++)
-            perm[k] = (size_t)nb->cell_items[k];
-        permute_state(nb, s);
-        {
-            /* oldmap follows: the element at new index k came from compacted index perm[k] */
-            size_t *inv = (size_t *)nb->scratch;
-            for (size_t k = 0; k < n; k++)
-                inv[perm[k]] = k;
-            for (size_t i = 0; i < n_old; i++)
-                if (nb->oldmap[i] != SIZE_MAX)
-                    nb->oldmap[i] = inv[nb->oldmap[i]];
-        }
-        {
-            /* cell_of follows the permutation */
-            int32_t *tmp = (int32_t *)nb->scratch;
-            for (size_t k = 0; k < n; k++)
-                tmp[k] = nb->cell_of[perm[k]];
-            memcpy(nb->cell_of, tmp, n * sizeof(int32_t));
-        }
-        nb->n_sorts++;
+        cell_of[i] = (int32_t)cdem_grid_cell(g, px[i], py[i]);
+    return CDEM_OK;
+}
+
+/* (3) Permutes the state (n > 1 elements) into cell order, and oldmap (over the n_old
+ * indices before the drop) and cell_of with it: a stable counting sort by cell, walls among
+ * the free elements of their cells, the cells taken along the grid's short side first:
+ * column by column in a model wider than high (row by row in a higher one). The force pass
+ * cuts the elements into index ranges, one per thread, so the cut between two chunks then
+ * runs across the short side, and the walls of each side belong to its chunk: the fewest
+ * pairs across the cut, whose cache lines the two cores must exchange every step
+ * (docs/performance.md, "Element order"). New index k holds old index perm[k]. The keys
+ * live in scratch, the sorted indices in cell_items (both free here). */
+static void resort_by_cell(cdem_neighbour *nb, cdem_state *s, const cdem_grid *g, size_t n_old) {
+    const size_t n = s->n, ncells = g->nx * g->ny;
+    int32_t *key = (int32_t *)nb->scratch;
+    const int columns = g->nx > g->ny;
+    for (size_t i = 0; i < n; i++) {
+        const size_t c = (size_t)nb->cell_of[i];
+        key[i] = (int32_t)(columns ? (c % g->nx) * g->ny + c / g->nx : c);
     }
-    /* counting sort by cell: cell_items lists each cell's elements in ascending index */
+    cdem_grid_sort(key, n, ncells, nb->cell_start, nb->cell_items);
+    size_t *perm = nb->perm;
+    for (size_t k = 0; k < n; k++)
+        perm[k] = (size_t)nb->cell_items[k];
+    permute_state(nb, s);
+    {
+        /* oldmap follows: the element at new index k came from compacted index perm[k] */
+        size_t *inv = (size_t *)nb->scratch;
+        for (size_t k = 0; k < n; k++)
+            inv[perm[k]] = k;
+        for (size_t i = 0; i < n_old; i++)
+            if (nb->oldmap[i] != SIZE_MAX)
+                nb->oldmap[i] = inv[nb->oldmap[i]];
+    }
+    {
+        /* cell_of follows the permutation */
+        int32_t *tmp = (int32_t *)nb->scratch;
+        for (size_t k = 0; k < n; k++)
+            tmp[k] = nb->cell_of[perm[k]];
+        memcpy(nb->cell_of, tmp, n * sizeof(int32_t));
+    }
+    nb->n_sorts++;
+}
+
+/* (4, the lists) Lists each cell's elements (cell_start, cell_items: ascending index, a counting
+ * sort by cell), chooses the distance test at the first build, and for the vector test copies the
+ * positions and radii into cell order. */
+static void list_cells(cdem_neighbour *nb, const cdem_state *s, size_t ncells) {
+    const size_t n = s->n;
     cdem_grid_sort(nb->cell_of, n, ncells, nb->cell_start, nb->cell_items);
     if (nb->simd == 0) {
         const char *req = getenv("CDEM_SIMD");
@@ -561,6 +573,7 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     }
     if (nb->simd == 2) {
         /* the vector test's cell-ordered copies */
+        const double *restrict px = s->x, *restrict py = s->y, *restrict prad = s->radius;
         const int32_t *restrict items = nb->cell_items;
         double *restrict cx = nb->cell_x, *restrict cy = nb->cell_y, *restrict cr = nb->cell_r;
 #pragma omp parallel for schedule(static) if ((long)n > nb->par_min)
@@ -571,63 +584,86 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
             cr[k] = prad[e];
         }
     }
+}
+
+/* (5) on nthr >= 2 threads (above par_min): thread t takes the t-th contiguous element range into
+ * its own buffer; the buffers are then appended in thread order: the same list as the serial loop.
+ */
+static cdem_status enumerate_threaded(cdem_neighbour *nb, const cdem_state *s, const cdem_grid *g,
+                                      int nthr, cdem_error *err) {
+    const size_t n = s->n;
+#pragma omp parallel num_threads(nthr)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
+        cdem_pair_buf *b = &nb->tbuf[t];
+        b->n = 0;
+        b->failed = 0;
+        enumerate(nb, s, g, lo, hi, b, NULL);
+#pragma omp barrier
+#pragma omp single
+        {
+            size_t total = 0;
+            int failed = 0;
+            for (int q = 0; q < nt; q++) {
+                total += nb->tbuf[q].n;
+                failed |= nb->tbuf[q].failed;
+            }
+            nb->np = failed ? SIZE_MAX : total;
+            if (!failed && total > nb->pcap && reserve_pairs(nb, total, NULL) != CDEM_OK)
+                nb->np = SIZE_MAX;
+        }
+        if (nb->np != SIZE_MAX) {
+            size_t off = 0;
+            for (int q = 0; q < t; q++)
+                off += nb->tbuf[q].n;
+            const size_t m = b->n;
+            if (m > 0) { /* a thread with no pairs may never have allocated its buffer */
+                memcpy(nb->pi + off, b->pi, m * sizeof *b->pi);
+                memcpy(nb->pj + off, b->pj, m * sizeof *b->pj);
+                memcpy(nb->R + off, b->R, m * sizeof *b->R);
+                memcpy(nb->cls + off, b->cls, m * sizeof *b->cls);
+                memset(nb->hist + off, 0, m * sizeof *nb->hist);
+            }
+            for (size_t k = 0; k < m; k++) {
+                nb->xs[off + k] = 0.0;
+                nb->pfx[off + k] = 0.0;
+                nb->pfy[off + k] = 0.0;
+            }
+        }
+    }
+    if (nb->np == SIZE_MAX) {
+        nb->np = 0;
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM,
+                         "neighbour list: out of memory for the pairs of a threaded build "
+                         "(%zu elements)",
+                         n);
+    }
+    return CDEM_OK;
+}
+
+/* The phases (1) to (7) of the file's opening note, in order. */
+cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsigned char *keep,
+                                 int resort, cdem_error *err) {
+    CDEM_TRY(save_carry(nb, s, err));
+    CDEM_TRY(reserve_elements(nb, s->n + 1, err));
+    const size_t n_old = s->n;
+    drop_removed(nb, s, keep);
+    const size_t n = s->n;
+    cdem_grid g;
+    CDEM_TRY(bin_elements(nb, s, &g, err));
+    int do_sort = resort > 0 || (resort == 0 && nb->n_builds % nb->resort_every == 0);
+    if (do_sort && n > 1)
+        resort_by_cell(nb, s, &g, n_old);
+    list_cells(nb, s, g.nx * g.ny);
 
     /* enumerate pairs: element i in index order, j > i in the 3 x 3 cells around it */
     nb->np = 0;
     const int nthr = build_threads(nb, n);
-    if (nthr < 2) {
+    if (nthr < 2)
         CDEM_TRY(enumerate(nb, s, &g, 0, n, NULL, err));
-    } else {
-        /* thread t takes the t-th contiguous element range into its own buffer; the buffers
-         * are then appended in thread order: the same list as the serial loop */
-#pragma omp parallel num_threads(nthr)
-        {
-            const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-            const size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
-            cdem_pair_buf *b = &nb->tbuf[t];
-            b->n = 0;
-            b->failed = 0;
-            enumerate(nb, s, &g, lo, hi, b, NULL);
-#pragma omp barrier
-#pragma omp single
-            {
-                size_t total = 0;
-                int failed = 0;
-                for (int q = 0; q < nt; q++) {
-                    total += nb->tbuf[q].n;
-                    failed |= nb->tbuf[q].failed;
-                }
-                nb->np = failed ? SIZE_MAX : total;
-                if (!failed && total > nb->pcap && reserve_pairs(nb, total, NULL) != CDEM_OK)
-                    nb->np = SIZE_MAX;
-            }
-            if (nb->np != SIZE_MAX) {
-                size_t off = 0;
-                for (int q = 0; q < t; q++)
-                    off += nb->tbuf[q].n;
-                const size_t m = b->n;
-                if (m > 0) { /* a thread with no pairs may never have allocated its buffer */
-                    memcpy(nb->pi + off, b->pi, m * sizeof *b->pi);
-                    memcpy(nb->pj + off, b->pj, m * sizeof *b->pj);
-                    memcpy(nb->R + off, b->R, m * sizeof *b->R);
-                    memcpy(nb->cls + off, b->cls, m * sizeof *b->cls);
-                    memset(nb->hist + off, 0, m * sizeof *nb->hist);
-                }
-                for (size_t k = 0; k < m; k++) {
-                    nb->xs[off + k] = 0.0;
-                    nb->pfx[off + k] = 0.0;
-                    nb->pfy[off + k] = 0.0;
-                }
-            }
-        }
-        if (nb->np == SIZE_MAX) {
-            nb->np = 0;
-            return CDEM_FAIL(err, CDEM_ERR_NOMEM,
-                             "neighbour list: out of memory for the pairs of a threaded build "
-                             "(%zu elements)",
-                             n);
-        }
-    }
+    else
+        CDEM_TRY(enumerate_threaded(nb, s, &g, nthr, err));
     CDEM_TRY(build_csr(nb, n, err));
     restore_carry(nb);
     memcpy(nb->x0, s->x, n * sizeof(double));
