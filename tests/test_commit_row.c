@@ -405,7 +405,7 @@ static void test_commit_row_commands(void **state) {
         has(err, "cmd.h5: damaged file: /increments/commit row", row);
         snprintf(needle, sizeof needle, "row %ld (", row);
         has(err, needle, row);
-        has(out, "damaged: damaged file: /increments/commit row", row);
+        has(out, "\ndamaged: /increments/commit row", row);
         assert_null(strstr(err, "..-1"));
         free(out);
         free(err);

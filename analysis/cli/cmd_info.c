@@ -72,9 +72,14 @@ static void print_stop(cdem_h5_reader *r, const char *path) {
  * rows, which increments they cost; the same text as the reader's warning on stderr. */
 static void print_damage(const cdem_h5_reader *r, const char *path) {
     const char *d = cdem_h5_reader_damage(r);
-    const size_t at = strlen(path); /* the text without "RUN.h5: " */
-    if (d[0])
-        printf("damaged: %s\n", !strncmp(d, path, at) && d[at] == ':' ? d + at + 2 : d);
+    const size_t at = strlen(path); /* the text without "RUN.h5: damaged file: " */
+    if (!d[0])
+        return;
+    if (!strncmp(d, path, at) && d[at] == ':')
+        d += at + 2;
+    if (!strncmp(d, "damaged file: ", 14))
+        d += 14;
+    printf("damaged: %s\n", d);
 }
 
 /* info on a file without increments yet (a run that has just started, or was killed
