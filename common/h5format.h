@@ -265,6 +265,18 @@ int cdem_h5_reader_writer_alive(const cdem_h5_reader *r);
  * Increment indices of earlier increments stay valid (increments are only appended). */
 cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *err);
 
+/* Added with issue 46: damaged rows of the commit record (docs/format.md,
+ * "/increments/commit"). A row that fails its checksum costs its own increment, no other:
+ * the file opens, lists every valid increment (before and after it), refuses the damaged
+ * rows' increments by number (and "last" when the last row is damaged) with CDEM_ERR_FORMAT
+ * naming the row, and _open writes one warning naming the file and each row to stderr.
+ * _damage: that warning's text ("" when the record is sound; a torn last row of a killed
+ * writer is no damage). _damaged_increments: 1 when a row that held an increment is
+ * damaged, *last_before (may be NULL) then the number of the last increment listed before
+ * the first such row (-1: none); 0 when none is (a damaged spare row costs nothing). */
+const char *cdem_h5_reader_damage(const cdem_h5_reader *r);
+int cdem_h5_reader_damaged_increments(const cdem_h5_reader *r, int32_t *last_before);
+
 /* The file format version of the open file (1 or CDEM_FORMAT_VERSION). */
 int cdem_h5_reader_format_version(const cdem_h5_reader *r);
 
@@ -301,6 +313,12 @@ cdem_status cdem_h5_check_free_space(const char *path, double bytes_needed, cdem
  * increment it belongs to. CDEM_ERR_NOTFOUND, naming the path, when the file has none. */
 cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *snap,
                                            int32_t *increment_number, cdem_error *err);
+/* Added with issue 46: the same, the newest complete checkpoint of an increment numbered at
+ * most through (a resume must not build on a damaged row); CDEM_ERR_NOTFOUND naming the
+ * limit when none is. */
+cdem_status cdem_h5_reader_read_checkpoint_through(cdem_h5_reader *r, cdem_snapshot *snap,
+                                                   int32_t through, int32_t *increment_number,
+                                                   cdem_error *err);
 
 cdem_status cdem_h5_reader_params(const cdem_h5_reader *r, cdem_params *p, cdem_error *err);
 

@@ -2,6 +2,7 @@
 #include "cmd_options.h"
 
 #include "analysis.h"
+#include "run_file.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -67,20 +68,27 @@ static void print_stop(cdem_h5_reader *r, const char *path) {
            rs.detail[0] ? ": " : "", rs.detail);
 }
 
+/* The "damaged: ..." line of a file whose commit record has damaged rows (issue 46): which
+ * rows, which increments they cost; the same text as the reader's warning on stderr. */
+static void print_damage(const cdem_h5_reader *r, const char *path) {
+    const char *d = cdem_h5_reader_damage(r);
+    const size_t at = strlen(path); /* the text without "RUN.h5: damaged file: " */
+    if (!d[0])
+        return;
+    if (!strncmp(d, path, at) && d[at] == ':')
+        d += at + 2;
+    if (!strncmp(d, "damaged file: ", 14))
+        d += 14;
+    printf("damaged: %s\n", d);
+}
+
 /* info on a file without increments yet (a run that has just started, or was killed
- * before its first increment): the stored texts and "increments: 0". -1 when it has some. */
-static int info_without_increments(const char *path) {
-    cdem_error err;
-    cdem_h5_reader *r = NULL;
-    if (cdem_h5_reader_open(path, &r, &err) != CDEM_OK)
-        return -1; /* open_run reports the problem */
-    if (cdem_h5_reader_increment_count(r) > 0) {
-        cdem_h5_reader_close(r);
-        return -1;
-    }
+ * before its first increment): the stored texts and "increments: 0" (r is closed). */
+static int info_without_increments(cdem_h5_reader *r, const char *path) {
     const char *sum = cdem_h5_reader_summary(r);
     printf("%s%s", sum, sum[0] && sum[strlen(sum) - 1] != '\n' ? "\n" : "");
     print_stop(r, path);
+    print_damage(r, path);
     printf("increments: 0 (%s)\n",
            cdem_h5_reader_writer_alive(r) == 1 ? "none written yet" : "none was written");
     cdem_h5_reader_close(r);
@@ -157,6 +165,11 @@ static int info_json(const cdem_cmd_options *o) {
     }
     fputs(",\n  \"recorded_stop_reason\": ", f);
     json_string(f, cdem_h5_reader_stop_reason(r));
+    fputs(",\n  \"damage\": ", f); /* null, or the reader's warning (issue 46) */
+    if (cdem_h5_reader_damage(r)[0])
+        json_string(f, cdem_h5_reader_damage(r));
+    else
+        fputs("null", f);
     fputs(",\n  \"summary\": ", f);
     json_string(f, cdem_h5_reader_summary(r));
     fprintf(f, ",\n  \"increment_count\": %zu", n);
@@ -209,19 +222,23 @@ static int info_json(const cdem_cmd_options *o) {
 static int cmd_info(const cdem_cmd_options *o) {
     if (o->json)
         return info_json(o);
-    int none = o->file ? info_without_increments(o->file) : -1;
-    if (none >= 0)
-        return none;
+    if (!o->file)
+        return cdem_cmd_usage(o->help, "missing the run file (RUN.h5)");
+    cdem_error err;
+    cdem_h5_reader *r = NULL;
+    if (cdem_h5_reader_open(o->file, &r, &err) != CDEM_OK)
+        return cdem_cmd_fail(NULL, NULL, &err);
+    if (cdem_h5_reader_increment_count(r) == 0)
+        return info_without_increments(r, o->file);
     cdem_analysis *a;
-    int rc = cdem_cmd_open_run(o, &a);
-    if (rc)
-        return rc;
-    cdem_h5_reader *r = cdem_analysis_reader(a);
+    if (cdem_analysis_open_reader(r, o->file, &a, &err) != CDEM_OK)
+        return cdem_cmd_fail(NULL, NULL, &err); /* the reader is closed */
     printf("%s", cdem_h5_reader_summary(r));
     if (cdem_h5_reader_summary(r)[0] &&
         cdem_h5_reader_summary(r)[strlen(cdem_h5_reader_summary(r)) - 1] != '\n')
         printf("\n");
     print_stop(r, o->file);
+    print_damage(r, o->file);
     /* the counts of the summary and the progress line (docs/format.md, "Counting"); the end
      * of equilibration only once known (never the last increment of a run still in it) */
     const size_t n_inc = cdem_analysis_count(a);

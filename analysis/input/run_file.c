@@ -31,6 +31,12 @@ cdem_status cdem_analysis_open(const char *path, cdem_analysis **out, cdem_error
     *out = NULL;
     cdem_h5_reader *r;
     CDEM_TRY(cdem_h5_reader_open(path, &r, err));
+    return cdem_analysis_open_reader(r, path, out, err);
+}
+
+cdem_status cdem_analysis_open_reader(cdem_h5_reader *r, const char *path, cdem_analysis **out,
+                                      cdem_error *err) {
+    *out = NULL;
     cdem_params p;
     cdem_status st = cdem_h5_reader_params(r, &p, err);
     if (st != CDEM_OK) {

@@ -11,5 +11,9 @@
 
 /* Opens the cdem file at path; messages name it. */
 cdem_status cdem_analysis_open(const char *path, cdem_analysis **out, cdem_error *err);
+/* The same over a reader already open on path (the context owns it from now on: it is closed
+ * on failure too), so that a command opens the file once (and warns of damage once). */
+cdem_status cdem_analysis_open_reader(cdem_h5_reader *r, const char *path, cdem_analysis **out,
+                                      cdem_error *err);
 
 #endif

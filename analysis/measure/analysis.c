@@ -253,6 +253,19 @@ cdem_status cdem_analysis_find(const cdem_analysis *a, const char *spec, size_t 
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "increment: empty specification (use a number, "
                          "first, last or equil)");
+    /* a run file whose commit record has a damaged row refuses that row's increment by
+     * number, and "last" when it is the last row (issue 46): said as the reader says it */
+    cdem_h5_reader *r = cdem_analysis_reader(a);
+    if (r && strcmp(spec, "first") != 0 && strcmp(spec, "equil") != 0) {
+        cdem_error e;
+        cdem_error_clear(&e);
+        size_t k = 0;
+        if (cdem_h5_reader_find_increment(r, spec, &k, &e) == CDEM_ERR_FORMAT) {
+            if (err)
+                *err = e;
+            return CDEM_ERR_FORMAT;
+        }
+    }
     if (strcmp(spec, "last") == 0) {
         *index = a->n - 1;
         return CDEM_OK;

@@ -70,6 +70,12 @@ cdem_status cdem_h5_writer_write_checkpoint(cdem_h5_writer *w, const cdem_snapsh
 
 cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *snap,
                                            int32_t *increment_number, cdem_error *err) {
+    return cdem_h5_reader_read_checkpoint_through(r, snap, INT32_MAX, increment_number, err);
+}
+
+cdem_status cdem_h5_reader_read_checkpoint_through(cdem_h5_reader *r, cdem_snapshot *snap,
+                                                   int32_t through, int32_t *increment_number,
+                                                   cdem_error *err) {
     if (!r || !snap || !increment_number)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_h5_reader_read_checkpoint: bad arguments");
     *increment_number = -1;
@@ -101,7 +107,7 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
                     r->path);
     char why[2][CDEM_ERROR_MSG_MAX / 2];
     why[0][0] = why[1][0] = '\0';
-    int tried = 0, found = 0;
+    int tried = 0, found = 0, later = 0;
     int order[2] = {rows[0].sequence >= rows[1].sequence ? 0 : 1,
                     rows[0].sequence >= rows[1].sequence ? 1 : 0};
     for (int o = 0; st == CDEM_OK && o < 2 && !found; o++) {
@@ -109,6 +115,12 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
         if (rows[s].sequence <= 0)
             continue;
         tried++;
+        if (rows[s].increment > through) {
+            snprintf(why[o], sizeof why[o], "slot%d belongs to increment %d, after %d", s,
+                     (int)rows[s].increment, (int)through);
+            later++;
+            continue;
+        }
         hsize_t ext = h5i_extent_of(slot[s]);
         if (rows[s].length < 16 || (uint64_t)rows[s].length > SNAP_MAX_BYTES ||
             (hsize_t)rows[s].length > ext) {
@@ -166,6 +178,10 @@ cdem_status cdem_h5_reader_read_checkpoint(cdem_h5_reader *r, cdem_snapshot *sna
                          dropped > 0 ? " (the run completed and its checkpoints were dropped)"
                                      : "");
     }
+    if (later > 0)
+        return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
+                         "%s: no valid checkpoint of increment %d or before (%s%s%s)", r->path,
+                         (int)through, why[0], why[0][0] && why[1][0] ? "; " : "", why[1]);
     return CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: no valid checkpoint (%s%s%s)", r->path, why[0],
                      why[0][0] && why[1][0] ? "; " : "", why[1]);
 }

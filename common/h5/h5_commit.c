@@ -14,9 +14,16 @@
  *  - a row is written once, at its own place, and never rewritten while it is committed;
  *  - each row carries a checksum (FNV-1a 64) of its members and of its position, so a row a
  *    kill or a power cut tore is invalid, and a row copied to another place is too.
- * So the committed increments are the longest run of valid rows from row 0; everything after
- * it must be blank (never written), except that the first row after it may be torn in a file
- * whose writer did not close it. Anything else is damage, and the reader names the row.
+ * So the committed increments are the valid rows. A writer writes the rows in order, so in a
+ * sound file they are a prefix, everything after them blank (never written), except that the
+ * first row after them may be torn in a file whose writer did not close it (a kill stops a
+ * write only between two pages, so only a row that crosses a page boundary can be torn, and
+ * only into what it was on one side of it: h5i_commit_scan). Any other row is damage: a row
+ * that held an increment (the rows /increments/index has, in a closed file) and fails its
+ * checksum or is blank costs that increment alone, and a spare row that is not blank costs
+ * none; the reader names each in one warning, refuses the damaged rows' increments, and
+ * lists every valid row, before and after them (each row's checksum covers its position, so
+ * a valid row is the writer's row at its place).
  * --resume drops rows by blanking them from the last to the first, each row its own write,
  * so that at any moment the valid rows still form a prefix (h5_resume.c).
  * The writer still appends every row to /increments/index as well, after this record, for
@@ -133,37 +140,106 @@ int h5i_commit_blank_from(hid_t ds, hid_t mtype, hsize_t keep, const commit_row 
     return 0;
 }
 
-const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, int unclosed,
-                            hsize_t *committed, hsize_t *torn, hsize_t *bad_row) {
-    hsize_t k = 0;
-    while (k < capacity && h5i_commit_row_valid(&rows[k], k))
-        k++;
-    *committed = k;
-    *torn = 0;
-    *bad_row = 0;
-    if (k == capacity)
-        return NULL;
-    hsize_t later = k + 1;
-    while (later < capacity && h5i_commit_row_blank(&rows[later]))
-        later++;
-    if (later < capacity) {
-        if (!h5i_commit_row_blank(&rows[k])) {
-            *bad_row = k;
-            return "its checksum does not match its contents, and rows after it are written (a "
-                   "kill tears only the last row)";
-        }
-        *bad_row = later;
-        return "it is written after an unwritten row (only the rows of a prefix can be "
-               "committed)";
+/* 1 when row i (of row_bytes bytes, the record's row 0 at file offset base) can be a row a
+ * killed writer's write tore: the kernel copies a write into the page cache page by page and
+ * a kill stops it only between two pages, so the row must cross a page boundary (a multiple
+ * of 4096 bytes, the smallest page: larger pages' boundaries are among them), and one side
+ * of that boundary must still hold what was there before: zeros after it (an append of the
+ * row stopped there) or zeros before it (--resume's blanking of the row stopped there). A
+ * flipped byte in a row that crosses no boundary cannot be a tear. */
+static int commit_row_tearable(const commit_row *c, hsize_t i, uint64_t base, size_t row_bytes) {
+    unsigned char b[16 * N_INDEX_MEMBERS];
+    size_t n = commit_bytes(&c->row, 0, b) - 8; /* the members, without the position */
+    for (size_t k = 0; k < 8; k++)
+        b[n++] = (unsigned char)(c->checksum >> (8 * k));
+    if (n != row_bytes)
+        return 1; /* not the documented layout: cannot tell, as before */
+    const uint64_t first = base + (uint64_t)i * row_bytes, end = first + row_bytes;
+    for (uint64_t page = (first / 4096 + 1) * 4096; page < end; page += 4096) {
+        const size_t cut = (size_t)(page - first);
+        int zero_after = 1, zero_before = 1;
+        for (size_t k = cut; k < n && zero_after; k++)
+            zero_after = b[k] == 0;
+        for (size_t k = 0; k < cut && zero_before; k++)
+            zero_before = b[k] == 0;
+        if (zero_after || zero_before)
+            return 1;
     }
-    if (!h5i_commit_row_blank(&rows[k])) {
-        if (!unclosed) {
-            *bad_row = k;
-            return "its checksum does not match its contents (a closed file has no torn row)";
+    return 0;
+}
+
+const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, const commit_scan_in *in,
+                            unsigned char *kind, commit_scan_out *out) {
+    memset(out, 0, sizeof *out);
+    out->first_damaged = capacity;
+    hsize_t last_valid = capacity; /* none */
+    for (hsize_t i = 0; i < capacity; i++) {
+        kind[i] = h5i_commit_row_valid(&rows[i], i) ? COMMIT_VALID
+                  : h5i_commit_row_blank(&rows[i])  ? COMMIT_BLANK
+                                                    : COMMIT_DAMAGED;
+        if (kind[i] == COMMIT_VALID) {
+            last_valid = i;
+            out->valid++;
         }
-        *torn = 1; /* the row a killed writer was writing */
     }
+    const hsize_t after = last_valid == capacity ? 0 : last_valid + 1;
+    const hsize_t index_rows = in->index_rows;
+    if (!in->unclosed && index_rows != H5I_ROWS_UNKNOWN) {
+        /* closed: the writer wrote its every row to both, so the index's extent is the number
+         * of rows written (a damaged last row is still a written one) */
+        hsize_t written_rows = 0; /* rows below the index's extent that are not blank */
+        for (hsize_t i = 0; i < index_rows && i < capacity; i++)
+            written_rows += kind[i] != COMMIT_BLANK;
+        out->written = index_rows;
+        if (after > index_rows || (index_rows > 0 && written_rows == 0))
+            return "its rows and /increments/index disagree"; /* blanked, or a valid row beyond */
+    } else {
+        out->written = after;
+        /* a killed writer wrote its index row after its commit row (--resume blanks commit
+         * rows before it shrinks the index): rows below the index's extent that are not blank
+         * were written */
+        if (index_rows != H5I_ROWS_UNKNOWN)
+            for (hsize_t i = after; i < index_rows && i < capacity; i++)
+                if (kind[i] != COMMIT_BLANK)
+                    out->written = i + 1;
+    }
+    /* the first row after the valid ones, in a file whose writer did not close it: the row
+     * it was writing (or blanking) when it was killed, torn, when only blank rows follow */
+    if (in->unclosed && after < capacity && kind[after] == COMMIT_DAMAGED) {
+        int rest_blank = 1;
+        for (hsize_t i = after + 1; i < capacity && rest_blank; i++)
+            rest_blank = kind[i] == COMMIT_BLANK;
+        if (rest_blank &&
+            (in->live || in->record_at == H5I_ROWS_UNKNOWN ||
+             commit_row_tearable(&rows[after], after, in->record_at, in->row_bytes))) {
+            kind[after] = COMMIT_TORN;
+            out->torn = 1;
+            if (out->written == after + 1)
+                out->written = after;
+        }
+    }
+    for (hsize_t i = 0; i < capacity; i++) {
+        if (kind[i] == COMMIT_BLANK && i < out->written && (!in->unclosed || i < after))
+            kind[i] = COMMIT_DAMAGED; /* blank among written rows */
+        if (kind[i] == COMMIT_DAMAGED) {
+            kind[i] = i < out->written ? COMMIT_DAMAGED : COMMIT_SPARE_DAMAGED;
+            if (out->damaged++ == 0)
+                out->first_damaged = i;
+            if (kind[i] == COMMIT_DAMAGED && out->damaged_written++ == 0)
+                out->first_damaged_written = i;
+        }
+    }
+    if (out->damaged_written == 0)
+        out->first_damaged_written = capacity;
     return NULL;
+}
+
+const char *h5i_commit_damage_text(const commit_row *row, unsigned char kind) {
+    if (kind == COMMIT_SPARE_DAMAGED)
+        return "a spare row (never written: no increment was there), not blank";
+    if (h5i_commit_row_blank(row))
+        return "blank (all zero) where its writer wrote an increment";
+    return "its checksum does not match its contents";
 }
 
 /* ------------------------------------------------------------------ files without it */

@@ -248,11 +248,38 @@ int h5i_commit_write(hid_t ds, hid_t mtype, hsize_t position, const index_row *r
  * one write each; 0 or -1. */
 int h5i_commit_blank_from(hid_t ds, hid_t mtype, hsize_t keep, const commit_row *rows,
                           hsize_t capacity);
-/* The committed rows of a record read whole: *committed = the length of the prefix of valid
- * rows; *torn = 1 when the row after them is torn (allowed only when unclosed). NULL, or
- * what is wrong with row *bad_row (damage). */
-const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, int unclosed,
-                            hsize_t *committed, hsize_t *torn, hsize_t *bad_row);
+/* What a row of the commit record is (h5i_commit_scan). */
+enum {
+    COMMIT_VALID,         /* its checksum matches: a committed increment */
+    COMMIT_BLANK,         /* all zero: never written, or blanked by --resume */
+    COMMIT_TORN,          /* the row a killed writer was writing: not committed, not damage */
+    COMMIT_DAMAGED,       /* a row that held an increment: its checksum fails, or it is blank */
+    COMMIT_SPARE_DAMAGED, /* a spare row (never written) that is not blank: no increment lost */
+};
+#define H5I_ROWS_UNKNOWN ((hsize_t)-1)
+typedef struct {
+    int unclosed;       /* 1: the writer did not close the file (a torn row is allowed) */
+    int live;           /* 1: a writer holds it now (any row after the valid ones may be torn) */
+    hsize_t index_rows; /* extent of /increments/index, or H5I_ROWS_UNKNOWN */
+    uint64_t record_at; /* file offset of row 0, or H5I_ROWS_UNKNOWN (every row tearable) */
+    size_t row_bytes;   /* bytes of a row in the file (92) */
+} commit_scan_in;
+typedef struct {
+    hsize_t valid;                 /* valid rows: the committed increments */
+    hsize_t written;               /* rows 0..written-1 held increments (valid or damaged) */
+    hsize_t torn;                  /* 1: row `written` is torn (left out, no damage) */
+    hsize_t damaged;               /* damaged rows, written or spare */
+    hsize_t first_damaged;         /* the first of them (capacity: none) */
+    hsize_t damaged_written;       /* damaged rows that held an increment */
+    hsize_t first_damaged_written; /* the first of them (capacity: none) */
+} commit_scan_out;
+/* The rows of a record read whole, each classified into kind[i] (capacity entries). NULL, or
+ * what is wrong with the record as a whole (a closed file whose rows below the index's extent
+ * are all blank, or with a valid row beyond it): then nothing of it can be trusted. */
+const char *h5i_commit_scan(const commit_row *rows, hsize_t capacity, const commit_scan_in *in,
+                            unsigned char *kind, commit_scan_out *out);
+/* What is wrong with a damaged row (kind COMMIT_DAMAGED or COMMIT_SPARE_DAMAGED). */
+const char *h5i_commit_damage_text(const commit_row *row, unsigned char kind);
 /* A file without the record: recovers rows [0, rows) of /increments/index into out when only
  * its last chunk fails its Fletcher-32 because a kill tore its rewrite (the stored checksum
  * is that of a shorter prefix of the rows). Returns the rows recovered (0: none). */
@@ -363,6 +390,14 @@ typedef struct {
     int64_t stress_offset;    /* version 2: first row in sxx, syy, sxy (-1 without stress) */
 } incr_entry;
 
+/* A damaged row of a file's commit record (h5_reader_list.c). */
+typedef struct {
+    hsize_t row;      /* row of /increments/commit */
+    int32_t number;   /* the increment it held (-1: unknown, or a spare row) */
+    int spare;        /* 1: a spare row (never written): no increment was lost */
+    const char *what; /* what is wrong with it (static text) */
+} damaged_row;
+
 struct cdem_h5_reader {
     hid_t file; /* open HDF5 file */
     char *path; /* as given */
@@ -386,7 +421,17 @@ struct cdem_h5_reader {
     incr_entry *incr;             /* increments sorted by number */
     size_t n_incr;                /* entries in incr */
     size_t cap_incr;              /* allocated entries */
+    damaged_row *damaged;         /* the damaged rows of the commit record (issue 46) */
+    size_t n_damaged;             /* entries in damaged */
+    int32_t damaged_through;      /* the last increment listed before the first damaged row
+                                     that held one (-1: none; INT32_MAX: no such row) */
+    int last_damaged;             /* 1: the last row written is damaged (so is "last") */
+    char damage[1024];            /* the warning naming them ("" when none) */
 };
+
+/* h5_reader.c: cdem_h5_reader_open without the damage warning on stderr (--resume's check of
+ * what it keeps: cdem-run opened the file, and warned, before). */
+cdem_status h5i_reader_open_quiet(const char *path, cdem_h5_reader **out, cdem_error *err);
 
 /* h5_reader_list.c: the list of increments into r->incr (r->n_incr, r->n_skipped), the
  * stop texts already read. */

@@ -38,6 +38,7 @@ void cdem_h5_reader_close(cdem_h5_reader *r) {
     free(r->source);
     free(r->created);
     free(r->incr);
+    free(r->damaged);
     free(r);
 }
 
@@ -143,7 +144,11 @@ cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *
     char *reason = h5i_dup_str(r->stop_reason);
     if (!reason)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory");
+    char damage[sizeof r->damage];
+    memcpy(damage, r->damage, sizeof damage);
     cdem_status st = scan_v2(r, err);
+    if (st == CDEM_OK && r->damage[0] && strcmp(damage, r->damage) != 0)
+        fprintf(stderr, "warning: %s\n", r->damage); /* new damage while following */
     if (changed && st == CDEM_OK)
         *changed = r->n_incr != before ||
                    (r->n_incr && r->incr[r->n_incr - 1].info.number != last) ||
@@ -272,7 +277,8 @@ static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     return h5i_reader_check_not_empty(r, err);
 }
 
-cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_error *err) {
+/* cdem_h5_reader_open; warn: 1 to write the damage warning to stderr. */
+static cdem_status open_reader(const char *path, cdem_h5_reader **out, int warn, cdem_error *err) {
     if (out)
         *out = NULL;
     if (!path || !out)
@@ -284,6 +290,7 @@ cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_err
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory opening %s", path);
     }
     r->file = r->index = -1;
+    r->damaged_through = INT32_MAX;
     for (size_t k = 0; k < N_ELEMENT_FIELDS; k++)
         r->data[k] = -1;
     cdem_status st = reader_setup(r, err);
@@ -291,8 +298,19 @@ cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_err
         cdem_h5_reader_close(r);
         return st;
     }
+    /* damaged commit rows cost their increments only: the file opens, and says so once */
+    if (warn && r->damage[0])
+        fprintf(stderr, "warning: %s\n", r->damage);
     *out = r;
     return CDEM_OK;
+}
+
+cdem_status cdem_h5_reader_open(const char *path, cdem_h5_reader **out, cdem_error *err) {
+    return open_reader(path, out, 1, err);
+}
+
+cdem_status h5i_reader_open_quiet(const char *path, cdem_h5_reader **out, cdem_error *err) {
+    return open_reader(path, out, 0, err);
 }
 
 size_t cdem_h5_reader_increment_count(const cdem_h5_reader *r) {
@@ -346,6 +364,15 @@ cdem_status cdem_h5_reader_equil_end(const cdem_h5_reader *r, size_t *index, cde
     return equil_end(r, index, "", err);
 }
 
+/* The last damaged row that held an increment (r->last_damaged: the last row written). */
+static const damaged_row *last_damaged_row(const cdem_h5_reader *r) {
+    const damaged_row *d = NULL;
+    for (size_t i = 0; i < r->n_damaged; i++)
+        if (!r->damaged[i].spare)
+            d = &r->damaged[i];
+    return d;
+}
+
 cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *spec, size_t *index,
                                           cdem_error *err) {
     if (!r || !spec || !index)
@@ -359,6 +386,14 @@ cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *s
         return CDEM_OK;
     }
     if (!strcmp(spec, "last")) {
+        if (r->last_damaged) { /* the run's last increment is the damaged row's, not this */
+            const damaged_row *d = last_damaged_row(r);
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                             "%s: increment 'last': the run's last row, /increments/commit row "
+                             "%llu (increment %d), is damaged (%s): that increment cannot be "
+                             "read; the last that can is %d",
+                             r->path, (unsigned long long)d->row, (int)d->number, d->what, (int)hi);
+        }
         *index = r->n_incr - 1;
         return CDEM_OK;
     }
@@ -380,6 +415,14 @@ cdem_status cdem_h5_reader_find_increment(const cdem_h5_reader *r, const char *s
             *index = i;
             return CDEM_OK;
         }
+    for (size_t i = 0; i < r->n_damaged; i++)
+        if (!r->damaged[i].spare && r->damaged[i].number == k)
+            return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                             "%s: increment %ld cannot be read: its row of the commit record, "
+                             "/increments/commit row %llu, is damaged (%s); the file's other "
+                             "%zu increments can be read",
+                             r->path, k, (unsigned long long)r->damaged[i].row, r->damaged[i].what,
+                             r->n_incr);
     return CDEM_FAIL(err, CDEM_ERR_NOTFOUND,
                      "%s: increment %ld does not exist (the file has %zu increments, %d..%d)",
                      r->path, k, r->n_incr, (int)lo, (int)hi);
@@ -526,6 +569,18 @@ int cdem_h5_reader_unclosed(const cdem_h5_reader *r) {
 
 int cdem_h5_reader_writer_alive(const cdem_h5_reader *r) {
     return r ? r->writer : 0;
+}
+
+const char *cdem_h5_reader_damage(const cdem_h5_reader *r) {
+    return r ? r->damage : "";
+}
+
+int cdem_h5_reader_damaged_increments(const cdem_h5_reader *r, int32_t *last_before) {
+    if (!r || r->damaged_through == INT32_MAX)
+        return 0;
+    if (last_before)
+        *last_before = r->damaged_through;
+    return 1;
 }
 
 int cdem_h5_reader_format_version(const cdem_h5_reader *r) {

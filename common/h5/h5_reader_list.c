@@ -12,15 +12,13 @@
 #include <string.h>
 #include <time.h>
 
-/* A closed file with the commit record: its writer wrote every row to both the record and
- * /increments/index, so their lengths agree; a record whose rows were blanked (all zero
- * passes as "never written") would otherwise read as a run of fewer increments, or none. The
- * index's chunks are not read (damage there costs no increment), only its extent; an index
- * that cannot be opened is left to HDF5 tools. */
-static cdem_status check_index_agrees(cdem_h5_reader *r, hsize_t committed, cdem_error *err) {
+/* The extent of /increments/index (H5I_ROWS_UNKNOWN when it cannot be opened or is not 1-D):
+ * in a closed file the number of rows its writer wrote. Its chunks are not read (damage
+ * there costs no increment); an index that cannot be opened is left to HDF5 tools. */
+static hsize_t index_extent(cdem_h5_reader *r) {
     if (r->index < 0 && (r->index = H5Dopen2(r->file, "increments/index", H5P_DEFAULT)) < 0) {
         H5Eclear2(H5E_DEFAULT);
-        return CDEM_OK;
+        return H5I_ROWS_UNKNOWN;
     }
     hid_t sp = H5Dget_space(r->index);
     hsize_t rows = 0;
@@ -30,21 +28,121 @@ static cdem_status check_index_agrees(cdem_h5_reader *r, hsize_t committed, cdem
     if (sp >= 0)
         H5Sclose(sp);
     H5Eclear2(H5E_DEFAULT);
-    if (rank != 1 || rows == committed)
-        return CDEM_OK;
-    return CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                     "%s: the commit record /increments/commit holds %llu committed rows but "
-                     "/increments/index %llu, in a file its writer closed (it writes every row to "
-                     "both): damaged file",
-                     r->path, (unsigned long long)committed, (unsigned long long)rows);
+    return rank == 1 ? rows : H5I_ROWS_UNKNOWN;
 }
 
-/* Version 2, a file with the commit record (h5_commit.c): its committed rows into *out
- * (malloc'd, *rows of them). The dataset is opened for this read alone, so a reader that
- * follows a running writer reads the rows from the file every time, never from a buffer. */
-static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_t *rows,
-                                      cdem_error *err) {
+/* The increment damaged row j held, from the valid rows around it (kind: the record's
+ * classification, c its rows): the number of the valid row before it plus the rows between,
+ * when the valid row after it (if any) agrees; from the row after it when none is before;
+ * j itself (cdem-run numbers its increments by row) when no row is valid. -1: unknown. */
+static int32_t damaged_number(const commit_row *c, const unsigned char *kind, hsize_t capacity,
+                              hsize_t j) {
+    hsize_t i = j, m = j + 1;
+    while (i > 0 && kind[i - 1] != COMMIT_VALID)
+        i--;
+    while (m < capacity && kind[m] != COMMIT_VALID)
+        m++;
+    const int have_prev = i > 0, have_next = m < capacity;
+    if (have_prev) {
+        const int64_t guess = (int64_t)c[i - 1].row.number + (int64_t)(j - (i - 1));
+        if (have_next && (int64_t)c[m].row.number != guess + (int64_t)(m - j))
+            return -1;
+        return guess <= INT32_MAX ? (int32_t)guess : -1;
+    }
+    if (have_next) {
+        const int64_t guess = (int64_t)c[m].row.number - (int64_t)(m - j);
+        return guess >= 0 ? (int32_t)guess : -1;
+    }
+    return j <= INT32_MAX ? (int32_t)j : -1;
+}
+
+/* The damaged rows of the record into r (r->damaged, r->damage: the one warning that names
+ * them, the file, what is wrong with each and what it costs). */
+static cdem_status note_damage(cdem_h5_reader *r, const commit_row *c, const unsigned char *kind,
+                               hsize_t capacity, const commit_scan_out *scan, cdem_error *err) {
+    free(r->damaged);
+    r->damaged = NULL;
+    r->n_damaged = 0;
+    r->damage[0] = '\0';
+    r->damaged_through = INT32_MAX;
+    r->last_damaged = 0;
+    if (scan->damaged == 0)
+        return CDEM_OK;
+    if (!(r->damaged = calloc((size_t)scan->damaged, sizeof *r->damaged)))
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory listing the damaged rows of %s",
+                         r->path);
+    char *t = r->damage;
+    const size_t cap = sizeof r->damage;
+    size_t at = (size_t)snprintf(t, cap, "%s: damaged file: /increments/commit ", r->path);
+    size_t named = 0, lost = 0;
+    char lost_list[200] = "";
+    for (hsize_t j = 0; j < capacity; j++) {
+        if (kind[j] != COMMIT_DAMAGED && kind[j] != COMMIT_SPARE_DAMAGED)
+            continue;
+        damaged_row *d = &r->damaged[r->n_damaged++];
+        d->row = j;
+        d->spare = kind[j] == COMMIT_SPARE_DAMAGED;
+        d->number = d->spare ? -1 : damaged_number(c, kind, capacity, j);
+        d->what = h5i_commit_damage_text(&c[j], kind[j]);
+        if (!d->spare) {
+            if (r->damaged_through == INT32_MAX) { /* the last valid increment before it */
+                hsize_t i = j;
+                while (i > 0 && kind[i - 1] != COMMIT_VALID)
+                    i--;
+                r->damaged_through = i > 0 ? c[i - 1].row.number : -1;
+            }
+            r->last_damaged = j + 1 == scan->written;
+            const size_t len = strlen(lost_list);
+            if (lost < 6 && d->number >= 0)
+                snprintf(lost_list + len, sizeof lost_list - len, "%s%d", lost ? ", " : "",
+                         (int)d->number);
+            else if (lost < 6)
+                snprintf(lost_list + len, sizeof lost_list - len, "%sthat of row %llu",
+                         lost ? ", " : "", (unsigned long long)j);
+            else if (lost == 6)
+                snprintf(lost_list + len, sizeof lost_list - len, ", ...");
+            lost++;
+        }
+        if (named < 4 && at < cap) {
+            char num[48];
+            if (d->spare)
+                snprintf(num, sizeof num, "a spare row");
+            else if (d->number >= 0)
+                snprintf(num, sizeof num, "increment %d", (int)d->number);
+            else
+                snprintf(num, sizeof num, "increment unknown");
+            at += (size_t)snprintf(t + at, cap - at, "%srow %llu (%s): %s", named ? "; " : "",
+                                   (unsigned long long)j, num,
+                                   d->spare ? "not blank, yet never written" : d->what);
+        } else if (named == 4 && at < cap) {
+            at += (size_t)snprintf(t + at, cap - at, "; and %llu more damaged rows",
+                                   (unsigned long long)(scan->damaged - 4));
+        }
+        named++;
+    }
+    if (at < cap) {
+        if (lost)
+            snprintf(t + at, cap - at,
+                     "; increment%s %s cannot be read, the other %llu increments can "
+                     "(docs/format.md, \"/increments/commit\")",
+                     lost > 1 ? "s" : "", lost_list, (unsigned long long)scan->valid);
+        else
+            snprintf(t + at, cap - at,
+                     "; no increment is lost: the %llu increments can be read (docs/format.md, "
+                     "\"/increments/commit\")",
+                     (unsigned long long)scan->valid);
+    }
+    return CDEM_OK;
+}
+
+/* Version 2, a file with the commit record (h5_commit.c): its valid rows into *out and their
+ * positions into *pos (malloc'd, *rows of them), its damaged rows into r (note_damage). The
+ * dataset is opened for this read alone, so a reader that follows a running writer reads the
+ * rows from the file every time, never from a buffer. */
+static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_t **pos,
+                                      hsize_t *rows, cdem_error *err) {
     *out = NULL;
+    *pos = NULL;
     *rows = 0;
     hid_t ds = H5Dopen2(r->file, "increments/commit", H5P_DEFAULT);
     if (ds < 0)
@@ -53,40 +151,65 @@ static cdem_status read_commit_record(cdem_h5_reader *r, index_row **out, hsize_
     const hsize_t capacity = h5i_extent_of(ds);
     hid_t ft = H5Dget_type(ds), mt = h5i_commit_type(0), want = h5i_commit_type(1);
     const int type_ok = ft >= 0 && want >= 0 && H5Tequal(ft, want) > 0;
-    commit_row *c = capacity && capacity <= MAX_ELEMENTS ? calloc(capacity, sizeof *c) : NULL;
-    index_row *ix = capacity && capacity <= MAX_ELEMENTS ? malloc(capacity * sizeof *ix) : NULL;
+    const int sized = capacity && capacity <= MAX_ELEMENTS;
+    commit_row *c = sized ? calloc(capacity, sizeof *c) : NULL;
+    index_row *ix = sized ? malloc(capacity * sizeof *ix) : NULL;
+    hsize_t *at = sized ? malloc(capacity * sizeof *at) : NULL;
+    unsigned char *kind = sized ? malloc(capacity) : NULL;
     cdem_status st = CDEM_OK;
     if (!type_ok)
         st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
                        "%s: dataset /increments/commit does not have the commit record's type "
                        "(docs/format.md)",
                        r->path);
-    else if (capacity == 0 || capacity > MAX_ELEMENTS)
+    else if (!sized)
         st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: /increments/commit claims %llu rows", r->path,
                        (unsigned long long)capacity);
-    else if (!c || !ix || mt < 0)
+    else if (!c || !ix || !at || !kind || mt < 0)
         st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the commit record of %s",
                        r->path);
     else if (h5i_read_all_rows(ds, mt, capacity, c) < 0)
         st = H5FAIL(err, CDEM_ERR_FORMAT,
                     "%s: /increments/commit (the commit record) is unreadable", r->path);
-    hsize_t committed = 0, torn = 0, bad = 0;
-    const char *why =
-        st == CDEM_OK ? h5i_commit_scan(c, capacity, r->unclosed, &committed, &torn, &bad) : NULL;
-    if (why)
-        st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                       "%s: /increments/commit row %llu: %s; rows 0..%lld are valid: damaged file",
-                       r->path, (unsigned long long)bad, why, (long long)committed - 1);
-    if (st == CDEM_OK && !r->unclosed)
-        st = check_index_agrees(r, committed, err);
+    commit_scan_out scan;
+    memset(&scan, 0, sizeof scan);
     if (st == CDEM_OK) {
-        for (hsize_t i = 0; i < committed; i++)
-            ix[i] = c[i].row;
-        *out = ix;
-        *rows = committed;
-        r->n_skipped = (size_t)torn;
-        ix = NULL;
+        const haddr_t base = H5Dget_offset(ds);
+        H5Eclear2(H5E_DEFAULT);
+        commit_scan_in in = {
+            .unclosed = r->unclosed,
+            .live = r->swmr,
+            /* a live writer's index is not read: it grows after the record */
+            .index_rows = r->swmr ? H5I_ROWS_UNKNOWN : index_extent(r),
+            .record_at = base == HADDR_UNDEF ? H5I_ROWS_UNKNOWN : (uint64_t)base,
+            .row_bytes = H5Tget_size(ft),
+        };
+        if (h5i_commit_scan(c, capacity, &in, kind, &scan))
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: the commit record /increments/commit holds %llu committed rows "
+                           "but /increments/index %llu, in a file its writer closed (it writes "
+                           "every row to both): damaged file",
+                           r->path, (unsigned long long)scan.valid,
+                           (unsigned long long)in.index_rows);
     }
+    if (st == CDEM_OK)
+        st = note_damage(r, c, kind, capacity, &scan, err);
+    if (st == CDEM_OK) {
+        hsize_t n = 0;
+        for (hsize_t i = 0; i < capacity; i++)
+            if (kind[i] == COMMIT_VALID) {
+                ix[n] = c[i].row;
+                at[n++] = i;
+            }
+        *out = ix;
+        *pos = at;
+        *rows = n;
+        r->n_skipped = (size_t)scan.torn;
+        ix = NULL;
+        at = NULL;
+    }
+    free(kind);
+    free(at);
     free(ix);
     free(c);
     if (mt >= 0)
@@ -240,8 +363,8 @@ cdem_status h5i_reader_scan(cdem_h5_reader *r, cdem_error *err) {
         return H5FAIL(err, CDEM_ERR_FORMAT, "%s: the group /increments is missing or corrupt",
                       r->path);
     index_row *ix = NULL;
-    hsize_t rows = 0;
-    CDEM_TRY(has_commit ? read_commit_record(r, &ix, &rows, err)
+    hsize_t rows = 0, *pos = NULL; /* pos: each listed row's place in the record (NULL: i) */
+    CDEM_TRY(has_commit ? read_commit_record(r, &ix, &pos, &rows, err)
                         : read_old_index(r, &ix, &rows, err));
     hsize_t data_ext = 0, stress_ext = 0;
     int first_data = 1, first_stress = 1;
@@ -327,7 +450,7 @@ cdem_status h5i_reader_scan(cdem_h5_reader *r, cdem_error *err) {
             }
             st = CDEM_FAIL(err, CDEM_ERR_FORMAT, "%s: %s row %llu (increment %d): %s: damaged file",
                            r->path, has_commit ? "/increments/commit" : "/increments/index",
-                           (unsigned long long)i, (int)ix[i].number, why);
+                           (unsigned long long)(pos ? pos[i] : i), (int)ix[i].number, why);
             break;
         }
         incr_entry *e = &r->incr[r->n_incr++];
@@ -347,5 +470,6 @@ cdem_status h5i_reader_scan(cdem_h5_reader *r, cdem_error *err) {
         snprintf(e->name, sizeof e->name, "%06d", (int)ix[i].number);
     }
     free(ix);
+    free(pos);
     return st == CDEM_OK ? h5i_reader_check_not_empty(r, err) : st;
 }

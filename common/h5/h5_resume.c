@@ -30,7 +30,7 @@
  * would already mark it closed). */
 static cdem_status verify_kept(const char *path, int32_t keep_inc, cdem_error *err) {
     cdem_h5_reader *r = NULL;
-    cdem_status st = cdem_h5_reader_open(path, &r, err);
+    cdem_status st = h5i_reader_open_quiet(path, &r, err);
     if (st != CDEM_OK) {
         cdem_error_prefix(err, "%s: cannot be resumed, it was not changed", path);
         return st;
@@ -69,18 +69,25 @@ static cdem_status verify_kept(const char *path, int32_t keep_inc, cdem_error *e
     return st;
 }
 
-/* The increments of the file as its commit record (or, in a file written before it, its
- * index) lists them, into *out (malloc'd, *rows of them; NULL when none). */
+/* The increments a resume can keep, into *out (malloc'd, *rows of them; NULL when none): the
+ * valid rows of the commit record up to its first row that is not (a resume keeps a prefix
+ * and never builds on a damaged row: *damaged_row is then that row, and *damaged_why what is
+ * wrong with it; else *damaged_row is the record's capacity), or, in a file written before
+ * the record, the rows of its index. */
 static cdem_status read_rows_to_keep(cdem_h5_writer *w, int unclosed, index_row **out,
-                                     hsize_t *rows, cdem_error *err) {
+                                     hsize_t *rows, hsize_t *damaged_row, const char **damaged_why,
+                                     cdem_error *err) {
     *out = NULL;
     *rows = 0;
+    *damaged_row = w->commit_capacity;
+    *damaged_why = NULL;
     if (w->commit >= 0) {
         const hsize_t cap = w->commit_capacity;
         commit_row *c = calloc(cap ? cap : 1, sizeof *c);
         index_row *ix = malloc((cap ? cap : 1) * sizeof *ix);
+        unsigned char *kind = malloc(cap ? cap : 1);
         cdem_status st = CDEM_OK;
-        if (!c || !ix)
+        if (!c || !ix || !kind)
             st = CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory reading the commit record of %s",
                            w->path);
         else if (h5i_read_all_rows(w->commit, w->commit_mtype, cap, c) < 0)
@@ -88,16 +95,39 @@ static cdem_status read_rows_to_keep(cdem_h5_writer *w, int unclosed, index_row 
                         "%s: cannot be resumed: its commit record /increments/commit is "
                         "unreadable; it was not changed",
                         w->path);
-        hsize_t committed = 0, torn = 0, bad = 0;
-        const char *why =
-            st == CDEM_OK ? h5i_commit_scan(c, cap, unclosed, &committed, &torn, &bad) : NULL;
-        if (why)
-            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
-                           "%s: cannot be resumed: /increments/commit row %llu: %s; it was not "
-                           "changed",
-                           w->path, (unsigned long long)bad, why);
+        commit_scan_out scan;
+        memset(&scan, 0, sizeof scan);
+        if (st == CDEM_OK) {
+            const haddr_t base = H5Dget_offset(w->commit);
+            hid_t ft = H5Dget_type(w->commit);
+            H5Eclear2(H5E_DEFAULT);
+            const commit_scan_in in = {
+                .unclosed = unclosed,
+                .live = 0, /* this writer holds the lock */
+                .index_rows = h5i_extent_of(w->index),
+                .record_at = base == HADDR_UNDEF ? H5I_ROWS_UNKNOWN : (uint64_t)base,
+                .row_bytes = ft >= 0 ? H5Tget_size(ft) : 0,
+            };
+            if (ft >= 0)
+                H5Tclose(ft);
+            if (h5i_commit_scan(c, cap, &in, kind, &scan))
+                st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                               "%s: cannot be resumed: its commit record /increments/commit "
+                               "holds %llu committed rows but /increments/index %llu (the writer "
+                               "writes every row to both): damaged file; it was not changed",
+                               w->path, (unsigned long long)scan.valid,
+                               (unsigned long long)in.index_rows);
+        }
+        hsize_t committed = 0;
+        while (st == CDEM_OK && committed < cap && kind[committed] == COMMIT_VALID)
+            committed++;
+        if (st == CDEM_OK && scan.damaged_written) {
+            *damaged_row = scan.first_damaged_written;
+            *damaged_why = h5i_commit_damage_text(&c[*damaged_row], kind[*damaged_row]);
+        }
         for (hsize_t i = 0; st == CDEM_OK && i < committed; i++)
             ix[i] = c[i].row;
+        free(kind);
         free(c);
         if (st != CDEM_OK) {
             free(ix);
@@ -283,14 +313,25 @@ static cdem_status reopen_setup(cdem_h5_writer *w, int32_t keep_inc, int64_t kee
             data_ext = e < data_ext ? e : data_ext;
     }
     index_row *ix = NULL;
-    hsize_t rows = 0;
-    CDEM_TRY(read_rows_to_keep(w, flags != 0, &ix, &rows, err));
+    hsize_t rows = 0, damaged = 0;
+    const char *damaged_why = NULL;
+    CDEM_TRY(read_rows_to_keep(w, flags != 0, &ix, &rows, &damaged, &damaged_why, err));
     hsize_t keep = 0;
     char why[300];
     while (keep < rows && ix[keep].number <= keep_inc &&
            !h5i_bad_index_row(&ix[keep], keep ? &ix[keep - 1] : NULL, data_ext, stress_ext, why,
                               sizeof why))
         keep++;
+    /* The kept rows end before the first damaged row: the checkpoint's increment must be
+     * among them, or the resumed run would build on the damaged row (issue 46). */
+    if (damaged_why && damaged == keep && !(keep > 0 && ix[keep - 1].number == keep_inc)) {
+        free(ix);
+        return CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                         "%s: cannot be resumed from increment %d: /increments/commit row %llu, "
+                         "at or before that increment's row, is damaged (%s): a resumed run "
+                         "would build on it; it was not changed",
+                         w->path, (int)keep_inc, (unsigned long long)damaged, damaged_why);
+    }
     /* Series samples to keep: the leading ones with step <= keep_step. */
     hsize_t slen = h5i_extent_of(w->series[0]);
     for (size_t c = 1; c < N_SERIES; c++) {

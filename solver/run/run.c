@@ -598,6 +598,31 @@ cdem_status cdem_run_resume(const char *path, const cdem_run_options *opt, cdem_
                 "written without; run the model again from the start",
                 path, p.checkpoint_interval);
     }
+    /* A damaged commit row that held an increment (issue 46): the resumed run must not build
+     * on it, so it continues from a checkpoint of an increment before that row (the resume
+     * then drops that row and every later one, and writes them again), or not at all. */
+    int32_t intact = 0;
+    if (st == CDEM_OK && cdem_h5_reader_damaged_increments(rd, &intact) && inc > intact) {
+        const int32_t newest = inc;
+        cdem_error e2;
+        cdem_error_clear(&e2);
+        if (intact < 0 ||
+            cdem_h5_reader_read_checkpoint_through(rd, snap, intact, &inc, &e2) != CDEM_OK)
+            st = CDEM_FAIL(err, CDEM_ERR_FORMAT,
+                           "%s: cannot be resumed: its checkpoint belongs to increment %d, after "
+                           "a damaged row of its commit record (%s), and no valid checkpoint "
+                           "belongs to an increment before that row (%d or earlier; %s): a "
+                           "resumed run would build on the damaged row; it was not changed, "
+                           "and its valid increments can still be read",
+                           path, (int)newest, cdem_h5_reader_damage(rd), (int)intact,
+                           intact < 0 ? "no increment precedes it" : e2.msg);
+        else if (opt->log)
+            fprintf(opt->log,
+                    "cdem-run: resuming %s from the checkpoint of increment %d, before its "
+                    "damaged commit row (the newest checkpoint, of increment %d, follows that "
+                    "row); the increments after %d are written again\n",
+                    path, (int)inc, (int)newest, (int)inc);
+    }
     cdem_h5_reader_close(rd);
     if (st == CDEM_OK) {
         int64_t next_inc = 0;
