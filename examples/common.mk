@@ -3,6 +3,8 @@
 #   make              full (paper) size; results in out/
 #   make QUICK=1      reduced sizes and runtimes (-s overrides from each folder's Q_* variables);
 #                     results in out-quick/, so quick and paper results never mix
+#   make quick        the same as make QUICK=1; make paper the same as make (as in the
+#                     folders that do not include this file: wedge, salt-*)
 #   make -j2          independent simulations run in parallel
 #   NICE=10           niceness of cdem-run (the machines are shared; NICE=0 to disable)
 #
@@ -59,7 +61,13 @@ $(OUT):
 
 TOOLS := $(CDEM_RUN) $(CDEM_STRAIN) $(OUT)
 
-.PHONY: all clean clean-quick summary
+.PHONY: all clean clean-quick summary quick paper
+
+# `make quick` = `make QUICK=1`, `make paper` = `make` (issue 46, item 13a: every folder has
+# both; tests/test_examples_tools.c checks that `make -n quick` goes to out-quick/)
+quick:
+	+$(MAKE) QUICK=1 all
+paper: all
 .DELETE_ON_ERROR:
 .SECONDARY:
 

@@ -2,8 +2,8 @@
 """Lists every message cdem-run and cdem-strain can print, from the sources: each call of
 MESSAGE_CALLS below (CDEM_FAIL, H5FAIL, the parameter rules, the context put before a
 message, the reasons a run file's value is refused, both programs' usage errors,
-fprintf(stderr, ...)) in common/, solver/ and
-analysis/, read by a C tokenizer (comments and character literals skipped). Writes
+fprintf(stderr, ...)) in every C file of common/, solver/ and analysis/ and their
+subfolders (at any depth), read by a C tokenizer (comments and character literals skipped). Writes
 markdown to stdout (`make errors` writes docs/errors.md with it).
 
 printf conversions are shown as <…> (a file name, a value, a line number...); a message
@@ -18,38 +18,62 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 
 
 def sources(pattern):
-    """The source files matching pattern (relative to the repository root), sorted."""
-    return sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, pattern)))
+    """The source files matching pattern (relative to the repository root; `**` matches any
+    depth of folders), sorted."""
+    return sorted(os.path.relpath(p, ROOT)
+                  for p in glob.glob(os.path.join(ROOT, pattern), recursive=True))
 
 
-# The run file's implementation, one file per concept (common/h5/h5_internal.h)
-H5_SOURCES = sources("common/h5/*.c")
+# Where the messages are: every .c (and .h) file of these folders, at any depth (the
+# solver's and the analysis's layers are subfolders: solver/modes/, analysis/cli/, ...).
+# tests/test_error_catalogue.c walks the same folders itself and fails when a file with a
+# message has no row here.
+TREES = ("common", "solver", "analysis")
+
+
+def all_sources():
+    """Every C source and header under TREES, relative to the root, sorted."""
+    out = []
+    for tree in TREES:
+        for dirpath, dirnames, filenames in os.walk(os.path.join(ROOT, tree)):
+            dirnames.sort()
+            out += [os.path.relpath(os.path.join(dirpath, f), ROOT) for f in filenames
+                    if f.endswith((".c", ".h"))]
+    return sorted(out)
+
+
 # The subcommands that draw (their messages are in the pictures group)
 PICTURE_COMMANDS = ["analysis/cli/cmd_render.c", "analysis/cli/cmd_plot.c",
                     "analysis/cli/cmd_plot_series.c", "analysis/cli/cmd_plot_csv.c"]
+PARAMETER_SOURCES = ["common/params.c", "solver/base/model.c", "solver/run/summary.c",
+                     "solver/run/run_validate.c"]
+FAULT_FILE_SOURCES = ["solver/modes/fault_file.c"]
+CDEM2D_SOURCES = ["analysis/input/cdem2d.c", "analysis/input/cdem2d_h5.c"]
 
+# A file is listed in the first group that names it (the solver's files not named before
+# are all in "Boundary modes, assembly, salt and the run"); a file in none is in "Other".
 GROUPS = [  # (title, source files, what to do)
-    ("Parameter files and -s overrides", ["common/params.c", "common/model.c", "common/summary.c"],
+    ("Parameter files and -s overrides", PARAMETER_SOURCES,
      "The message names the file, line, key and value and says what is allowed: correct that "
      "line (or the -s argument). `cdem-run --print-defaults` writes a valid file to start "
      "from; docs/parameters.md lists every key, range and rule between keys."),
-    ("Fault vertex files (irregular-fault)", ["solver/fault_file.c"],
+    ("Fault vertex files (irregular-fault)", FAULT_FILE_SOURCES,
      "Fix the named line of the vertex file: two plain decimal numbers `x y` in metres per "
      "line; first point at (fault_location x width x unit_scaling, 0); every later point at "
      "lower x and higher y, every segment dipping at least 1 degree and at least half the "
      "smallest radius long, no point above twice the model's height. The path is relative to "
      "the directory cdem-run runs in."),
-    ("Boundary modes and the run", ["solver/bc_registry.c", "solver/bc_planar_fault.c", "solver/bc_listric.c",
-      "solver/bc_vertical_faults.c", "solver/bc_detachment.c", "solver/bc_repose.c", "solver/bc_biaxial.c",
-      "solver/run.c", "solver/run_output.c", "solver/run_progress.c", "solver/run_ckpt.c", "solver/sediment.c",
-      "solver/integrate.c", "solver/force.c", "solver/loads.c", "solver/removal.c", "solver/contact.c", "solver/neighbour.c",
-      "solver/assembly.c", "solver/stress.c"],
+    ("Boundary modes, assembly, salt and the run", [
+      f for f in sources("solver/**/*.c") if f not in PARAMETER_SOURCES + FAULT_FILE_SOURCES],
      "Combinations the mode cannot build are refused before the run (change the named key); "
-     "a numeric blow-up (NaN/Inf) means the time step is too large for the stiffness: keep "
-     "`keep_constants = off` at small unit scaling or use the default constants; "
-     "\"settling > displacement\" gives the display_interval and equilibration that work."),
-    ("cdem (HDF5) files", [*H5_SOURCES, "common/state.c", "common/runlock.c",
-                           "common/xdmf.c", "common/outfile.c"],
+     "a numeric blow-up (NaN/Inf, a non-finite position) means the time step is too large for "
+     "the stiffness: keep `keep_constants = off` at small unit scaling or use the default "
+     "constants; \"settling > displacement\" gives the display_interval and equilibration "
+     "that work. \"out of memory\" names what was being allocated: a smaller model (larger "
+     "radii, a narrower box) or a machine with more memory; `cdem-run --dry-run` states a "
+     "model's size before it runs."),
+    ("cdem (HDF5) files", [*sources("common/h5/*.c"), "common/state.c", "common/runlock.c",
+                           "common/xdmf.c", "common/outfile.c", "common/snapshot.c"],
      "The file is not a cdem file, is damaged (a checksum failed: copy it again or re-run) or "
      "truncated (cut short by a full disk or an interrupted copy), of another format version "
      "(re-run with this cdem-run), or the increment/dataset asked for does not exist "
@@ -58,20 +82,21 @@ GROUPS = [  # (title, source files, what to do)
      "it is, other HDF5 tools after `h5clear -s RUN.h5`). \"is being written by another "
      "process\" names the run writing the file: wait for it, stop it or write elsewhere. An "
      "existing output is replaced only with `--force`, and a file that is not a cdem run file "
-     "never."),
-    ("cdem2D import", ["analysis/input/cdem2d.c"],
+     "never. A cdem2D folder is read after `cdem-strain import-cdem2d FOLDER -o run.h5`."),
+    ("cdem2D import", CDEM2D_SOURCES,
      "Fix the named file and line of the cdem2D folder: `x y radius layer` per line "
      "(modelresults_N.txt), `sxx syy sxy` per line and the same number of lines "
      "(modelforces_N.txt); docs/formats-text.md."),
     ("Analysis (compute, element, limits, strain, stress, axes)", [
-      *(f for f in sources("analysis/cli/cmd_*.c") if f not in PICTURE_COMMANDS),
-      *sources("analysis/measure/*.c"),
-      *sources("analysis/export/*.c"), "common/grid.c"],
+      *(f for f in sources("analysis/cli/*.c") if f not in PICTURE_COMMANDS),
+      *sources("analysis/measure/**/*.c"), *sources("analysis/export/**/*.c"),
+      *(f for f in sources("analysis/input/**/*.c") if f not in CDEM2D_SOURCES),
+      "common/grid.c"],
      "Use a quantity name from `cdem-strain quantities`, an increment from `cdem-strain info`; "
      "stress quantities need a run with `physics.calculate_stress = on`; mohr needs biaxial "
      "runs at two or more different confining pressures; repose needs a repose run."),
     ("Pictures, plots and GIFs", [
-      *sources("analysis/draw/*.c"), *PICTURE_COMMANDS],
+      *sources("analysis/draw/**/*.c"), *PICTURE_COMMANDS],
      "Check the output name's extension (.png, .pdf, .svg; .gif for --gif), that the output "
      "directory exists and is writable, the option values (sizes, colours #RRGGBB, zoom "
      "window, ranges MIN,MAX) and, for plot-series, the column names (`h5ls RUN.h5/series`)."),
@@ -262,15 +287,9 @@ STDERR_FIX = ("cdem-run's refusals of its command line and output (exit status 1
 
 
 def main():
-    files = sorted(glob.glob(os.path.join(ROOT, d, "*.c"))
-                   for d in ("common", "common/h5", "solver", "analysis", "analysis/cli",
-                             "analysis/input", "analysis/measure", "analysis/draw",
-                             "analysis/export"))
-    files = [f for group in files for f in group]
     rows, special = {}, {"usage": {}, "stderr": {}}
-    for path in files:
-        rel = os.path.relpath(path, ROOT)
-        text = open(path, encoding="utf-8").read()
+    for rel in all_sources():
+        text = open(os.path.join(ROOT, rel), encoding="utf-8").read()
         for line, kind, fmt in messages(text):
             table = special[kind] if kind in special else rows
             table.setdefault(rel, []).append((line, kind, show(fmt)))
@@ -280,7 +299,8 @@ def main():
     print("# Error messages of cdem-run and cdem-strain")
     print()
     print("Generated by `make errors` (`/usr/bin/python3 scripts/error_catalogue.py >")
-    print("docs/errors.md`) from every message call in common/, solver/ and analysis/:")
+    print("docs/errors.md`) from every message call in the C files of common/, solver/ and")
+    print("analysis/ and their subfolders:")
     print("`CDEM_FAIL` and `H5FAIL` (the run file's errors; HDF5's own reason may follow in")
     print("\"(HDF5: …)\"), the context `cdem_error_prefix` puts before a message (kind")
     print("\"context\"), the parameter rules of `cdem_params_validate` (kind \"rule\": reported")

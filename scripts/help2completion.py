@@ -8,7 +8,9 @@ usage: help2completion.py BUILD_DIR OUT_FILE
 
 The help texts are parsed as scripts/help2roff.py parses them (common/cli_help.h layout).
 Completion rules: command words and options from the tables; after an option that takes a
-value: quantity names for NAME/QUANTITY (from `cdem-strain quantities`), the lower-case
+value: `section.key=` words for cdem-run's -s section.key=value (every key of
+`cdem-run --print-defaults`, no space after the word), quantity names for NAME/QUANTITY
+(from `cdem-strain quantities`), the lower-case
 words of a choice list such as `incr|total` or `K|last|first|equil|all`, file names for
 file-like values, nothing otherwise; other words complete file names.
 """
@@ -36,8 +38,32 @@ def options_of(lists):
     return out
 
 
-def value_rule(arg, quantities):
+def parameter_keys(run):
+    """`section.key=` of every parameter, from `cdem-run --print-defaults` ([section] lines,
+    then `key = value` lines)."""
+    out, section = [], None
+    text = subprocess.run([run, "--print-defaults"], capture_output=True, text=True,
+                          check=True).stdout
+    for line in text.splitlines():
+        line = line.strip()
+        m = re.fullmatch(r"\[([A-Za-z0-9_]+)\]", line)
+        if m:
+            section = m.group(1)
+            continue
+        m = re.match(r"([A-Za-z0-9_]+)\s*=", line)
+        if m and section and not line.startswith(("#", ";")):
+            out.append(f"{section}.{m.group(1)}=")
+    if not out:
+        sys.exit(f"help2completion.py: {run} --print-defaults listed no keys")
+    return out
+
+
+def value_rule(arg, quantities, keys=None):
     """A bash snippet completing the value of an option whose metavariable is arg."""
+    if arg == "section.key=value" and keys:
+        # the word is completed up to its '=', where the value starts: no space after it
+        return (f'COMPREPLY=($(compgen -W "{" ".join(keys)}" -- "$cur")); '
+                "compopt -o nospace 2>/dev/null")
     if arg in ("NAME", "QUANTITY"):
         return f'COMPREPLY=($(compgen -W "{quantities}" -- "$cur"))'
     words = [w for w in arg.split("|") if re.fullmatch(r"[a-z][a-z0-9-]*", w)]
@@ -48,13 +74,13 @@ def value_rule(arg, quantities):
     return ""  # a number or free text: nothing to offer
 
 
-def case_block(options, quantities, indent):
+def case_block(options, quantities, indent, keys=None):
     """`case "$prev" in ... esac` for the options that take values."""
     pad = " " * indent
     lines = [f'{pad}case "$prev" in']
     for names, arg in options:
         if arg:
-            rule = value_rule(arg, quantities)
+            rule = value_rule(arg, quantities, keys)
             lines.append(f"{pad}    {'|'.join(names)}) {rule + '; ' if rule else ''}return ;;")
     lines.append(f"{pad}esac")
     return lines if len(lines) > 2 else []
@@ -81,7 +107,7 @@ def main(argv):
     run_opts = options_of(parse(run_help(run, "--help"))[2])
     r.append("_cdem_run() {")
     r.append('    local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"')
-    r += case_block(run_opts, quantities, 4)
+    r += case_block(run_opts, quantities, 4, parameter_keys(run))
     r.append('    if [[ "$cur" == -* ]]; then')
     r.append(f'        COMPREPLY=($(compgen -W "{spellings(run_opts)} -" -- "$cur"))')
     r.append("    else")

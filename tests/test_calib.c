@@ -9,7 +9,7 @@
  * friction angle and out of reach at another.
  * Secant convergence within the issue's budget of 8 series, refusal with the reachable
  * range, tolerance handling, monotonicity violations, budget, stalling and the problem's
- * checks. */
+ * checks; and the wording of a design point's run counts (calib_runs.h). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -23,6 +23,7 @@
 
 #include "assert_near.h"
 #include "calib.h"
+#include "calib_runs.h"
 
 #define LN10 2.302585092994046
 
@@ -322,6 +323,26 @@ static void test_calib_first_point_and_checks(void **state) {
     assert_string_equal(cdem_calib_verdict_name(CDEM_CALIB_UNREACHABLE), "unreachable");
 }
 
+/* A design point's run counts in words (issue 46, item 13d: "(2 runs, 3 run now)"): the
+ * noun agrees with its count, and no more runs are run now than there are. */
+static void test_calib_count_text(void **state) {
+    (void)state;
+    char buf[96];
+    static const struct {
+        size_t runs, ran;
+        const char *want;
+    } cases[] = {
+        {1, 0, "1 run, none run now"},       {1, 1, "1 run, it was run now"},
+        {2, 0, "2 runs, none run now"},      {2, 2, "2 runs, all run now"},
+        {3, 1, "3 runs, 1 of them run now"}, {10, 7, "10 runs, 7 of them run now"},
+        {2, 3, "2 runs, all run now"}, /* clamped */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cdem_calib_count_text(cases[i].runs, cases[i].ran, buf, sizeof buf);
+        assert_string_equal(buf, cases[i].want);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_calib_converges_by_secant_steps),
@@ -332,6 +353,7 @@ int main(void) {
         cmocka_unit_test(test_calib_reports_monotonicity_violations),
         cmocka_unit_test(test_calib_budget_stall_and_restart),
         cmocka_unit_test(test_calib_first_point_and_checks),
+        cmocka_unit_test(test_calib_count_text),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

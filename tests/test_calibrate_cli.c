@@ -82,7 +82,7 @@ static void test_calibrate_finds_checks_and_resumes(void **state) {
         print_error("%s\n", out);
     assert_int_equal(rc, 0);
     assert_non_null(strstr(out, "series 1: mu = 0.25, C0 = 5e+09 N: phi = "));
-    assert_non_null(strstr(out, "(2 runs, 2 run now)"));
+    assert_non_null(strstr(out, "(2 runs, all run now)"));
     assert_non_null(strstr(out, "found in 1 series"));
     assert_non_null(strstr(out, "fresh-seed check: seeds 2..2"));
     assert_non_null(strstr(out, "fresh-seed check: within the tolerances"));
@@ -103,7 +103,7 @@ static void test_calibrate_finds_checks_and_resumes(void **state) {
     rc = run(cmd, out, sizeof out);
     assert_int_equal(rc, 0);
     assert_null(strstr(out, "  running "));
-    assert_non_null(strstr(out, "(2 runs, 0 run now)"));
+    assert_non_null(strstr(out, "(2 runs, none run now)"));
 
     /* a run file left unreadable (killed before its first write) is run again, alone */
     char path[2200];
@@ -116,7 +116,34 @@ static void test_calibrate_finds_checks_and_resumes(void **state) {
     assert_int_equal(rc, 0);
     assert_non_null(strstr(out, "  running biaxial_mu0.25_C0-5e09_seed1_20MPa\n"));
     assert_null(strstr(out, "  running biaxial_mu0.25_C0-5e09_seed1_0MPa"));
-    assert_non_null(strstr(out, "(2 runs, 1 run now)"));
+    assert_non_null(strstr(out, "(2 runs, 1 of them run now)"));
+    assert_non_null(strstr(out, "| 2 runs, 1 of them run now |"));
+
+    /* a child that dies before writing (killed at its start) is run again: one run, counted
+     * once (issue 46, item 13d: "2 runs, 3 run now" counted every round's starts) */
+    snprintf(path, sizeof path, "%s/w1/biaxial_mu0.25_C0-5e09_seed1_20MPa.h5", g_dir.dir);
+    assert_int_equal(unlink(path), 0);
+    char wrapper[2200], real[2200];
+    snprintf(wrapper, sizeof wrapper, "%s/die-once.sh", g_dir.dir);
+    snprintf(real, sizeof real, "%.*s/cdem-run", (int)(strrchr(g_exe, '/') - g_exe), g_exe);
+    f = fopen(wrapper, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "#!/bin/sh\n[ -e \"$0.once\" ] || { touch \"$0.once\"; exit 1; }\nexec '%s' \"$@\"\n",
+            real);
+    fclose(f);
+    assert_int_equal(chmod(wrapper, 0755), 0);
+    static char cmd2[8192 + 2300];
+    snprintf(cmd2, sizeof cmd2, "%s --cdem-run '%s'", cmd, wrapper);
+    rc = run(cmd2, out, sizeof out);
+    if (rc != 0)
+        print_error("%s\n", out);
+    assert_int_equal(rc, 0);
+    const char *first = strstr(out, "  running biaxial_mu0.25_C0-5e09_seed1_20MPa\n");
+    assert_non_null(first);
+    assert_non_null(strstr(first + 1, "  running biaxial_mu0.25_C0-5e09_seed1_20MPa\n"));
+    assert_non_null(strstr(out, "(2 runs, 1 of them run now)"));
+    assert_null(strstr(out, "2 of them"));
 
     /* the folder of another model (other overrides) is refused, never mixed */
     snprintf(cmd, sizeof cmd,

@@ -1,7 +1,8 @@
 /* The examples' Python tools, run as the example Makefiles run them (/usr/bin/python3 with
  * Debian's Pillow): examples/montage.py keeps every colour of its inputs (issue 35: it saved
  * a palette of 256 to 32 colours, which posterised the colour bars of calibration.png,
- * fig14.png and fig7.png). Runs from the repository root; scratch in $CDEM_TEST_TMP. */
+ * fig14.png and fig7.png); and every example folder's Makefile has a `quick` target (a dry
+ * run of it, no simulation). Runs from the repository root; scratch in $CDEM_TEST_TMP. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -9,6 +10,7 @@
 
 #include <cmocka.h>
 
+#include <glob.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,9 +67,37 @@ static void test_examples_montage_keeps_the_gradients(void **unused) {
     remove(out_png);
 }
 
+/* Every examples/FOLDER/Makefile has a `quick` target meaning QUICK=1 (issue 46, item 13a:
+ * `make -C examples/inversion quick` had no such target): `make -n quick` (a dry run: no
+ * simulation, no folder made) succeeds and its runs go to out-quick/. */
+static void test_examples_every_folder_has_quick(void **unused) {
+    (void)unused;
+    glob_t gl;
+    assert_int_equal(glob("examples/*/Makefile", 0, NULL, &gl), 0);
+    assert_true(gl.gl_pathc >= 10);
+    const char *build = getenv("CDEM_BUILD");
+    static char out[1 << 16];
+    for (size_t k = 0; k < gl.gl_pathc; k++) {
+        char dir[1024], cmd[4096];
+        snprintf(dir, sizeof dir, "%.*s", (int)(strlen(gl.gl_pathv[k]) - strlen("/Makefile")),
+                 gl.gl_pathv[k]);
+        snprintf(cmd, sizeof cmd, "env -u MAKEFLAGS -u MAKELEVEL make -n -C '%s' quick%s%s 2>&1",
+                 dir, build && *build ? " BUILD=" : "", build && *build ? build : "");
+        const int st = run_cmd(cmd, out, sizeof out);
+        if (st != 0)
+            fail_msg("make -n -C %s quick failed (status %d):\n%.2000s", dir, st, out);
+        if (!strstr(out, "out-quick/"))
+            fail_msg("make -n -C %s quick writes nothing to out-quick/ (not QUICK=1?):\n%.2000s",
+                     dir, out);
+    }
+    printf("    %zu example folders have a quick target\n", gl.gl_pathc);
+    globfree(&gl);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_examples_montage_keeps_the_gradients),
+        cmocka_unit_test(test_examples_every_folder_has_quick),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -68,6 +68,8 @@ static void test_follow_renders_new_increments(void **state) {
         }
         if (strstr(line, "the run stopped (completed)"))
             stopped = 1;
+        if (strstr(line, "follow it again")) /* a completed run is not continued */
+            fail_msg("follow offered to follow a completed run again: %s", line);
         if (!at && !strstr(line, "the run stopped"))
             printf("follow said: %s", line); /* an error, shown when the test fails */
     }
@@ -136,7 +138,58 @@ static void test_follow_ends_when_the_writer_is_gone(void **state) {
     fclose(f);
     assert_non_null(strstr(out, "its writer is gone"));
     assert_non_null(strstr(out, "cdem-run --resume"));
+    /* and how to follow the resumed run: --follow does not wait for it (issue 46, 13e) */
+    char again[3400];
+    snprintf(again, sizeof again,
+             "then follow it again with cdem-strain render %s --follow -o %s (and the same "
+             "options): --follow does not wait for a resume",
+             run, live);
+    if (!strstr(out, again))
+        fail_msg("missing \"%s\" in:\n%s", again, out);
     assert_int_equal(access(live, F_OK), 0); /* its last increment was rendered */
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* A run that stopped and can be continued (--max-steps: "stopped-early"): --follow renders
+ * its last increment, exits 0 and says how to follow the run once it is resumed (issue 46,
+ * item 13e: it ended without a word of it, and a resume started after it had gone was not
+ * followed). */
+static void test_follow_says_how_to_follow_a_resumed_run(void **state) {
+    (void)state;
+    char dir[1024], run[1100], live[1100], cmd[4400], out[4096] = "";
+    scratch_path(dir, sizeof dir, "follow_stopped");
+    snprintf(run, sizeof run, "%s/stopped.h5", dir);
+    snprintf(live, sizeof live, "%s/live.png", dir);
+    snprintf(cmd, sizeof cmd,
+             "mkdir -p '%s' && '%s/cdem-run' -q -s assembly.height=2.5 -s "
+             "time.equilibration=150 -s time.display_interval=0.85 --max-steps 200 -o '%s' "
+             ">/dev/null 2>&1",
+             dir, build_dir(), run);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd,
+             "timeout 60 '%s/cdem-strain' render '%s' --follow -o '%s' --interval 0.1 "
+             "> '%s/out.txt' 2>&1",
+             build_dir(), run, live, dir);
+    const int st = system(cmd);
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), 0);
+    snprintf(cmd, sizeof cmd, "%s/out.txt", dir);
+    FILE *f = fopen(cmd, "r");
+    assert_non_null(f);
+    out[fread(out, 1, sizeof out - 1, f)] = '\0';
+    fclose(f);
+    char want[5000];
+    snprintf(want, sizeof want, "%s: the run stopped (stopped-early), last increment ", run);
+    if (!strstr(out, want))
+        fail_msg("missing \"%s\" in:\n%s", want, out);
+    snprintf(want, sizeof want,
+             "%s: after cdem-run --resume %s, follow it again with cdem-strain render %s "
+             "--follow -o %s (and the same options): --follow does not wait for a resume",
+             run, run, run, live);
+    if (!strstr(out, want))
+        fail_msg("missing \"%s\" in:\n%s", want, out);
+    assert_int_equal(access(live, F_OK), 0);
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     assert_int_equal(system(cmd), 0);
 }
@@ -160,6 +213,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_follow_renders_new_increments),
         cmocka_unit_test(test_follow_ends_when_the_writer_is_gone),
+        cmocka_unit_test(test_follow_says_how_to_follow_a_resumed_run),
         cmocka_unit_test(test_follow_usage_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

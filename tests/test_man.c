@@ -186,7 +186,7 @@ static void test_man_detects_a_stale_page(void **state) {
 /* The bash completion is generated from the same help texts (make completion) and must not
  * be stale; and it completes: command words, a command's options, quantity names after
  * --color, the words of a choice list, cdem-run's options (issue 18: generated from the
- * option tables). */
+ * option tables) and the section.key= words after cdem-run -s. */
 static void test_man_completion_fresh_and_working(void **state) {
     man_ctx *c = *state;
     char cmd[4400], generated[2100], msg[2400];
@@ -211,6 +211,9 @@ static void test_man_completion_fresh_and_working(void **state) {
         {"cdem-strain help plot", "plot-series plot-csv"},
         {"cdem-strain info run.h5 --j", "--json"},
         {"cdem-run --par", "--params-markdown --par-min"},
+        /* -s: every key of --print-defaults as section.key= (issue 46, item 13b: nothing) */
+        {"cdem-run model.ini -s physics.grav", "physics.gravity="},
+        {"cdem-run -s assembly.half", "assembly.half_radii="},
         /* a choice list whose words hold hyphens: whole words, and no "-strain" option */
         {"cdem-strain render run.h5 --axes ''", "incr-strain total-strain stress"},
         {"cdem-strain render run.h5 -", NULL},

@@ -9,6 +9,8 @@
  *    says with the run and the increments.
  *  - A damaged index gave "analysis: the run has no increments": the message says what is
  *    wrong and names the file.
+ *  - A folder given as a run file said "not a regular file" (issue 46, item 13c): it says it
+ *    is a folder, and for a cdem2D folder how to import it.
  * Files go to a scratch folder; cdem-run and cdem-strain come from $CDEM_BUILD. */
 #define _GNU_SOURCE /* unshare, CLONE_NEWNS, CLONE_NEWUSER */
 #include <stdarg.h>
@@ -367,11 +369,41 @@ static void test_messages_no_increments(void **state) {
              "0 (killed or crashed; no writer holds the file)");
 }
 
+/* ------------------------------------------------------------------ a folder */
+
+/* A folder given as a run file (issue 46, item 13c: "not a regular file" for a cdem2D
+ * folder, without a word of import-cdem2d): the message says it is a folder and, for a
+ * cdem2D simulation folder, gives the import command. */
+static void test_messages_folder_given_as_run(void **state) {
+    (void)state;
+    char out[1 << 14], dir[1200];
+    const char *data = getenv("CDEM_TEST_DATA");
+    if (!realpath(data && *data ? data : "tests/data", dir))
+        fail_msg("no tests/data");
+    static const char *const commands[][2] = {
+        {"info", ""}, {"compute", " --increment last --quantity incr-e1"}, {"render", " -o x.png"}};
+    for (size_t c = 0; c < 3; c++) {
+        assert_int_equal(run(out, sizeof out, "%s %s '%s/cdem2d_basic'%s", g_strain, commands[c][0],
+                             dir, commands[c][1]),
+                         1);
+        HAS(out, "/cdem2d_basic: is a folder, not a cdem run file; it holds modelresults_N.txt "
+                 "files, so it looks like a cdem2D simulation folder: import it with "
+                 "`cdem-strain import-cdem2d ");
+        HAS(out, "/cdem2d_basic -o run.h5` and read run.h5");
+        assert_null(strstr(out, "not a regular file"));
+    }
+    /* any other folder: a folder, and no import advice */
+    assert_int_equal(run(out, sizeof out, "mkdir -p plain && %s info plain", g_strain), 1);
+    HAS(out, "plain: is a folder, not a cdem run file (the HDF5 file cdem-run writes)");
+    assert_null(strstr(out, "import-cdem2d"));
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_messages_read_only_folder),
         cmocka_unit_test(test_messages_duplicate_id),
         cmocka_unit_test(test_messages_no_increments),
+        cmocka_unit_test(test_messages_folder_given_as_run),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

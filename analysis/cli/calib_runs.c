@@ -312,12 +312,27 @@ cdem_status cdem_calib_complete(const cdem_calib_runner *r, cdem_calib_run *runs
             nanosleep(&ts, NULL);
             continue;
         }
-        *n_ran += m;
         st = r->slurm_script ? run_slurm(r, runs, todo, m, round, err)
                              : run_local(r, runs, todo, resume, m, err);
     }
+    /* each run once, however many rounds it took (a run killed and resumed was counted
+     * twice: "2 runs, 3 run now", issue 46, item 13d) */
+    for (size_t i = 0; i < n; i++)
+        *n_ran += attempts[i] > 0;
     free(attempts);
     free(todo);
     free(resume);
     return st;
+}
+
+void cdem_calib_count_text(size_t n_runs, size_t n_ran, char *buf, size_t cap) {
+    if (n_ran > n_runs)
+        n_ran = n_runs;
+    const char *runs = n_runs == 1 ? "run" : "runs";
+    if (n_ran == 0)
+        snprintf(buf, cap, "%zu %s, none run now", n_runs, runs);
+    else if (n_ran == n_runs)
+        snprintf(buf, cap, "%zu %s, %s run now", n_runs, runs, n_runs == 1 ? "it was" : "all");
+    else
+        snprintf(buf, cap, "%zu %s, %zu of them run now", n_runs, runs, n_ran);
 }

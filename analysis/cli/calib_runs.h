@@ -64,11 +64,16 @@ cdem_status cdem_calib_find_cdem_run(const char *given, char *path, size_t cap, 
 void cdem_calib_self(char *path, size_t cap);
 
 /* Brings every run to "completed": reads each file's state, runs, resumes or waits for
- * those not finished (see above), then checks every file again. *n_ran gets the number run
- * or resumed now. Fails naming the first run that did not complete and its log's last
- * lines. */
+ * those not finished (see above), then checks every file again. *n_ran gets the number of
+ * runs run or resumed now, each counted once (a run killed and resumed is one run). Fails naming
+ * the first run that did not complete and its log's last lines. */
 cdem_status cdem_calib_complete(const cdem_calib_runner *r, cdem_calib_run *runs, size_t n,
                                 size_t *n_ran, cdem_error *err);
+
+/* The counts of a design point's runs in words, into buf: "1 run, it was run now", "2 runs,
+ * all run now", "3 runs, 1 of them run now", "2 runs, none run now" (read from finished
+ * files). n_ran is clamped to n_runs. */
+void cdem_calib_count_text(size_t n_runs, size_t n_ran, char *buf, size_t cap);
 
 /* The stop reason of a run file in *reason ("" when it cannot be opened: not yet written),
  * and whether a writer holds it (1), none (0) or it cannot be told (-1). */

@@ -451,7 +451,9 @@ static void say_measure(cal_report *r, const char *label, const cal_measure *m, 
         m->phi, pm(m->phi_err, e1, sizeof e1), m->coh, pm(m->coh_err, e2, sizeof e2));
     if (ucs && isfinite(m->ucs))
         say(r, ", unconfined %.3f %s MPa", m->ucs, pm(m->ucs_err, e1, sizeof e1));
-    say(r, " (%zu runs, %zu run now)\n", m->n_runs, m->n_ran);
+    char counts[96];
+    cdem_calib_count_text(m->n_runs, m->n_ran, counts, sizeof counts);
+    say(r, " (%s)\n", counts);
 }
 
 static double elapsed_since(const struct timespec *t0) {
@@ -621,10 +623,11 @@ static void say_table(cal_state *c) {
     say(&c->rep, "|---|---|---|---|---|---|---|\n");
     for (size_t i = 0; i < c->n; i++) {
         const cal_measure *m = &c->meas[i];
-        say(&c->rep, "| %zu | %.4g | %.4g | %.2f %s | %.3f %s | %.3f %s | %zu (%zu run now) |\n",
-            i + 1, m->mu, m->c0, m->phi, pm(m->phi_err, e1, sizeof e1), m->coh,
-            pm(m->coh_err, e2, sizeof e2), m->ucs, pm(m->ucs_err, e3, sizeof e3), m->n_runs,
-            m->n_ran);
+        char counts[96];
+        cdem_calib_count_text(m->n_runs, m->n_ran, counts, sizeof counts);
+        say(&c->rep, "| %zu | %.4g | %.4g | %.2f %s | %.3f %s | %.3f %s | %s |\n", i + 1, m->mu,
+            m->c0, m->phi, pm(m->phi_err, e1, sizeof e1), m->coh, pm(m->coh_err, e2, sizeof e2),
+            m->ucs, pm(m->ucs_err, e3, sizeof e3), counts);
     }
     say(&c->rep, "\n");
 }

@@ -530,7 +530,8 @@ static int wait_for_stop(const sigset_t *set, double seconds) {
  * re-renders its newest increment whenever a new one arrives; ends when the run's stop
  * reason is no longer "running" (after rendering its last increment), when the run's
  * writer is gone without recording a stop (killed: its lock is free, runlock.h), or on
- * Ctrl-C. */
+ * Ctrl-C. It does not wait for a resume: when the run can be continued, its last message
+ * gives the --follow command for the resumed run. */
 static int run_follow(const render_args *a) {
     cdem_error err;
     cdem_error_clear(&err);
@@ -575,17 +576,29 @@ static int run_follow(const render_args *a) {
                 fprintf(stderr, "cdem-strain render: note: %s\n", err.msg);
             }
         }
+        /* --follow ends with its run: a run continued later (cdem-run --resume) is followed
+         * by a new --follow, which the messages give (issue 46, item 13e: "writer is gone"
+         * said nothing of following the resumed run) */
         if (stopped) {
-            printf("%s: the run stopped (%s), last increment %d\n", a->path,
-                   cdem_h5_reader_stop_reason(r), (int)shown);
+            const char *why = cdem_h5_reader_stop_reason(r);
+            const int resumable = !strcmp(why, "interrupted") || !strcmp(why, "stopped-early") ||
+                                  !strcmp(why, "write-failure");
+            printf("%s: the run stopped (%s), last increment %d\n", a->path, why, (int)shown);
+            if (resumable)
+                printf("%s: after cdem-run --resume %s, follow it again with cdem-strain render "
+                       "%s --follow -o %s (and the same options): --follow does not wait for a "
+                       "resume\n",
+                       a->path, a->path, a->path, a->output);
             break;
         }
         if (writer_gone) { /* the file was read again after its writer's lock was free */
             fprintf(stderr,
                     "cdem-strain render: %s: its writer is gone without recording how the run "
                     "ended (killed?); the file keeps its %zu complete increments, the last one "
-                    "rendered (%d); continue the run with cdem-run --resume %s\n",
-                    a->path, n, (int)shown, a->path);
+                    "rendered (%d); continue the run with cdem-run --resume %s, then follow it "
+                    "again with cdem-strain render %s --follow -o %s (and the same options): "
+                    "--follow does not wait for a resume\n",
+                    a->path, n, (int)shown, a->path, a->path, a->output);
             rc = 1;
             break;
         }

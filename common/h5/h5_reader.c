@@ -10,6 +10,7 @@
 #include "h5_internal.h"
 
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -157,14 +158,46 @@ cdem_status cdem_h5_reader_refresh(cdem_h5_reader *r, int *changed, cdem_error *
     return st;
 }
 
+/* 1 when the folder holds a modelresults_N.txt file, as a cdem2D simulation folder does
+ * (analysis/input/cdem2d.c reads one; here it is only recognised, to say what to do). */
+static int looks_like_cdem2d(const char *dir) {
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    static const char pre[] = "modelresults_";
+    int found = 0;
+    const struct dirent *e;
+    while (!found && (e = readdir(d)) != NULL) {
+        const char *name = e->d_name;
+        const size_t len = strlen(name);
+        found = len > strlen(pre) + 4 && strncmp(name, pre, strlen(pre)) == 0 &&
+                isdigit((unsigned char)name[strlen(pre)]) && !strcmp(name + len - 4, ".txt");
+    }
+    closedir(d);
+    return found;
+}
+
 static cdem_status reader_setup(cdem_h5_reader *r, cdem_error *err) {
     const char *path = r->path;
     struct stat sb;
     if (stat(path, &sb) != 0)
         return CDEM_FAIL(err, errno == ENOENT ? CDEM_ERR_NOTFOUND : CDEM_ERR_IO,
                          "%s: cannot open: %s", path, strerror(errno));
+    if (S_ISDIR(sb.st_mode) && looks_like_cdem2d(path))
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: is a folder, not a cdem run file; it holds modelresults_N.txt "
+                         "files, so it looks like a cdem2D simulation folder: import it with "
+                         "`cdem-strain import-cdem2d %s -o run.h5` and read run.h5",
+                         path, path);
+    if (S_ISDIR(sb.st_mode))
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: is a folder, not a cdem run file (the HDF5 file cdem-run writes)",
+                         path);
     if (!S_ISREG(sb.st_mode))
-        return CDEM_FAIL(err, CDEM_ERR_IO, "%s: not a regular file", path);
+        return CDEM_FAIL(err, CDEM_ERR_IO,
+                         "%s: not a regular file (a device, pipe or socket), so not a cdem run "
+                         "file",
+                         path);
     htri_t is = H5Fis_hdf5(path);
     if (is <= 0)
         return H5FAIL(err, CDEM_ERR_FORMAT,
