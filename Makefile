@@ -62,7 +62,9 @@ CDEM_CFLAGS += -DCDEM_VERSION='"$(VERSION)"'
 # The solver is layered by its second folder too (docs/solver.md, "Source files"), each
 # seeing those before it: base/ (derived constants, checkpoint helpers), contact/ (the pair
 # force), modes/ (the boundary modes: base/ only), step/ (the time step), packing/ (the
-# assembly and the growth strata's deposits), run/ (the run loop) and main.c (all).
+# assembly and the growth strata's deposits), run/ (the run loop) and main.c (all); between
+# step/ and packing/ the physical processes: process/ (their interface and registry) and a
+# folder per process (salt/), which sees process/ and the stepper.
 # The analysis is layered again by its second folder (docs/analysis.md, "Source files"):
 # measure/ sees only itself, input/ and export/ see measure/, draw/ sees only itself, and
 # cli/ sees them all (each also sees common/).
@@ -71,7 +73,9 @@ INC_solver_base    := -Icommon -Isolver/base
 INC_solver_contact := $(INC_solver_base) -Isolver/contact
 INC_solver_modes   := $(INC_solver_base) -Isolver/modes
 INC_solver_step    := $(INC_solver_contact) -Isolver/modes -Isolver/step
-INC_solver_packing := $(INC_solver_step) -Isolver/packing
+INC_solver_process := $(INC_solver_step) -Isolver/process
+INC_solver_salt    := $(INC_solver_process) -Isolver/salt
+INC_solver_packing := $(INC_solver_salt) -Isolver/packing
 INC_solver_run     := $(INC_solver_packing) -Isolver/run
 INC_solver   := $(INC_solver_run)
 INC_analysis := -Icommon -Ianalysis
@@ -83,7 +87,10 @@ INC_analysis_cli     := $(INC_analysis) -Ianalysis/measure -Ianalysis/input -Ian
                         -Ianalysis/draw -Ianalysis/cli
 INC_tests    := $(INC_solver) $(filter-out -Icommon,$(INC_analysis_cli))
 path_words = $(subst /, ,$(1))
-layer_inc = $(or $(INC_$(word 1,$(call path_words,$(1)))_$(word 2,$(call path_words,$(1)))),$(INC_$(word 1,$(call path_words,$(1)))))
+# A solver folder without a line above is a process's (solver/process/process.h): it sees the
+# processes' interface, the stepper below it and itself, so a new process adds no line here.
+process_inc = $(if $(and $(filter solver,$(word 1,$(call path_words,$(1)))),$(word 3,$(call path_words,$(1)))),$(INC_solver_process) -Isolver/$(word 2,$(call path_words,$(1))))
+layer_inc = $(or $(INC_$(word 1,$(call path_words,$(1)))_$(word 2,$(call path_words,$(1)))),$(call process_inc,$(1)),$(INC_$(word 1,$(call path_words,$(1)))))
 compile_flags = $(CDEM_CFLAGS) $(1) $(PKG_CFLAGS) $(CPPFLAGS) $(CFLAGS)
 
 COMMON_SRC   := $(wildcard common/*.c common/h5/*.c)

@@ -58,6 +58,7 @@ typedef struct {
     cdem_state s;
     cdem_integrator it;
     cdem_salt_layer layer;
+    cdem_salt salt;     /* the module, joined to it.viscous (cdem_salt_join) */
     double y_base, gap; /* m: the base's surface, the salt's height */
 } salt_cell;
 
@@ -105,8 +106,8 @@ __attribute__((unused)) static int salt_cell_open(salt_cell *c, const cdem_param
         return 0;
     if (cdem_integrator_init(&c->it, &c->p, &c->m, err) != CDEM_OK)
         return 0;
-    if (cdem_salt_configure(&c->it.viscous.salt, &c->m, &c->p, &c->layer, c->it.nb.skin, err) !=
-        CDEM_OK)
+    if (cdem_salt_configure(&c->salt, &c->m, &c->p, &c->layer, c->it.nb.skin, err) != CDEM_OK ||
+        cdem_salt_join(&c->salt, &c->it.viscous, err) != CDEM_OK)
         return 0;
     c->it.damping_factor = 0.0; /* the deformation steps of damping_mode = contact */
     c->it.equilibrating = 0;
@@ -115,6 +116,7 @@ __attribute__((unused)) static int salt_cell_open(salt_cell *c, const cdem_param
 
 __attribute__((unused)) static void salt_cell_close(salt_cell *c) {
     cdem_integrator_free(&c->it);
+    cdem_salt_free(&c->salt);
     cdem_state_free(&c->s);
 }
 
@@ -204,8 +206,7 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     free(keep);
     /* the salt measured again in the box it now fills, and the module set up with it */
     if (cdem_salt_measure(&c.s, W * H, c.m.salt.reach, &c.layer, err) != CDEM_OK ||
-        cdem_salt_configure(&c.it.viscous.salt, &c.m, &c.p, &c.layer, c.it.nb.skin, err) !=
-            CDEM_OK) {
+        cdem_salt_configure(&c.salt, &c.m, &c.p, &c.layer, c.it.nb.skin, err) != CDEM_OK) {
         salt_cell_close(&c);
         return 0;
     }
@@ -263,7 +264,7 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
         out->tau_base += fb / W;
         out->tau_walls += fw / W;
         n_avg++;
-        const cdem_salt *salt = &c.it.viscous.salt;
+        const cdem_salt *salt = &c.salt;
         for (size_t i = 0; i < c.s.n; i++) {
             if (!(c.s.flags[i] & CDEM_FLAG_SALT))
                 continue;

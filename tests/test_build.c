@@ -81,11 +81,11 @@ static void test_build_layer_include_paths(void **state) {
     (void)state;
     static const struct {
         const char *object, *source;
-        const char *allowed[3], *forbidden[4];
+        const char *allowed[3], *forbidden[5];
     } layers[] = {
         {"common/state.o", "common/state.c", {"-Icommon"}, {"-Isolver", "-Ianalysis"}},
-        /* the solver's layers: base/ < contact/ < step/ < packing/ < run/, and modes/ sees
-         * base/ only (step/ and above see it) */
+        /* the solver's layers: base/ < contact/ < step/ < process/ < salt/ < packing/ < run/, and
+         * modes/ sees base/ only (step/ and above see it) */
         {"solver/base/model.o",
          "solver/base/model.c",
          {"-Icommon", "-Isolver/base"},
@@ -101,6 +101,16 @@ static void test_build_layer_include_paths(void **state) {
         {"solver/step/integrate.o",
          "solver/step/integrate.c",
          {"-Isolver/contact", "-Isolver/modes", "-Isolver/step"},
+         {"-Ianalysis", "-Isolver/process", "-Isolver/salt", "-Isolver/packing", "-Isolver/run"}},
+        /* the processes (process.h): their interface and registry see the stepper, a
+         * process's folder sees them and the stepper, nothing above */
+        {"solver/process/process_registry.o",
+         "solver/process/process_registry.c",
+         {"-Isolver/step", "-Isolver/process"},
+         {"-Ianalysis", "-Isolver/salt", "-Isolver/packing", "-Isolver/run"}},
+        {"solver/salt/salt_process.o",
+         "solver/salt/salt_process.c",
+         {"-Isolver/step", "-Isolver/process", "-Isolver/salt"},
          {"-Ianalysis", "-Isolver/packing", "-Isolver/run"}},
         {"solver/packing/sediment.o",
          "solver/packing/sediment.c",

@@ -1,5 +1,5 @@
-/* test_salt: the viscous salt (solver/step/salt.h, its pair law common/laws/law_salt.h, its
- * rules solver/step/salt_rules.c). Fast checks of make test:
+/* test_salt: the viscous salt (solver/salt/salt.h, its pair law common/laws/law_salt.h, its
+ * rules solver/salt/salt_rules.c). Fast checks of make test:
  *   salt-1 the pair law's kernels: no shear strength, the repulsion only against a non-salt
  *          element, the central dashpot and its weight, no force for a rigid rotation;
  *   salt-2 the viscous kernel: the grid's stress of an affine simple shear is eta x rate and
@@ -87,7 +87,7 @@ static void test_salt_viscous_kernel_simple_shear(void **state) {
             c.s.vx[i] = rate * (c.s.y[i] - 0.5 * H);
     cdem_error err;
     assert_int_equal(cdem_integrator_prime(&c.it, &c.s, &err), CDEM_OK);
-    const cdem_salt *salt = &c.it.viscous.salt;
+    const cdem_salt *salt = &c.salt;
     const double eta = salt->viscosity;
     const double p_expect = c.m.salt.bulk_modulus * (1.0 / j0 - 1.0);
     double sum_sxy = 0.0, sum_p = 0.0, worst = 0.0;
@@ -170,7 +170,7 @@ static void test_salt_projection_moves_with_j(void **state) {
         open_cell(&c, 1.0);
         cdem_error err;
         assert_int_equal(cdem_integrator_prime(&c.it, &c.s, &err), CDEM_OK);
-        cdem_salt *salt = &c.it.viscous.salt;
+        cdem_salt *salt = &c.salt;
         const double U = 0.3, V = -0.1, dt = c.it.dt, a = sign * 1e-2;
         double *x0 = malloc(c.s.n * sizeof *x0), *y0 = malloc(c.s.n * sizeof *y0);
         assert_non_null(x0);

@@ -140,12 +140,9 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_contact_assign_weak(p, &r->s, &n_weak, err));
     if (run_logging(r) && p->weak_interval != CDEM_WEAK_OFF)
         fprintf(opt->log, "cdem-run: weak/light interval: %ld elements flagged weak\n", n_weak);
-    CDEM_TRY(cdem_salt_place(p, &r->m, &r->s, &r->salt, err));
-    if (run_logging(r) && r->salt.elements > 0)
-        fprintf(opt->log,
-                "cdem-run: salt: %ld elements between y = %.6g and %.6g m, packing fraction %.4f, "
-                "dashpot beta %.4g\n",
-                r->salt.elements, r->salt.band_lo, r->salt.band_hi, r->salt.phi, r->salt.beta);
+    CDEM_TRY(cdem_processes_init(&r->procs, p, err));
+    CDEM_TRY(
+        cdem_processes_place(&r->procs, p, &r->m, &r->s, run_logging(r) ? opt->log : NULL, err));
     r->erosion_y = INFINITY;
     /* the base: wall elements within half a radius of the lowest; the lateral walls' sides:
      * halfway between the outermost wall elements (walls only ever move inward, never past
@@ -161,7 +158,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     r->wall_mid_x = 0.5 * (xlo + xhi);
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
-    CDEM_TRY(cdem_salt_configure(&r->it.viscous.salt, &r->m, p, &r->salt, r->it.nb.skin, err));
+    CDEM_TRY(cdem_processes_configure(&r->procs, p, &r->m, &r->it, err));
     r->it.unstable_guard = 1;    /* check_unstable */
     r->ckpt.boundary_forces = 1; /* the forces of the first evaluation are current */
     r->it.equilibrating = 1;     /* the packing phase's law until the end of equilibration */
@@ -395,6 +392,7 @@ static void run_release(run_ctx *r) {
     if (r->gov_started)
         cdem_governor_finish(&r->gov);
     cdem_integrator_free(&r->it);
+    cdem_processes_free(&r->procs); /* after the stepper, which held their hooks */
     cdem_sediment_free(&r->sed);
     cdem_bc_free(&r->bc);
     cdem_state_free(&r->s);
@@ -471,11 +469,7 @@ cdem_status cdem_run_close(cdem_run_ctx *r, cdem_status st, cdem_error *err) {
                                                           : "failed";
         run_progress_line(r, 1, ending);
         run_end_progress_line(r);
-        if (r->salt.elements > 0)
-            fprintf(r->opt->log,
-                    "cdem-run: salt: area %.6g m^2 at placement; largest change at an increment "
-                    "%.3g %%\n",
-                    r->salt.disc_area / r->salt.phi, 100.0 * r->salt_area_change);
+        cdem_processes_finish(&r->procs, r->opt->log);
     }
     const int had_writer = r->w != NULL;
     if (r->w) {

@@ -17,6 +17,7 @@
 #include "h5format.h"
 #include "integrate.h"
 #include "model.h"
+#include "process.h"
 #include "run.h"
 #include "sediment.h"
 #include "snapshot.h"
@@ -63,9 +64,7 @@ struct cdem_run_ctx {
     cdem_model m;                /* derived constants */
     cdem_state s;                /* the elements */
     cdem_assembly_info info;     /* what the assembly generator built */
-    cdem_salt_layer salt;        /* what the salt's placement measured (none: zeros) */
-    double salt_area_change;     /* largest |salt area / its area at placement - 1| over the
-                                    increments this process wrote (logged at the end) */
+    cdem_processes procs;        /* the processes the parameters turn on (process.h) */
     cdem_bc bc;                  /* boundary mode */
     cdem_integrator it;          /* time stepper */
     cdem_sediment sed;           /* syn-tectonic sedimentation (disabled when off) */

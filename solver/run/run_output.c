@@ -5,7 +5,6 @@
  * measures) and the summary text. */
 #include "run_ctx.h"
 
-#include "salt.h"
 #include "stress.h"
 #include "summary.h"
 
@@ -33,19 +32,9 @@ static cdem_status erode(run_ctx *r, cdem_error *err) {
 
 cdem_status run_write_increment(run_ctx *r, cdem_error *err) {
     CDEM_TRY(erode(r, err));
-    if (r->p->calculate_stress) {
+    if (r->p->calculate_stress)
         CDEM_TRY(cdem_stress_compute(&r->it.nb, &r->s, err));
-        /* salt elements: their continuum stress (no pair of the list carries theirs) */
-        cdem_salt_stress(&r->it.viscous.salt, &r->s);
-    }
-    if (r->salt.elements > 0 && r->salt.phi > 0.0) {
-        double area, top;
-        long count;
-        cdem_salt_measures(&r->s, r->salt.phi, &area, &top, &count);
-        const double change = fabs(area / (r->salt.disc_area / r->salt.phi) - 1.0);
-        if (change > r->salt_area_change)
-            r->salt_area_change = change;
-    }
+    cdem_processes_increment(&r->procs, &r->s); /* their stress and measures (process.h) */
     cdem_increment_info inf;
     memset(&inf, 0, sizeof inf);
     inf.number = r->next_inc;
@@ -111,11 +100,8 @@ cdem_status run_write_sample(run_ctx *r, cdem_error *err) {
     q.right_wall_force_x = wall[1][0];
     q.right_wall_force_y = wall[1][1];
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
-    q.salt_area = q.salt_top = NAN;
-    if (r->salt.elements > 0 && r->salt.phi > 0.0) {
-        long count;
-        cdem_salt_measures(s, r->salt.phi, &q.salt_area, &q.salt_top, &count);
-    }
+    q.salt_area = q.salt_top = NAN; /* the columns of a process that is off */
+    cdem_processes_sample(&r->procs, s, &q);
     cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;
 }

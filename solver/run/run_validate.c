@@ -1,14 +1,14 @@
 /* run_validate: every rule the parameters of a cdem-run run obey, checked before anything is
  * built: the table's ranges and rules (common/params.c) and, in the same message, the
  * solver's own: the boundary mode's (its validate hook and excludes, and whether it inverts:
- * modes/bc_registry.c), the growth strata's (packing/sediment.c) and the salt's
- * (step/salt_rules.c). And the one limit on the size of a model that is not a rule of its
- * parameters: the memory of the machine it runs on (cdem_run_check_memory). */
+ * modes/bc_registry.c), the growth strata's (packing/sediment.c) and the processes' (their
+ * rules hooks: process/process.h). And the one limit on the size of a model that is not a rule of
+ * its parameters: the memory of the machine it runs on (cdem_run_check_memory). */
 #include "run.h"
 
 #include "bc.h"
 #include "model.h"
-#include "salt.h"
+#include "process.h"
 #include "sediment.h"
 
 #include <stdio.h>
@@ -19,7 +19,7 @@
 static void solver_rules(const cdem_params *p, cdem_rule_log *log) {
     cdem_bc_rules(p, log);
     cdem_sediment_rules(p, log);
-    cdem_salt_rules(p, log);
+    cdem_processes_rules(p, log);
 }
 
 cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err) {

@@ -10,7 +10,7 @@
 #include "summary.h"
 
 #include "bc.h"
-#include "salt.h"
+#include "process.h"
 #include "summary_line.h"
 
 #include <math.h>
@@ -42,54 +42,6 @@ static void contact_line(FILE *f, const char *label, const cdem_params *p,
     else
         line(f, label, "breaking strain %g (bond breaks when r - R >= %g R)", c->breaking_strain,
              c->breaking_strain);
-}
-
-/* The salt's section (docs/solver.md, section 9): where it is, its material and how the
- * model's clock maps onto geological time, with the ratio that mapping keeps. */
-static void salt_lines(FILE *f, const cdem_params *p, const cdem_model *m) {
-    const cdem_salt_model *sm = &m->salt;
-    cdem_salt_time t;
-    cdem_salt_time_map(p, m, &t);
-    heading(f, "Salt");
-    if (p->salt_layer == CDEM_SALT_BASAL)
-        line(f, "layer",
-             "basal, lowest %g %% of the span of element centres = %.6g m (fixed at "
-             "assembly)",
-             p->salt_thickness_percent, t.salt_thickness);
-    else
-        line(f, "layer",
-             "interval from %g to %g %% of the span of element centres = %.6g m "
-             "(fixed at assembly)",
-             p->salt_interval_bottom_percent, p->salt_interval_top_percent, t.salt_thickness);
-    line(f, "cover above", "%.6g m", t.cover_thickness);
-    line(f, "salt density", "%g kg/m^3 (smallest salt mass %.6g kg/m)", sm->density, sm->mass[0]);
-    line(f, "viscosity", "%g Pa s geological = %.4g Pa s in the model (/ time scale)",
-         sm->viscosity_geological, sm->viscosity);
-    line(f, "geological rate", "%g mm/yr = %.4g m/s, shown by the model's %.6g m/s", p->salt_rate,
-         sm->rate, m->boundary_speed);
-    line(f, "time scale S", "%.4g (1 model s = %.4g yr%s)", sm->time_scale,
-         sm->time_scale / CDEM_SECONDS_PER_YEAR,
-         isnan(p->salt_time_scale) ? "; boundary speed / geological rate" : "; salt.time_scale");
-    line(f, "deformation phase", "%g s of model time = %.4g Myr", p->runtime - p->equilibration,
-         t.deformation_yr / 1e6);
-    if (isnan(t.pi_ratio))
-        line(f, "eta V / (rho g h H)", "none (gravity off)");
-    else
-        line(f, "eta V / (rho g h H)",
-             "%.3g (salt %.6g m, cover %.6g m): the same in model and nature", t.pi_ratio,
-             t.salt_thickness, t.cover_thickness);
-    line(f, "Reynolds number", "%.3g (rho_s V h / eta in the model; %s)", t.reynolds,
-         t.reynolds < 0.1 ? "viscous" : "WARNING: above 0.1, inertia is not negligible");
-    line(f, "grid", "%.6g m (%g mean radii), bulk modulus %g Pa", sm->grid_spacing,
-         p->salt_grid_spacing, sm->bulk_modulus);
-    line(f, "time-step limits", "grid viscosity %.3g s, grid pressure %.3g s (time step %.6g s)",
-         t.dt_viscous, t.dt_pressure, m->dt);
-    line(f, "damping", "%s (absolute damping would give D = %.3g)",
-         p->damping_mode == CDEM_DAMPING_CONTACT ? "contact" : "absolute", t.damping_number);
-    line(f, "contacts", "cover %s, base %s, walls %s; salt pairs: no friction, no cohesion",
-         p->salt_cover_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip",
-         p->salt_base_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip",
-         p->salt_wall_contact == CDEM_SALT_NO_SLIP ? "no-slip" : "free-slip");
 }
 
 cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
@@ -268,8 +220,7 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, "layered friction", "off");
     line(f, "pre-growth layers", "%d of equal thickness", CDEM_PREGROWTH_LAYERS);
 
-    if (m->salt.on)
-        salt_lines(f, p, m);
+    cdem_processes_describe(p, m, f); /* each process's section (process.h) */
 
     heading(f, "Surface processes");
     if (p->overburden_pressure > 0)

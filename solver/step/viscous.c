@@ -13,10 +13,20 @@ void cdem_viscous_init(cdem_viscous *v, const cdem_model *m) {
     v->kn = m->kn;
 }
 
+cdem_status cdem_viscous_add(cdem_viscous *v, const cdem_viscous_hooks *hooks, void *ctx,
+                             cdem_error *err) {
+    if (v->n_processes >= CDEM_VISCOUS_PROCESSES)
+        return CDEM_FAIL(err, CDEM_ERR_RANGE, "viscous forces: at most %d processes at once",
+                         CDEM_VISCOUS_PROCESSES);
+    v->hooks[v->n_processes] = hooks;
+    v->ctx[v->n_processes] = ctx;
+    v->n_processes++;
+    return CDEM_OK;
+}
+
 void cdem_viscous_free(cdem_viscous *v) {
     if (!v)
         return;
-    cdem_salt_free(&v->salt);
     free(v->ex);
     free(v->ey);
     memset(v, 0, sizeof *v);
@@ -38,7 +48,10 @@ cdem_status cdem_viscous_after_build(cdem_viscous *v, const cdem_neighbour *nb, 
         v->ey = b;
         v->cap = c;
     }
-    return cdem_salt_after_build(&v->salt, nb, s, err);
+    for (int k = 0; k < v->n_processes; k++)
+        if (v->hooks[k]->after_build)
+            CDEM_TRY(v->hooks[k]->after_build(v->ctx[k], nb, s, err));
+    return CDEM_OK;
 }
 
 /* The contact dashpots over the pair list (viscous.h). */
@@ -71,7 +84,9 @@ void cdem_viscous_forces(cdem_viscous *v, const cdem_neighbour *nb, const cdem_s
     memset(v->ey, 0, s->n * sizeof *v->ey);
     if (v->contact_damping > 0.0)
         contact_dashpots(v, nb, s);
-    cdem_salt_forces(&v->salt, s, v->ex, v->ey);
+    for (int k = 0; k < v->n_processes; k++)
+        if (v->hooks[k]->forces)
+            v->hooks[k]->forces(v->ctx[k], s, v->ex, v->ey);
 }
 
 void cdem_viscous_finish(cdem_viscous *v, cdem_state *s, int kick, double dt, double c) {
@@ -89,7 +104,8 @@ void cdem_viscous_finish(cdem_viscous *v, cdem_state *s, int kick, double dt, do
             s->fy[i] += ey;
         }
     }
-    if (kick && dt > 0.0) {
-        cdem_salt_project(&v->salt, s, dt);
-    }
+    if (kick && dt > 0.0)
+        for (int k = 0; k < v->n_processes; k++)
+            if (v->hooks[k]->after_step)
+                v->hooks[k]->after_step(v->ctx[k], s, dt);
 }

@@ -19,35 +19,60 @@
  * the salt does (docs/solver.md, "Damping").
  * Determinism: serial sums in pair order (the pair list's slots, then the salt's pairs): the
  * same bits for any thread count. Nothing allocates in a step (buffers grow at list builds).
- * Ownership: cdem_viscous owns its buffers and the salt module; never the state. Units: SI. */
+ * The processes' forces (the salt's, solver/salt/) come through cdem_viscous_hooks: a
+ * process adds its hooks and its context (cdem_viscous_add) when it is configured, and the
+ * module calls them in the order they were added; it knows no process by name.
+ * Ownership: cdem_viscous owns its buffers, never the state or a process's context (the
+ * process's, solver/process/). Units: SI. */
 #ifndef CDEM_VISCOUS_H
 #define CDEM_VISCOUS_H
 
 #include "cdem_error.h"
 #include "model.h"
 #include "neighbour.h"
-#include "salt.h"
 #include "state.h"
+
+/* A process's forces beside the pair list's (a viscous continuum: the salt). */
+typedef struct {
+    /* after each list build (and a checkpoint's restored list): its own structures from the
+     * list and the positions of the build */
+    cdem_status (*after_build)(void *ctx, const cdem_neighbour *nb, const cdem_state *s,
+                               cdem_error *err);
+    /* its forces of the current positions and mid-step velocities, added into ex, ey */
+    void (*forces)(void *ctx, const cdem_state *s, double *ex, double *ey);
+    /* after a time step dt (its kick done): its own update (the salt's area) */
+    void (*after_step)(void *ctx, cdem_state *s, double dt);
+} cdem_viscous_hooks;
+
+/* The processes a step can hold at once. */
+#define CDEM_VISCOUS_PROCESSES 4
 
 typedef struct {
     double contact_damping; /* zeta, fraction of critical (0: off) */
     double kn;              /* N/m */
-    cdem_salt salt;         /* salt.on = 0: no salt */
-    double *ex, *ey;        /* N: this step's forces on each element */
-    size_t cap;             /* capacity of ex, ey */
+    int n_processes;        /* processes whose forces join the step */
+    const cdem_viscous_hooks *hooks[CDEM_VISCOUS_PROCESSES];
+    void *ctx[CDEM_VISCOUS_PROCESSES]; /* theirs, not owned */
+    double *ex, *ey;                   /* N: this step's forces on each element */
+    size_t cap;                        /* capacity of ex, ey */
 } cdem_viscous;
 
-/* Sets up the contact damping from the model (the salt: cdem_salt_configure on .salt). */
+/* Sets up the contact damping from the model (a process adds itself: cdem_viscous_add). */
 void cdem_viscous_init(cdem_viscous *v, const cdem_model *m);
 void cdem_viscous_free(cdem_viscous *v);
 
-/* 1 when there is anything to add (contact damping or salt). */
+/* A process's forces join the step from now on (hooks and ctx are the process's; they must
+ * outlive v). CDEM_ERR_RANGE when CDEM_VISCOUS_PROCESSES are already there. */
+cdem_status cdem_viscous_add(cdem_viscous *v, const cdem_viscous_hooks *hooks, void *ctx,
+                             cdem_error *err);
+
+/* 1 when there is anything to add (contact damping or a process's forces). */
 static inline int cdem_viscous_active(const cdem_viscous *v) {
-    return v->contact_damping > 0.0 || v->salt.on;
+    return v->contact_damping > 0.0 || v->n_processes > 0;
 }
 
 /* After each list build, and after a checkpoint's list is restored: the buffers for the
- * state's elements, the salt's grid and pairs (from the positions of the list's build). */
+ * state's elements, and each process's after_build (the salt's grid and pairs). */
 cdem_status cdem_viscous_after_build(cdem_viscous *v, const cdem_neighbour *nb, const cdem_state *s,
                                      cdem_error *err);
 
@@ -56,7 +81,8 @@ void cdem_viscous_forces(cdem_viscous *v, const cdem_neighbour *nb, const cdem_s
 
 /* Adds ex, ey to the state: to fx, fy of every element and, when kick, to the velocities of
  * the free elements with the second half kick's factor for time step dt and absolute damping
- * c (see the top of this file); after a time step (dt > 0 and kick) the salt's area update. */
+ * c (see the top of this file); after a time step (dt > 0 and kick) each process's after_step
+ * (the salt's area update). */
 void cdem_viscous_finish(cdem_viscous *v, cdem_state *s, int kick, double dt, double c);
 
 #endif

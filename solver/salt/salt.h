@@ -21,6 +21,7 @@
 #include "neighbour.h"
 #include "params.h"
 #include "state.h"
+#include "viscous.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -134,6 +135,11 @@ cdem_status cdem_salt_measure(const cdem_state *s, double region_area, double re
  * it); contact_damping: as physics (0 with absolute damping); skin: the pair list's. */
 cdem_status cdem_salt_configure(cdem_salt *salt, const cdem_model *m, const cdem_params *p,
                                 const cdem_salt_layer *layer, double skin, cdem_error *err);
+
+/* The configured module's forces join the step of the viscous module v (viscous.h): its grid
+ * and pairs after each list build, its forces each step, its area update after each step.
+ * The salt must outlive v's use of it. Nothing when salt->on is 0. */
+cdem_status cdem_salt_join(cdem_salt *salt, cdem_viscous *v, cdem_error *err);
 
 /* The model's coefficient of the pair dashpots: dashpot_fraction x beta x viscosity, capped
  * at 0.25 m_min / (max_pairs dt). */
