@@ -7,7 +7,9 @@
  *   tilt-2: the summary states the tilt and the vector; the vector helper gives exactly
  *           (0, -g) untilted and keeps g's magnitude tilted.
  *   tilt-3: a run resumed from a mid-deformation checkpoint (taken while gravity turns) ends
- *           bit-identical to the uninterrupted run, gravity's last direction included. */
+ *           bit-identical to the uninterrupted run, gravity's last direction included.
+ *   tilt-4: the scalar and the vector force paths (CDEM_SIMD) give the same bits with a
+ *           tilted gravity, as they do without. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -175,11 +177,47 @@ static void test_bc_test_tilt_resumed_bit_identical(void **state) {
     cdem_snapshot_free(end_resumed);
 }
 
+/* The run to its end on the force path CDEM_SIMD = path. */
+static cdem_snapshot *run_on_path(const cdem_params *p, const char *path) {
+    setenv("CDEM_SIMD", path, 1);
+    cdem_error err;
+    cdem_run_ctx *r = open_run(p, NULL);
+    assert_int_equal(cdem_run_advance(r, cdem_run_total_steps(r), &err), CDEM_OK);
+    cdem_snapshot *end = capture(r);
+    assert_int_equal(cdem_run_close(r, CDEM_OK, &err), CDEM_OK);
+    return end;
+}
+
+/* tilt-4 */
+static void test_bc_test_tilt_paths_agree(void **state) {
+    (void)state;
+    const cdem_params p = tilt_params();
+    const char *saved = getenv("CDEM_SIMD");
+    char keep[32] = "";
+    if (saved)
+        snprintf(keep, sizeof keep, "%s", saved);
+    cdem_snapshot *scalar = run_on_path(&p, "scalar");
+    const char *paths[] = {"avx2", "avx512"};
+    for (int k = 0; k < 2; k++) {
+        cdem_snapshot *vec = run_on_path(&p, paths[k]);
+        const char *diff = NULL;
+        if (!cdem_snapshot_equal(scalar, vec, &diff))
+            fail_msg("CDEM_SIMD=%s differs from scalar at %s", paths[k], diff ? diff : "?");
+        cdem_snapshot_free(vec);
+    }
+    cdem_snapshot_free(scalar);
+    if (saved)
+        setenv("CDEM_SIMD", keep, 1);
+    else
+        unsetenv("CDEM_SIMD");
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bc_test_tilt_walls_carry_the_tilted_weight),
         cmocka_unit_test(test_bc_test_tilt_summary_and_vector),
         cmocka_unit_test(test_bc_test_tilt_resumed_bit_identical),
+        cmocka_unit_test(test_bc_test_tilt_paths_agree),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
