@@ -60,7 +60,10 @@ static const cdem_cli_option calibrate_options[] = {
      "sbatch --wait)"},
     {"--work", "DIR", "the work folder, kept (default calibrate-MODEL)"},
     {"--cdem-run", "PATH", "the cdem-run program (default: next to cdem-strain, else on PATH)"},
-    {"-s, --set", "section.key=value", "an override for every run (repeatable)"},
+    {"-s, --set", "section.key=value",
+     "an override for every run (repeatable); not of a value calibrate sets itself: "
+     "assembly.seed, boundary.confining_pressure, and element_friction or element_cohesion "
+     "while searched"},
     {"-o, --output", "OUT.png|.pdf|.svg",
      "stress-strain curves and Mohr circles of the material found (default DIR/calibration.png)"},
     {NULL, NULL, NULL}};
@@ -81,7 +84,9 @@ static const cdem_cli_help help = {
         "material found is then run with fresh seeds. Prints each series, the result with "
         "its fit uncertainties, and a [material] block (also DIR/material.ini; the report in "
         "DIR/calibration.txt). Interrupted, the same command resumes: finished runs are read, "
-        "killed ones continued with cdem-run --resume (docs/analysis.md, \"Calibration\").",
+        "killed ones continued with cdem-run --resume (docs/analysis.md, \"Calibration\"). "
+        "Every option is checked before the first run: the inputs and pressures against the "
+        "ranges cdem-run allows for the parameters they set.",
     .options = calibrate_options,
     .exit_status = "0 the material is found and its fresh-seed check is within tolerance, 1 "
                    "refused, not found or an error, 2 usage error.",
