@@ -353,7 +353,7 @@ static int refuse_duplicates(const cdem_plot_args *a) {
         known[k] = stat(a->files[k], &st[k]) == 0; /* one that cannot be read fails later */
         for (size_t j = 0; j < k && known[k]; j++)
             if (known[j] && st[j].st_dev == st[k].st_dev && st[j].st_ino == st[k].st_ino) {
-                char msg[700];
+                char msg[800];
                 snprintf(msg, sizeof msg,
                          "%.300s (run %zu) is the same file as %.300s (run %zu): each run counts "
                          "once; give each file once",
