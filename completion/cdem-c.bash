@@ -102,7 +102,7 @@ _cdem_strain() {
             --width) return ;;
             --height) return ;;
         esac
-        opts="--increment -o --output --width --height -h --help" ;;
+        opts="--increment --include-poor-fits -o --output --width --height -h --help" ;;
     calibrate)
         case "$prev" in
             --phi) return ;;

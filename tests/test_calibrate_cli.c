@@ -274,7 +274,8 @@ static void test_calibrate_usage_errors(void **state) {
         {"MODEL --phi 34 --mu-range 1:0.5", "--mu-range 1:0.5: must be LO:HI"},
         {"MODEL --phi 34 --c0-range 0:1e9", "--c0-range 0:1e9: must be LO:HI (N) with 0 < LO"},
         {"MODEL --ucs 10 --pressures 5,10", "--ucs needs 0 among --pressures"},
-        {"MODEL --phi 34 --pressures 5", "--pressures 5: must be 2 to 12 different numbers"},
+        {"MODEL --phi 34 --pressures 5",
+         "--pressures 5: one item only; give 2 to 12 different numbers >= 0 (MPa)"},
         {"MODEL --phi 95", "--phi 95: must be a number of degrees in 0..90"},
         {"MODEL --phi 34 --seeds 0", "--seeds 0: must be a whole number 1 to 8"},
         {"MODEL --phi 34 --margin 2", "--margin 2: must be a number in (0, 1]"},
@@ -311,6 +312,97 @@ static void test_calibrate_usage_errors(void **state) {
     assert_non_null(strstr(out, "--cdem-run /nonexistent: not an executable file"));
 }
 
+/* Every option is checked before the first run (issue 46, item 5): each value against the
+ * range cdem-run's parameter table allows for the parameter it sets, empty list items, the
+ * runs per series the envelope fit can take, the -s of a value calibrate sets itself and the
+ * seeds the model's seed leads to. A stand-in cdem-run marks any run started: none is, and no
+ * work folder is made. */
+static void test_calibrate_checks_every_option_before_running(void **state) {
+    (void)state;
+    static char out[16384];
+    char cmd[8192], standin[2200], marker[2200];
+    snprintf(marker, sizeof marker, "%s/cdem-run-started", g_dir.dir);
+    snprintf(standin, sizeof standin, "%s/standin-cdem-run", g_dir.dir);
+    FILE *f = fopen(standin, "w");
+    assert_non_null(f);
+    fprintf(f, "#!/bin/sh\necho \"$@\" >> '%s'\nexit 1\n", marker);
+    fclose(f);
+    chmod(standin, 0755);
+    static const struct {
+        const char *args, *says;
+    } cases[] = {
+        {"--phi 34 --pressures 1e300,10",
+         "--pressures 1e300,10: item 1, 1e+300 MPa, is outside the range cdem-run allows for "
+         "boundary.confining_pressure: 0 to 1000 MPa"},
+        {"--phi 34 --pressures 0,1001",
+         "--pressures 0,1001: item 2, 1001 MPa, is outside the range cdem-run allows for "
+         "boundary.confining_pressure: 0 to 1000 MPa"},
+        {"--phi 34 --mu-range 0:1e300",
+         "--mu-range 0:1e300: HI 1e+300 is outside the range cdem-run allows for "
+         "material.element_friction: 0 to 10"},
+        {"--cohesion 5 --c0-range 1e20:1e30",
+         "--c0-range 1e20:1e30: LO 1e+20 is outside the range cdem-run allows for "
+         "material.element_cohesion: 0 to 1e+15 N"},
+        {"--phi 34 --pressures 0,,10", "--pressures 0,,10: item 2 is empty; give 2 to 12"},
+        {"--phi 34 --pressures ,5,10", "--pressures ,5,10: item 1 is empty; give 2 to 12"},
+        {"--phi 34 --pressures 0,5,", "--pressures 0,5,: item 3 is empty; give 2 to 12"},
+        {"--phi 34 --pressures 0,5,x", "--pressures 0,5,x: item 3, 'x', is not a number"},
+        {"--phi 34 --pressures 0,5,0", "--pressures 0,5,0: item 3, 0 MPa, repeats item 1"},
+        {"--phi 34 --seeds 8 --pressures 0,1,2,3,4,5,6,7,8,9,10,11",
+         "--seeds 8 with 12 --pressures: 96 runs per series, at most 64"},
+        {"--phi 34 --check-seeds 6 --pressures 0,1,2,3,4,5,6,7,8,9,10,11",
+         "--check-seeds 6 with 12 --pressures: 72 runs per series, at most 64"},
+        {"--phi 34 -s material.element_friction=0.3",
+         "-s material.element_friction=0.3: calibrate sets material.element_friction in every "
+         "run itself (it searches it for --phi; bound it with --mu-range)"},
+        {"--ucs 5 -s material.element_cohesion=1e9",
+         "-s material.element_cohesion=1e9: calibrate sets material.element_cohesion in every "
+         "run itself"},
+        {"--phi 34 -s boundary.confining_pressure=5e6",
+         "-s boundary.confining_pressure=5e6: calibrate sets boundary.confining_pressure"},
+        {"--phi 34 -s assembly.seed=4", "-s assembly.seed=4: calibrate sets assembly.seed"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        snprintf(cmd, sizeof cmd, "'%s' calibrate '%s' %s --cdem-run '%s' --work w-opt", g_exe,
+                 g_model, cases[i].args, standin);
+        int rc = run(cmd, out, sizeof out);
+        if (rc != 2 || !strstr(out, cases[i].says))
+            print_error("%s\n-> %d: %s\n", cmd, rc, out);
+        assert_int_equal(rc, 2);
+        assert_non_null(strstr(out, cases[i].says));
+        assert_int_equal(access(marker, F_OK), -1); /* no run started */
+        assert_false(exists("w-opt", ""));          /* no work folder made */
+    }
+    /* the search's and the check's seeds S..S+N+M-1 from the model's seed S */
+    char model[2200], line[512];
+    snprintf(model, sizeof model, "%s/seed-max.ini", g_dir.dir);
+    FILE *in = fopen(g_model, "r"), *mf = fopen(model, "w");
+    assert_non_null(in);
+    assert_non_null(mf);
+    while (fgets(line, sizeof line, in)) {
+        fputs(line, mf);
+        if (!strncmp(line, "[assembly]", 10))
+            fputs("seed = 2147483647\n", mf);
+    }
+    fclose(in);
+    fclose(mf);
+    snprintf(cmd, sizeof cmd, "'%s' calibrate '%s' --phi 34 --cdem-run '%s' --work w-opt", g_exe,
+             model, standin);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "assembly.seed = 2147483647 with --seeds 2 and --check-seeds 1: "
+                                "the runs would use seeds 2147483647..2147483649, beyond the "
+                                "range cdem-run allows for assembly.seed (0 to 2147483647)"));
+    assert_int_equal(access(marker, F_OK), -1);
+    assert_false(exists("w-opt", ""));
+    /* a value calibrate does not search may be set by -s: the model's, for every run */
+    snprintf(cmd, sizeof cmd,
+             "'%s' calibrate '%s' --cohesion 5 -s material.element_friction=0.3 --cdem-run "
+             "/nonexistent --work w-opt",
+             g_exe, g_model);
+    assert_int_equal(run(cmd, out, sizeof out), 1);
+    assert_non_null(strstr(out, "--cdem-run /nonexistent: not an executable file"));
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_calibrate_finds_checks_and_resumes),
@@ -319,6 +411,7 @@ int main(void) {
         cmocka_unit_test(test_calibrate_through_slurm),
         cmocka_unit_test(test_calibrate_unconfined_strength),
         cmocka_unit_test(test_calibrate_usage_errors),
+        cmocka_unit_test(test_calibrate_checks_every_option_before_running),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -117,6 +117,7 @@ static void test_repose_command_prints_and_draws(void **state) {
     make_pile(&s, wedge_surface, 11);
     cdem_params p;
     cdem_params_defaults(&p);
+    p.mode = CDEM_MODE_REPOSE;
     cdem_run_meta meta = {&p, "", "repose test", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
@@ -292,11 +293,13 @@ static int run_repose_captured(char **argv, int argc, char *out, size_t n_out, c
 }
 
 /* A run file of the pile: increment 0 ends the equilibration, then `n` increments of the
- * collapse 60 s apart, in which the free elements move down by drop[k] m (cumulative). */
-static void write_collapse(const char *h5, const cdem_state *pile, const double *drop, int n) {
+ * collapse 60 s apart, in which the free elements move down by drop[k] m (cumulative); its
+ * boundary.mode is `mode`. */
+static void write_run_of_mode(const char *h5, const cdem_state *pile, const double *drop, int n,
+                              cdem_mode mode) {
     cdem_params p;
     cdem_params_defaults(&p);
-    p.mode = CDEM_MODE_REPOSE;
+    p.mode = mode;
     cdem_run_meta meta = {&p, "", "repose test", "0", "test", 0};
     cdem_h5_writer *w;
     cdem_error err;
@@ -319,6 +322,11 @@ static void write_collapse(const char *h5, const cdem_state *pile, const double 
     assert_int_equal(cdem_h5_writer_close(w, &err), CDEM_OK);
 }
 
+/* write_run_of_mode of a repose-collapse run. */
+static void write_collapse(const char *h5, const cdem_state *pile, const double *drop, int n) {
+    write_run_of_mode(h5, pile, drop, n, CDEM_MODE_REPOSE);
+}
+
 /* The command judges the settling over the last third of the run: a pile that still
  * sags is "still moving" (with a warning on stderr), one that stopped is "settled"; a poor
  * fit is said on stdout and stderr. */
@@ -334,6 +342,14 @@ static void test_repose_command_says_when_moving_or_poor(void **state) {
     write_collapse(h5, &pile, sagging, 9);
     assert_int_equal(run_repose_captured(argv, 2, out, sizeof out, errs, sizeof errs), 0);
     assert_non_null(strstr(out, "right flank: good fit"));
+    /* the flank's angle and its confidence half-width, each with its unit */
+    const char *flank = strstr(out, "  right flank: ");
+    assert_non_null(flank);
+    char *after;
+    strtod(flank + strlen("  right flank: "), &after);
+    assert_true(!strncmp(after, " deg +- ", 8));
+    strtod(after + 8, &after);
+    assert_true(!strncmp(after, " deg (95 %), ", 13));
     assert_non_null(strstr(out, "motion in the last increment (8 to 9): mean "));
     assert_non_null(strstr(out, ": moving (the limit is 1 % of the largest radius, 125 m)"));
     assert_non_null(strstr(out, "angle over the last third of the run (increments 6 to 9, "
@@ -402,60 +418,109 @@ static double reported_angle(const char *out) {
     return strtod(p + strlen("angle of repose = "), NULL);
 }
 
-/* Several runs of one material: each reported under its name, then their mean, standard
- * deviation and range, how many fit well and settled; a run that cannot be read is named on
- * stderr, left out of the spread and makes the exit status 1; -o takes one run. */
+/* The number after `key` in text (NaN when key is not there). */
+static double number_after(const char *text, const char *key) {
+    const char *p = text ? strstr(text, key) : NULL;
+    return p ? strtod(p + strlen(key), NULL) : NAN;
+}
+
+/* Several runs of one material: each reported under its name, then the mean, standard
+ * deviation and range of those measured with a good fit (issue 46, item 6), the mean with the
+ * poor fits beside it (--include-poor-fits makes that the result); a run that cannot be read
+ * is named on stderr, left out of the count and makes the exit status 1; -o takes one run. */
 static void test_repose_command_several_runs(void **state) {
     (void)state;
-    char h5a[512], h5b[512], missing[512];
+    char h5a[512], h5b[512], h5c[512], missing[512];
     scratch_path(h5a, sizeof h5a, "repose-packing-a.h5");
     scratch_path(h5b, sizeof h5b, "repose-packing-b.h5");
+    scratch_path(h5c, sizeof h5c, "repose-packing-c.h5");
     scratch_path(missing, sizeof missing, "repose-packing-missing.h5");
     remove(missing);
     double stopped[9] = {0, 50, 100, 150, 200, 200, 200, 200, 200};
-    cdem_state straight = {0}, convex = {0};
+    cdem_state straight = {0}, convex = {0}, other = {0};
     make_pile(&straight, wedge_surface, 3);
     make_pile(&convex, convex_surface, 5);
+    make_pile(&other, wedge_surface, 8);
     write_collapse(h5a, &straight, stopped, 9);
     write_collapse(h5b, &convex, stopped, 9);
-    static char out[32768];
+    write_collapse(h5c, &other, stopped, 9);
+    static char out[65536];
     char errs[4096];
-    char *one_a[] = {"repose", h5a}, *one_b[] = {"repose", h5b};
+    char *one_a[] = {"repose", h5a}, *one_b[] = {"repose", h5b}, *one_c[] = {"repose", h5c};
     assert_int_equal(run_repose_captured(one_a, 2, out, sizeof out, errs, sizeof errs), 0);
     const double a = reported_angle(out);
     assert_int_equal(run_repose_captured(one_b, 2, out, sizeof out, errs, sizeof errs), 0);
     const double b = reported_angle(out);
-    assert_true(fabs(a - b) > 1.0); /* two different slopes, so the spread is not zero */
+    assert_non_null(strstr(out, "poor fit: the slope is curved"));
+    assert_int_equal(run_repose_captured(one_c, 2, out, sizeof out, errs, sizeof errs), 0);
+    const double c = reported_angle(out);
+    assert_non_null(strstr(out, "good fit (a straight slope)"));
+    assert_true(fabs(a - b) > 1.0 && fabs(a - c) > 0.05); /* different slopes: a spread */
 
-    char *both[] = {"repose", h5a, h5b};
-    assert_int_equal(run_repose_captured(both, 3, out, sizeof out, errs, sizeof errs), 0);
+    /* two good fits and a poor one: the mean is the good fits', the poor fit's beside */
+    char *three[] = {"repose", h5a, h5b, h5c};
+    assert_int_equal(run_repose_captured(three, 4, out, sizeof out, errs, sizeof errs), 0);
     char expect[1024];
     snprintf(expect, sizeof expect, "run %s:\nangle of repose = ", h5a);
     assert_non_null(strstr(out, expect));
     snprintf(expect, sizeof expect, "\nrun %s:\nangle of repose = ", h5b);
     assert_non_null(strstr(out, expect));
-    const char *sum = strstr(out, "over 2 runs: angle of repose ");
+    const char *sum = strstr(out, "\nover 2 runs: angle of repose ");
     assert_non_null(sum);
-    assert_near(strtod(sum + strlen("over 2 runs: angle of repose "), NULL), 0.5 * (a + b), 0.006);
-    /* a and b as printed (2 decimals): the spread's numbers agree to within their rounding */
-    const char *sd = strstr(sum, "standard deviation ");
-    assert_non_null(sd);
-    assert_near(strtod(sd + strlen("standard deviation "), NULL), fabs(a - b) / sqrt(2.0), 0.011);
-    const char *se = strstr(sum, "standard error of the mean ");
-    assert_non_null(se);
-    assert_near(strtod(se + strlen("standard error of the mean "), NULL), fabs(a - b) / 2.0, 0.011);
-    assert_non_null(strstr(sum, "good fits: 1 of 2 runs; settled: 2 of 2 runs"));
+    assert_near(number_after(sum, "angle of repose "), 0.5 * (a + c), 0.006);
+    /* a and c as printed (2 decimals): the spread's numbers agree to within their rounding */
+    assert_near(number_after(sum, "standard deviation "), fabs(a - c) / sqrt(2.0), 0.011);
+    assert_near(number_after(sum, "standard error of the mean "), fabs(a - c) / 2.0, 0.011);
+    const char *with = strstr(sum, "  left out: 1 poor fit (--include-poor-fits counts them); "
+                                   "with them:\n  over 3 runs: angle of repose ");
+    assert_non_null(with);
+    assert_near(number_after(with, "angle of repose "), (a + b + c) / 3.0, 0.006);
+    assert_non_null(strstr(sum, "good fits: 2 of 3 runs measured; settled: 3 of 3 runs measured"));
 
-    char *with_missing[] = {"repose", h5a, missing, h5b};
+    /* --include-poor-fits: the mean of all three, the good fits' beside */
+    char *counted[] = {"repose", h5a, h5b, h5c, "--include-poor-fits"};
+    assert_int_equal(run_repose_captured(counted, 5, out, sizeof out, errs, sizeof errs), 0);
+    sum = strstr(out, "\nover 3 runs: angle of repose ");
+    assert_non_null(sum);
+    assert_near(number_after(sum, "angle of repose "), (a + b + c) / 3.0, 0.006);
+    with = strstr(sum, "  poor fits counted (--include-poor-fits): 1; the good fits alone:\n"
+                       "  over 2 runs: angle of repose ");
+    assert_non_null(with);
+    assert_near(number_after(with, "angle of repose "), 0.5 * (a + c), 0.006);
+
+    /* only poor fits: no angle of repose, exit 1; with the option their mean */
+    char h5d[512];
+    scratch_path(h5d, sizeof h5d, "repose-packing-d.h5");
+    cdem_state convex2 = {0};
+    make_pile(&convex2, convex_surface, 9);
+    write_collapse(h5d, &convex2, stopped, 9);
+    cdem_state_free(&convex2);
+    char *poor_two[] = {"repose", h5b, h5d};
+    assert_int_equal(run_repose_captured(poor_two, 3, out, sizeof out, errs, sizeof errs), 1);
+    assert_non_null(strstr(out, "no good fit among the 2 runs measured: no angle of repose"));
+    assert_non_null(strstr(errs, "cdem-strain repose: no good fit among the 2 runs: no angle of "
+                                 "repose (--include-poor-fits counts the poor fits)"));
+    char *poor_counted[] = {"repose", h5b, h5d, "--include-poor-fits"};
+    assert_int_equal(run_repose_captured(poor_counted, 4, out, sizeof out, errs, sizeof errs), 0);
+    assert_non_null(strstr(out, "\nover 2 runs: angle of repose "));
+
+    /* a missing run: counted neither in the mean nor in "over N runs" */
+    char *with_missing[] = {"repose", h5a, missing, h5c};
     assert_int_equal(run_repose_captured(with_missing, 4, out, sizeof out, errs, sizeof errs), 1);
-    assert_non_null(strstr(out, "over 3 runs: angle of repose "));
-    assert_non_null(strstr(out, "not measured: 1 of 3 runs"));
+    sum = strstr(out, "\nover 2 runs: angle of repose ");
+    assert_non_null(sum);
+    assert_near(number_after(sum, "angle of repose "), 0.5 * (a + c), 0.006);
+    assert_non_null(strstr(out, "good fits: 2 of 2 runs measured"));
+    assert_non_null(strstr(out, "not measured: 1 of 3 runs given"));
+    assert_null(strstr(out, "over 3 runs"));
     snprintf(expect, sizeof expect, "cdem-strain repose: %s: cannot open", missing);
     assert_non_null(strstr(errs, expect));
 
-    char *none[] = {"repose", missing, missing};
+    char missing2[512];
+    scratch_path(missing2, sizeof missing2, "repose-packing-missing-2.h5");
+    char *none[] = {"repose", missing, missing2};
     assert_int_equal(run_repose_captured(none, 3, out, sizeof out, errs, sizeof errs), 1);
-    assert_non_null(strstr(out, "over 2 runs: none measured"));
+    assert_non_null(strstr(out, "over 2 runs given: none measured"));
 
     char png[512];
     scratch_path(png, sizeof png, "repose-packings.png");
@@ -463,11 +528,92 @@ static void test_repose_command_several_runs(void **state) {
     assert_int_equal(run_repose_captured(drawn, 5, out, sizeof out, errs, sizeof errs), 2);
     assert_non_null(strstr(errs, "-o draws one run: give one RUN.h5 with -o"));
     assert_int_equal(access(png, F_OK), -1);
+    char *one_counted[] = {"repose", h5a, "--include-poor-fits"};
+    assert_int_equal(run_repose_captured(one_counted, 3, out, sizeof out, errs, sizeof errs), 2);
+    assert_non_null(strstr(errs, "--include-poor-fits counts poor fits in the mean of several "
+                                 "runs: give two or more RUN.h5"));
     cdem_state_free(&straight);
     cdem_state_free(&convex);
-    const char *names[6] = {"repose-packing-a.h5",  "repose-packing-a.xmf", "repose-packing-b.h5",
-                            "repose-packing-b.xmf", "repose-out.txt",       "repose-err.txt"};
-    for (int k = 0; k < 6; k++) {
+    cdem_state_free(&other);
+    const char *names[10] = {"repose-packing-a.h5",  "repose-packing-a.xmf", "repose-packing-b.h5",
+                             "repose-packing-b.xmf", "repose-packing-c.h5",  "repose-packing-c.xmf",
+                             "repose-packing-d.h5",  "repose-packing-d.xmf", "repose-out.txt",
+                             "repose-err.txt"};
+    for (int k = 0; k < 10; k++) {
+        char path[512];
+        scratch_path(path, sizeof path, names[k]);
+        remove(path);
+    }
+}
+
+/* Each run counts once (issue 46, item 6): one file given twice, also by another path (with
+ * ./ in it, through a symbolic link), is refused before anything is measured; a run that is
+ * not a repose collapse is not measured, not counted, and makes the exit status 1. */
+static void test_repose_command_counts_each_repose_run_once(void **state) {
+    (void)state;
+    char h5a[512], h5c[512], det[512], link_path[512], dotted[600];
+    scratch_path(h5a, sizeof h5a, "repose-once-a.h5");
+    scratch_path(h5c, sizeof h5c, "repose-once-c.h5");
+    scratch_path(det, sizeof det, "repose-once-detachment.h5");
+    scratch_path(link_path, sizeof link_path, "repose-once-link.h5");
+    double stopped[9] = {0, 50, 100, 150, 200, 200, 200, 200, 200};
+    cdem_state straight = {0}, other = {0};
+    make_pile(&straight, wedge_surface, 3);
+    make_pile(&other, wedge_surface, 8);
+    write_collapse(h5a, &straight, stopped, 9);
+    write_collapse(h5c, &other, stopped, 9);
+    write_run_of_mode(det, &straight, stopped, 9, CDEM_MODE_DETACHMENT);
+    remove(link_path);
+    assert_int_equal(symlink(h5a, link_path), 0);
+    const char *slash = strrchr(h5a, '/');
+    assert_non_null(slash);
+    snprintf(dotted, sizeof dotted, "%.*s/./%s", (int)(slash - h5a), h5a, slash + 1);
+    static char out[65536];
+    char errs[4096], expect[2048];
+
+    char *thrice[] = {"repose", h5a, h5a, h5a};
+    assert_int_equal(run_repose_captured(thrice, 4, out, sizeof out, errs, sizeof errs), 2);
+    snprintf(expect, sizeof expect,
+             "%s (run 2) is the same file as %s (run 1): each run counts once; give each file "
+             "once",
+             h5a, h5a);
+    assert_non_null(strstr(errs, expect));
+    assert_string_equal(out, ""); /* nothing measured */
+    char *by_dot[] = {"repose", h5a, h5c, dotted};
+    assert_int_equal(run_repose_captured(by_dot, 4, out, sizeof out, errs, sizeof errs), 2);
+    snprintf(expect, sizeof expect, "%s (run 3) is the same file as %s (run 1)", dotted, h5a);
+    assert_non_null(strstr(errs, expect));
+    char *by_link[] = {"repose", link_path, h5c, h5a};
+    assert_int_equal(run_repose_captured(by_link, 4, out, sizeof out, errs, sizeof errs), 2);
+    snprintf(expect, sizeof expect, "%s (run 3) is the same file as %s (run 1)", h5a, link_path);
+    assert_non_null(strstr(errs, expect));
+
+    /* a detachment run: named, not measured, not counted, exit 1 */
+    char *one_det[] = {"repose", det};
+    assert_int_equal(run_repose_captured(one_det, 2, out, sizeof out, errs, sizeof errs), 1);
+    snprintf(expect, sizeof expect,
+             "cdem-strain repose: %s: a 'detachment' run (boundary.mode = detachment), not a "
+             "repose-collapse run (boundary.mode = repose): not measured",
+             det);
+    assert_non_null(strstr(errs, expect));
+    assert_null(strstr(out, "angle of repose = "));
+    char *mixed[] = {"repose", h5a, det, h5c};
+    assert_int_equal(run_repose_captured(mixed, 4, out, sizeof out, errs, sizeof errs), 1);
+    assert_non_null(strstr(errs, expect));
+    assert_non_null(strstr(out, "\nover 2 runs: angle of repose "));
+    assert_non_null(strstr(out, "not measured: 1 of 3 runs given"));
+    cdem_state_free(&straight);
+    cdem_state_free(&other);
+    const char *names[9] = {"repose-once-a.h5",
+                            "repose-once-a.xmf",
+                            "repose-once-c.h5",
+                            "repose-once-c.xmf",
+                            "repose-once-detachment.h5",
+                            "repose-once-detachment.xmf",
+                            "repose-once-link.h5",
+                            "repose-out.txt",
+                            "repose-err.txt"};
+    for (int k = 0; k < 9; k++) {
         char path[512];
         scratch_path(path, sizeof path, names[k]);
         remove(path);
@@ -493,6 +639,7 @@ int main(void) {
         cmocka_unit_test(test_repose_command_says_when_moving_or_poor),
         cmocka_unit_test(test_repose_spread_of_angles),
         cmocka_unit_test(test_repose_command_several_runs),
+        cmocka_unit_test(test_repose_command_counts_each_repose_run_once),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     cairo_debug_reset_static_data(); /* drop cairo's font caches before LeakSanitizer looks */

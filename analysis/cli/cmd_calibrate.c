@@ -61,7 +61,10 @@ static const cdem_cli_option calibrate_options[] = {
      "sbatch --wait)"},
     {"--work", "DIR", "the work folder, kept (default calibrate-MODEL)"},
     {"--cdem-run", "PATH", "the cdem-run program (default: next to cdem-strain, else on PATH)"},
-    {"-s, --set", "section.key=value", "an override for every run (repeatable)"},
+    {"-s, --set", "section.key=value",
+     "an override for every run (repeatable); not of a value calibrate sets itself: "
+     "assembly.seed, boundary.confining_pressure, and element_friction or element_cohesion "
+     "while searched"},
     {"-o, --output", "OUT.png|.pdf|.svg",
      "stress-strain curves and Mohr circles of the material found (default DIR/calibration.png)"},
     {NULL, NULL, NULL}};
@@ -82,7 +85,9 @@ static const cdem_cli_help help = {
         "material found is then run with fresh seeds. Prints each series, the result with "
         "its fit uncertainties, and a [material] block (also DIR/material.ini; the report in "
         "DIR/calibration.txt). Interrupted, the same command resumes: finished runs are read, "
-        "killed ones continued with cdem-run --resume (docs/analysis.md, \"Calibration\").",
+        "killed ones continued with cdem-run --resume (docs/analysis.md, \"Calibration\"). "
+        "Every option is checked before the first run: the inputs and pressures against the "
+        "ranges cdem-run allows for the parameters they set.",
     .options = calibrate_options,
     .exit_status = "0 the material is found and its fresh-seed check is within tolerance, 1 "
                    "refused, not found or an error, 2 usage error.",
@@ -123,31 +128,111 @@ static void say(cal_report *r, const char *fmt, ...) {
     fflush(stdout);
 }
 
-static int parse_range(const char *v, double *lo, double *hi) {
+/* Whether v, in the option's unit (scale x v in the parameter's), lies in the range cdem-run's
+ * parameter table allows section.key; range gets that range in the option's unit. The ranges
+ * are the table's (common/params.c), never repeated here. */
+static int run_allows(const char *section, const char *key, double v, double scale,
+                      const char *unit, char *range, size_t cap) {
+    const cdem_param_def *d = cdem_params_find(section, key);
+    if (!d) { /* never: the keys are the table's */
+        snprintf(range, cap, "unknown");
+        return 0;
+    }
+    char lo[32], hi[32];
+    cdem_params_format_number(d->min / scale, lo, sizeof lo);
+    cdem_params_format_number(d->max / scale, hi, sizeof hi);
+    const char *sp = unit[0] ? " " : "";
+    if (isinf(d->max))
+        snprintf(range, cap, "%s %s%s%s", d->min_exclusive ? ">" : ">=", lo, sp, unit);
+    else if (!d->min_exclusive && !d->max_exclusive)
+        snprintf(range, cap, "%s to %s%s%s", lo, hi, sp, unit);
+    else
+        snprintf(range, cap, "%s %s and %s %s%s%s", d->min_exclusive ? ">" : ">=", lo,
+                 d->max_exclusive ? "<" : "<=", hi, sp, unit);
+    const double x = v * scale;
+    return isfinite(x) && (d->min_exclusive ? x > d->min : x >= d->min) &&
+           (isinf(d->max) || (d->max_exclusive ? x < d->max : x <= d->max));
+}
+
+/* --mu-range, --c0-range: LO:HI with lo_min <= LO (lo_min < LO when lo_excl) and LO < HI,
+ * both within the range cdem-run allows section.key. 0, with msg, when not. */
+static int parse_range(const char *opt, const char *v, const char *section, const char *key,
+                       const char *unit, int lo_excl, double *lo, double *hi, char *msg,
+                       size_t cap) {
     char buf[128];
     snprintf(buf, sizeof buf, "%s", v);
     char *colon = strchr(buf, ':');
-    if (!colon)
+    if (colon)
+        *colon = '\0';
+    if (!colon || !cdem_cmd_parse_number(buf, lo) || !cdem_cmd_parse_number(colon + 1, hi) ||
+        (lo_excl ? !(*lo > 0) : !(*lo >= 0)) || !(*lo < *hi)) {
+        snprintf(msg, cap, "%s %.100s: must be LO:HI%s%s%s with %s < HI", opt, v,
+                 unit[0] ? " (" : "", unit, unit[0] ? ")" : "", lo_excl ? "0 < LO" : "0 <= LO");
         return 0;
-    *colon = '\0';
-    return cdem_cmd_parse_number(buf, lo) && cdem_cmd_parse_number(colon + 1, hi) && *lo >= 0 &&
-           *lo < *hi;
+    }
+    for (int end = 0; end < 2; end++) {
+        char range[96];
+        const double x = end ? *hi : *lo;
+        if (!run_allows(section, key, x, 1, unit, range, sizeof range)) {
+            snprintf(msg, cap,
+                     "%s %.100s: %s %g is outside the range cdem-run allows for %s.%s: %s", opt, v,
+                     end ? "HI" : "LO", x, section, key, range);
+            return 0;
+        }
+    }
+    return 1;
 }
 
-static int parse_pressures(const char *v, cal_args *a) {
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", v);
+/* --pressures: 2 to MAX_PRESSURES different numbers (MPa), comma-separated, each within the
+ * range cdem-run allows for boundary.confining_pressure (N/m, 1 MPa = 1e6); an empty item
+ * is refused, not skipped. 0, with msg, when not. */
+static int parse_pressures(const char *v, cal_args *a, char *msg, size_t cap) {
+    static const char *const allowed = "give 2 to 12 different numbers >= 0 (MPa), comma-separated";
     a->n_pressures = 0;
-    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-        double p;
-        if (a->n_pressures == MAX_PRESSURES || !cdem_cmd_parse_number(tok, &p) || p < 0)
+    int item = 0;
+    for (const char *p = v;; p++) {
+        const size_t len = strcspn(p, ",");
+        item++;
+        char tok[64];
+        snprintf(tok, sizeof tok, "%.*s", (int)(len < sizeof tok ? len : sizeof tok - 1), p);
+        double x;
+        char range[96];
+        if (len == 0) {
+            snprintf(msg, cap, "--pressures %.100s: item %d is empty; %s", v, item, allowed);
             return 0;
+        }
+        if (len >= sizeof tok || !cdem_cmd_parse_number(tok, &x)) {
+            snprintf(msg, cap, "--pressures %.100s: item %d, '%.30s', is not a number; %s", v, item,
+                     tok, allowed);
+            return 0;
+        }
+        if (!run_allows("boundary", "confining_pressure", x, 1e6, "MPa", range, sizeof range)) {
+            snprintf(msg, cap,
+                     "--pressures %.100s: item %d, %g MPa, is outside the range cdem-run "
+                     "allows for boundary.confining_pressure: %s",
+                     v, item, x, range);
+            return 0;
+        }
         for (int k = 0; k < a->n_pressures; k++)
-            if (a->pressures[k] == p)
+            if (a->pressures[k] == x) {
+                snprintf(msg, cap, "--pressures %.100s: item %d, %g MPa, repeats item %d; %s", v,
+                         item, x, k + 1, allowed);
                 return 0;
-        a->pressures[a->n_pressures++] = p;
+            }
+        if (a->n_pressures == MAX_PRESSURES) {
+            snprintf(msg, cap, "--pressures %.100s: more than 12 items; %s", v, allowed);
+            return 0;
+        }
+        a->pressures[a->n_pressures++] = x;
+        p += len;
+        if (!*p)
+            break;
     }
-    return a->n_pressures >= 2;
+    if (a->n_pressures < 2) {
+        snprintf(msg, cap, "--pressures %.100s: one item only; %s", v, allowed);
+        return 0;
+    }
+    return 1;
 }
 
 static int parse_args(int argc, char **argv, cal_args *a) {
@@ -169,7 +254,7 @@ static int parse_args(int argc, char **argv, cal_args *a) {
                     .jobs = 0,
                     .nice = 10,
                     .margin = 0.6};
-    char msg[300];
+    char msg[400] = "";
     for (int i = 1; i < argc; i++) {
         const cdem_cli_option *o;
         const char *v, *typed = argv[i]; /* the option as spelled, for messages */
@@ -197,11 +282,13 @@ static int parse_args(int argc, char **argv, cal_args *a) {
         else if (!strcmp(n, "--ucs-tol"))
             ok = cdem_cmd_parse_number(v, &a->ucs_tol) && a->ucs_tol > 0;
         else if (!strcmp(n, "--mu-range"))
-            ok = parse_range(v, &a->mu_lo, &a->mu_hi);
+            ok = parse_range("--mu-range", v, "material", "element_friction", "", 0, &a->mu_lo,
+                             &a->mu_hi, msg, sizeof msg);
         else if (!strcmp(n, "--c0-range"))
-            ok = parse_range(v, &a->c0_lo, &a->c0_hi) && a->c0_lo > 0;
+            ok = parse_range("--c0-range", v, "material", "element_cohesion", "N", 1, &a->c0_lo,
+                             &a->c0_hi, msg, sizeof msg);
         else if (!strcmp(n, "--pressures"))
-            ok = parse_pressures(v, a);
+            ok = parse_pressures(v, a, msg, sizeof msg);
         else if (!strcmp(n, "--seeds"))
             ok = cdem_cmd_parse_int(v, 1, MAX_SEEDS, &a->seeds);
         else if (!strcmp(n, "--check-seeds"))
@@ -227,16 +314,14 @@ static int parse_args(int argc, char **argv, cal_args *a) {
             if (ok)
                 a->sets[a->n_sets++] = v;
         }
+        if (!ok && msg[0]) /* the parser's own message */
+            return cdem_cmd_usage(&help, msg);
         if (!ok) {
             char spelled[64];
             snprintf(spelled, sizeof spelled, "%.*s", (int)strcspn(typed, "="), typed);
             snprintf(msg, sizeof msg, "%s %.100s: %s", spelled, v,
-                     !strcmp(n, "--phi")         ? "must be a number of degrees in 0..90"
-                     : !strcmp(n, "--mu-range")  ? "must be LO:HI with 0 <= LO < HI"
-                     : !strcmp(n, "--c0-range")  ? "must be LO:HI (N) with 0 < LO < HI"
-                     : !strcmp(n, "--pressures") ? "must be 2 to 12 different numbers >= 0 (MPa), "
-                                                   "comma-separated"
-                     : !strcmp(n, "--seeds")     ? "must be a whole number 1 to 8"
+                     !strcmp(n, "--phi")           ? "must be a number of degrees in 0..90"
+                     : !strcmp(n, "--seeds")       ? "must be a whole number 1 to 8"
                      : !strcmp(n, "--check-seeds") ? "must be a whole number 0 to 8"
                      : !strcmp(n, "--series")      ? "must be a whole number 1 to 32"
                      : !strcmp(n, "--margin")      ? "must be a number in (0, 1]"
@@ -259,6 +344,43 @@ static int parse_args(int argc, char **argv, cal_args *a) {
             zero |= a->pressures[k] == 0;
         if (!zero)
             return cdem_cmd_usage(&help, "--ucs needs 0 among --pressures (the unconfined test)");
+    }
+    /* every run of a series (and of the fresh-seed check) is one file of one envelope fit
+     * and one picture, which read at most CDEM_PLOT_MAX_FILES files */
+    const int per_series[2] = {a->seeds, a->check_seeds};
+    for (int k = 0; k < 2; k++)
+        if (per_series[k] * a->n_pressures > CDEM_PLOT_MAX_FILES) {
+            snprintf(msg, sizeof msg,
+                     "%s %d with %d --pressures: %d runs per series, at most %d (one envelope "
+                     "is fitted to all the runs of a series); give fewer seeds or pressures",
+                     k ? "--check-seeds" : "--seeds", per_series[k], a->n_pressures,
+                     per_series[k] * a->n_pressures, CDEM_PLOT_MAX_FILES);
+            return cdem_cmd_usage(&help, msg);
+        }
+    /* the values calibrate gives every run itself: an -s of one would override them */
+    for (size_t k = 0; k < a->n_sets; k++) {
+        static const char *const own[] = {"material.element_friction", "material.element_cohesion",
+                                          "assembly.seed", "boundary.confining_pressure"};
+        const char *s = a->sets[k];
+        size_t len = strcspn(s, "=");
+        while (len > 0 && s[len - 1] == ' ')
+            len--;
+        for (int j = 0; j < 4; j++) {
+            if (strlen(own[j]) != len || strncmp(s, own[j], len) != 0)
+                continue;
+            const int fixed =
+                (j == 0 && isnan(a->phi)) || (j == 1 && isnan(a->coh) && isnan(a->ucs));
+            if (fixed) /* not searched: the model's value, which -s may set */
+                continue;
+            snprintf(msg, sizeof msg, "-s %.100s: calibrate sets %s in every run itself (%s)", s,
+                     own[j],
+                     j == 0   ? "it searches it for --phi; bound it with --mu-range"
+                     : j == 1 ? "it searches it for --cohesion or --ucs; bound it with --c0-range"
+                     : j == 2 ? "the model's seed S and the --seeds after it; set the seed in "
+                                "the model file"
+                              : "from --pressures");
+            return cdem_cmd_usage(&help, msg);
+        }
     }
     if (a->jobs == 0) {
         long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -508,6 +630,17 @@ static cdem_status cal_setup(const cal_args *a, cal_state *c, cdem_error *err) {
             len -= 4;
         snprintf(c->dir, sizeof c->dir, "calibrate-%.*s", (int)len, base);
     }
+    /* the seeds of the search and of the fresh-seed check, S..S+N+M-1, are values of
+     * assembly.seed too: checked before anything runs */
+    char range[96];
+    const long last_seed = m.p.seed + a->seeds + a->check_seeds - 1;
+    if (st == CDEM_OK &&
+        !run_allows("assembly", "seed", (double)last_seed, 1, "", range, sizeof range))
+        st = CDEM_FAIL(err, CDEM_ERR_INVALID,
+                       "%s: assembly.seed = %ld with --seeds %d and --check-seeds %d: the runs "
+                       "would use seeds %ld..%ld, beyond the range cdem-run allows for "
+                       "assembly.seed (%s); give the model a smaller seed",
+                       a->model, m.p.seed, a->seeds, a->check_seeds, m.p.seed, last_seed, range);
     if (st == CDEM_OK)
         st = cdem_calib_find_cdem_run(a->cdem_run, c->cdem_run, sizeof c->cdem_run, err);
     if (st == CDEM_OK)
@@ -530,9 +663,13 @@ static cdem_status cal_setup(const cal_args *a, cal_state *c, cdem_error *err) {
                                         .tol = a->phi_tol * a->margin,
                                         .fixed = isnan(a->phi)};
     double c0_lo = a->c0_lo, c0_hi = a->c0_hi;
-    if (isnan(c0_lo)) { /* three decades below the model's C0, two above */
+    if (isnan(c0_lo)) { /* three decades below the model's C0, two above, within the range
+                           cdem-run allows */
         c0_lo = c->c00 > 0 ? c->c00 / 1000 : 1e6;
         c0_hi = c->c00 > 0 ? c->c00 * 100 : 1e12;
+        const cdem_param_def *d = cdem_params_find("material", "element_cohesion");
+        if (d && c0_hi > d->max)
+            c0_hi = d->max;
     }
     c->c_target = c->use_ucs ? a->ucs : a->coh;
     c->c_tol = c->use_ucs ? a->ucs_tol : a->coh_tol;

@@ -128,6 +128,8 @@ int cdem_cmd_plot_parse(int argc, char **argv, cdem_plot_args *a) {
             a->data = val;
         } else if (cdem_cli_option_is(o, "--increment")) {
             a->increment = val;
+        } else if (cdem_cli_option_is(o, "--include-poor-fits")) {
+            a->include_poor = 1;
         } else if (cdem_cli_option_is(o, "--xrange") || cdem_cli_option_is(o, "--yrange")) {
             const int y = cdem_cli_option_is(o, "--yrange");
             if (!parse_range(val, a->range + 2 * y)) {

@@ -47,6 +47,7 @@ typedef struct {
     int width, height;                      /* --width, --height; 0 = default */
     int fix_x, fix_y;                       /* 1: --xrange / --yrange given */
     double window;                          /* --window M (voids); 0 = default */
+    int include_poor;                       /* --include-poor-fits (repose) */
     double range[4];                        /* xmin, xmax, ymin, ymax of --xrange, --yrange */
 } cdem_plot_args;
 

@@ -9,12 +9,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char *const repose_forms[] = {
     "RUN.h5 [--increment K|last|equil|first] [-o OUT.png|.pdf|.svg] [--width N] [--height N]",
-    "RUN1.h5 RUN2.h5 ... [--increment K|last|equil|first]", NULL};
+    "RUN1.h5 RUN2.h5 ... [--increment K|last|equil|first] [--include-poor-fits]", NULL};
 static const cdem_cli_option repose_options[] = {
     {"--increment", "K|last|equil|first", "the increment (default last)"},
+    {"--include-poor-fits", NULL,
+     "several runs: count the runs with a poor fit in the mean too (by default they are left "
+     "out, and the mean with them is printed beside)"},
     {"-o, --output", "OUT.png|.pdf|.svg", "the free surface with the fitted flanks"},
     CDEM_PLOT_WIDTH_OPTION,
     CDEM_PLOT_HEIGHT_OPTION,
@@ -28,9 +32,16 @@ static const cdem_cli_help help = {
              "angle within 2 deg over the last third of the run); both warnings also go to "
              "stderr. One collapse's angle depends on its packing (a standard deviation of "
              "2-3 deg): given several runs of one material (other assembly.seed), it reports "
-             "each and then their mean, standard deviation, standard error and range, the "
-             "material's angle of repose (docs/rendering.md, \"cdem-strain repose\").",
+             "each and then the mean, standard deviation, standard error and range of the runs "
+             "measured with a good fit, the material's angle of repose (and the mean with the "
+             "poor fits beside; --include-poor-fits counts them). Each run counts once: a file "
+             "given twice, also by another path, is refused. A run whose mode is not repose is "
+             "not measured (docs/rendering.md, \"cdem-strain repose\").",
     .options = repose_options,
+    .exit_status = "0 every run given measured (a poor fit or a slope still moving is warned "
+                   "about), 1 a run that cannot be read or measured, or is not a "
+                   "repose-collapse run, or several runs without a good fit to average, 2 "
+                   "usage error.",
 };
 
 static cdem_status repose_figure(const cdem_plot_args *a, const cdem_state *s, int number,
@@ -85,10 +96,11 @@ static void print_measure(const char *file, const cdem_repose_result *res,
         if (f->n < 2)
             continue;
         const char *name = side ? "right" : "left";
-        printf("  %s flank: %.2f deg +- %.2g (95 %%), %zu elements, x %.4g .. %.4g m, rms misfit "
-               "%.4g m; upper half %.1f deg, lower half %.1f deg\n",
-               name, f->angle_deg, f->angle_ci_deg, f->n, f->x_first, f->x_last, f->residual_rms,
-               f->angle_upper_deg, f->angle_lower_deg);
+        printf(
+            "  %s flank: %.2f deg +- %.2g deg (95 %%), %zu elements, x %.4g .. %.4g m, rms misfit "
+            "%.4g m; upper half %.1f deg, lower half %.1f deg\n",
+            name, f->angle_deg, f->angle_ci_deg, f->n, f->x_first, f->x_last, f->residual_rms,
+            f->angle_upper_deg, f->angle_lower_deg);
         char why[512];
         cdem_repose_poor_text(f, res->r_max, why, sizeof why);
         if (f->poor) {
@@ -247,8 +259,10 @@ static cdem_status measure_run(const cdem_plot_args *a, const char *file, double
     cdem_error ignored;
     if (st == CDEM_OK && cdem_h5_reader_params(r, &prm, &ignored) == CDEM_OK &&
         prm.mode != CDEM_MODE_REPOSE)
-        fprintf(stderr, "cdem-strain repose: note: %s is a '%s' run, not a repose-collapse run\n",
-                file, cdem_mode_name(prm.mode));
+        st = CDEM_FAIL(err, CDEM_ERR_INVALID,
+                       "a '%s' run (boundary.mode = %s), not a repose-collapse run "
+                       "(boundary.mode = repose): not measured",
+                       cdem_mode_name(prm.mode), cdem_mode_name(prm.mode));
     if (st == CDEM_OK)
         st = cdem_repose_measure(&s, &res, err);
     if (st == CDEM_OK) {
@@ -267,31 +281,87 @@ static cdem_status measure_run(const cdem_plot_args *a, const char *file, double
     return st;
 }
 
-/* The spread of the angles of several runs (packings of one material): a material's angle
- * of repose is their mean, not one collapse's. */
-static cdem_status print_spread(const double *angles, const int *poor, const int *moving, size_t n,
-                                cdem_error *err) {
-    cdem_repose_spread sp;
-    CDEM_TRY(cdem_repose_spread_of(angles, n, &sp, err));
-    size_t good = 0, settled = 0;
-    for (size_t k = 0; k < n; k++)
-        if (isfinite(angles[k])) {
-            good += !poor[k];
-            settled += !moving[k];
-        }
-    if (!sp.n) {
-        printf("\nover %zu runs: none measured (their errors are on stderr)\n", n);
-        return CDEM_OK;
-    }
-    printf("\nover %zu runs: angle of repose %.2f deg (mean)", n, sp.mean_deg);
-    if (sp.n >= 2)
+/* One line of a spread: the mean, and the standard deviation, standard error and range of
+ * two or more runs. */
+static void print_mean(const char *lead, const cdem_repose_spread *sp) {
+    printf("%sover %zu run%s: angle of repose %.2f deg (mean)", lead, sp->n, sp->n == 1 ? "" : "s",
+           sp->mean_deg);
+    if (sp->n >= 2)
         printf(", standard deviation %.2f deg, standard error of the mean %.2f deg, range %.2f "
                "to %.2f deg",
-               sp.sd_deg, sp.se_deg, sp.min_deg, sp.max_deg);
-    printf("\n  good fits: %zu of %zu runs; settled: %zu of %zu runs\n", good, sp.n, settled, sp.n);
-    if (sp.n < n)
-        printf("  not measured: %zu of %zu runs (their errors are on stderr)\n", n - sp.n, n);
+               sp->sd_deg, sp->se_deg, sp->min_deg, sp->max_deg);
+    printf("\n");
+}
+
+/* The spread of the angles of several runs (packings of one material): a material's angle
+ * of repose is their mean, not one collapse's. Counted: the runs measured (angle finite),
+ * of them the good fits unless include_poor. *none: 1 when there is no mean to give. */
+static cdem_status print_spread(const double *angles, const int *poor, const int *moving, size_t n,
+                                int include_poor, int *none, cdem_error *err) {
+    double good_angles[CDEM_PLOT_MAX_FILES];
+    size_t settled = 0;
+    for (size_t k = 0; k < n; k++) {
+        good_angles[k] = poor[k] ? NAN : angles[k];
+        settled += isfinite(angles[k]) && !moving[k];
+    }
+    cdem_repose_spread all, good;
+    CDEM_TRY(cdem_repose_spread_of(angles, n, &all, err));
+    CDEM_TRY(cdem_repose_spread_of(good_angles, n, &good, err));
+    const size_t n_poor = all.n - good.n;
+    *none = 0;
+    if (!all.n) {
+        printf("\nover %zu runs given: none measured (their errors are on stderr)\n", n);
+        *none = 1;
+        return CDEM_OK;
+    }
+    if (!include_poor && !good.n) {
+        printf("\nno good fit among the %zu run%s measured: no angle of repose (a poor fit's "
+               "angle depends on where the line is fitted); with the poor fits (give "
+               "--include-poor-fits to count them):\n",
+               all.n, all.n == 1 ? "" : "s");
+        print_mean("  ", &all);
+        *none = 1;
+    } else {
+        print_mean("\n", include_poor ? &all : &good);
+        if (n_poor && !include_poor) {
+            printf("  left out: %zu poor fit%s (--include-poor-fits counts them); with them:\n",
+                   n_poor, n_poor == 1 ? "" : "s");
+            print_mean("  ", &all);
+        } else if (n_poor) {
+            printf("  poor fits counted (--include-poor-fits): %zu; the good fits alone:\n",
+                   n_poor);
+            if (good.n)
+                print_mean("  ", &good);
+            else
+                printf("  none\n");
+        }
+    }
+    printf("  good fits: %zu of %zu runs measured; settled: %zu of %zu runs measured\n", good.n,
+           all.n, settled, all.n);
+    if (all.n < n)
+        printf("  not measured: %zu of %zu runs given (their errors are on stderr)\n", n - all.n,
+               n);
     return CDEM_OK;
+}
+
+/* Each run once: a file given twice, also by another path (a link, ./, ..), is the same
+ * device and inode. 0, or the usage error's exit status (printed). */
+static int refuse_duplicates(const cdem_plot_args *a) {
+    struct stat st[CDEM_PLOT_MAX_FILES];
+    int known[CDEM_PLOT_MAX_FILES];
+    for (size_t k = 0; k < a->n_files; k++) {
+        known[k] = stat(a->files[k], &st[k]) == 0; /* one that cannot be read fails later */
+        for (size_t j = 0; j < k && known[k]; j++)
+            if (known[j] && st[j].st_dev == st[k].st_dev && st[j].st_ino == st[k].st_ino) {
+                char msg[800];
+                snprintf(msg, sizeof msg,
+                         "%.300s (run %zu) is the same file as %.300s (run %zu): each run counts "
+                         "once; give each file once",
+                         a->files[k], k + 1, a->files[j], j + 1);
+                return cdem_cmd_usage(a->help, msg);
+            }
+    }
+    return 0;
 }
 
 int cdem_cmd_plot_repose(int argc, char **argv) {
@@ -303,6 +373,12 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
         return cdem_cmd_usage(a.help, "need a run file (RUN.h5), or several runs of one material");
     if (a.n_files > 1 && a.out)
         return cdem_cmd_usage(a.help, "-o draws one run: give one RUN.h5 with -o");
+    if (a.include_poor && a.n_files == 1)
+        return cdem_cmd_usage(a.help, "--include-poor-fits counts poor fits in the mean of "
+                                      "several runs: give two or more RUN.h5");
+    rc = refuse_duplicates(&a);
+    if (rc)
+        return rc;
     cdem_error err;
     cdem_render_format fmt;
     if (a.out && cdem_render_format_from_path(a.out, &fmt, &err) != CDEM_OK)
@@ -319,8 +395,17 @@ int cdem_cmd_plot_repose(int argc, char **argv) {
             rc = cdem_cmd_fail(a.cmd, a.files[k], &err);
         }
     }
-    if (a.n_files > 1 && print_spread(angles, poor, moving, a.n_files, &err) != CDEM_OK)
+    int none = 0;
+    if (a.n_files > 1 &&
+        print_spread(angles, poor, moving, a.n_files, a.include_poor, &none, &err) != CDEM_OK)
         rc = cdem_cmd_fail(a.cmd, NULL, &err);
+    if (none && !rc) {
+        fprintf(stderr,
+                "cdem-strain repose: no good fit among the %zu runs: no angle of repose "
+                "(--include-poor-fits counts the poor fits)\n",
+                a.n_files);
+        rc = CDEM_EXIT_ERROR;
+    }
     return rc;
 }
 

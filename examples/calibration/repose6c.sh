@@ -115,9 +115,11 @@ for set in keep200 default; do
     phi_se=$(sed -n 's/.*friction angle = [0-9.]* +- \([0-9.]*\) deg.*/\1/p' "$OUT/$(first_dir $set)/mohr.txt")
     files=""
     for s in 1 2 3 $PACKINGS; do files="$files $(packing_file $set $s)"; done
-    # the spread as cdem-strain repose gives it for several runs of one material
+    # the spread as cdem-strain repose gives it for several runs of one material; the table
+    # lists every packing's angle, so its mean counts the poor fits too (the good fits' mean
+    # is printed beside it)
     # shellcheck disable=SC2086
-    "$STRAIN" repose $files > "$OUT/packings-$set/spread.txt" 2>/dev/null || true
+    "$STRAIN" repose --include-poor-fits $files > "$OUT/packings-$set/spread.txt" 2>/dev/null || true
     list=$(sed -n 's/^angle of repose = \([0-9.]*\) deg.*/\1/p' "$OUT/packings-$set/spread.txt" | tr '\n' ' ')
     line=$(grep "^over " "$OUT/packings-$set/spread.txt")
     mean=$(echo "$line" | sed -n 's/.*angle of repose \([0-9.]*\) deg (mean).*/\1/p')
