@@ -18,6 +18,7 @@
 #define CDEM_H5FORMAT_H
 
 #include "cdem_error.h"
+#include "file_bounds.h"
 #include "params.h"
 #include "snapshot.h"
 #include "state.h"
@@ -28,18 +29,8 @@
 #define CDEM_FORMAT_NAME    "cdem-c"
 #define CDEM_FORMAT_VERSION 2
 
-/* Physical bounds of what a run file holds (docs/format.md, "Physical bounds"). A checksum
- * only says the bytes are those written; these say the values are a model's. The reader
- * refuses a value outside them as damage, naming the file, dataset, row and value; the writer
- * refuses to write one (CDEM_ERR_NUMERIC: a run that produced it has blown up), so a file
- * cdem-c writes is always one it reads. They lie far beyond any model (the parameters allow
- * at most 100 km wide assemblies and 2e6 s of model time) and keep every square and sum over
- * all elements finite. */
-#define CDEM_FILE_MAX_LENGTH 1e7  /* m: |x|, |y|, |net displacement|, |sea level| */
-#define CDEM_FILE_MAX_RADIUS 1e5  /* m: radius in (0, this] */
-#define CDEM_FILE_MAX_TIME   1e9  /* s: model time in [0, this] */
-#define CDEM_FILE_MAX_STRESS 1e20 /* N/m: |sxx|, |syy|, |sxy|, |differential stress| */
-#define CDEM_FILE_MAX_STRAIN 1e6  /* |axial strain|: the length bound over a 10 m sample */
+/* Physical bounds of what a run file holds (docs/format.md, "Physical bounds"):
+ * CDEM_FILE_MAX_*, file_bounds.h. */
 
 /* The stop reasons a file may record (/stop_reason; "" = none recorded): the reader refuses
  * any other text. NULL-terminated. */

@@ -17,6 +17,7 @@
  * export the table to every caller instead of keeping "one table, one owner". */
 #include "params.h"
 
+#include "file_bounds.h"
 #include "suggest.h"
 
 #include <assert.h>
@@ -1272,6 +1273,114 @@ int cdem_params_prefix_ok(const char *prefix) {
     return 1;
 }
 
+/* The limits of a model's size the file bounds set (file_bounds.h): its largest radius
+ * (0.125 units x the radius scale x unit_scaling), m, and its size, m: width, and height x
+ * wall_height_multiplier, times unit_scaling. */
+static double largest_radius(const cdem_params *p) {
+    return CDEM_LARGEST_RADIUS_UNITS * cdem_params_radius_scale(p) * p->unit_scaling;
+}
+static double model_size_units(const cdem_params *p) {
+    return fmax(p->width, p->height * p->wall_height_multiplier);
+}
+
+/* An assembly at least 8 of its largest elements wide and high (issue 33: no longer cdem's
+ * box of 10 to 100 by 2.5 to 7.5 units; the memory a run needs is checked before it starts,
+ * with the machine's own memory, by cdem-run). The advice is one that works (issue 46, item
+ * 2): to enlarge the assembly only when the enlarged one and its elements fit the file
+ * bounds, else to make the elements smaller. */
+static void size_rule(const cdem_params *p, cdem_rule_log *log) {
+    const double scale = cdem_params_radius_scale(p);
+    const double least = 8.0 * 2.0 * CDEM_LARGEST_RADIUS_UNITS * scale;
+    if (!(p->width < least || p->height < least))
+        return;
+    char v1[64], v2[64], v3[64], advice[400];
+    cdem_params_format_number(least, v2, sizeof v2);
+    cdem_params_format_number(p->width < least ? p->width : p->height, v1, sizeof v1);
+    const double enlarged =
+        fmax(fmax(p->width, least), fmax(p->height, least) * p->wall_height_multiplier);
+    const int enlarge_ok = largest_radius(p) <= CDEM_FILE_MAX_RADIUS &&
+                           enlarged * p->unit_scaling <= CDEM_MODEL_MAX_SIZE;
+    /* the radius scale whose assembly of this width and height is 8 largest elements */
+    const double rs_max = fmin(p->width, p->height) / (8.0 * 2.0 * CDEM_LARGEST_RADIUS_UNITS);
+    const cdem_param_def *rs = cdem_params_find("assembly", "radius_scale");
+    if (enlarge_ok) {
+        snprintf(advice, sizeof advice,
+                 "enlarge it or make the elements smaller ([assembly] radius_scale)");
+    } else if (rs && rs_max >= rs->min) {
+        cdem_params_format_number(rs_max, v3, sizeof v3);
+        snprintf(advice, sizeof advice,
+                 "make the elements smaller: [assembly] radius_scale <= %s%s (an assembly "
+                 "enlarged to %s units would not fit a run file, below)",
+                 v3, p->half_radii ? " with half_radii = off" : "", v2);
+    } else {
+        snprintf(advice, sizeof advice,
+                 "no assembly of this unit_scaling fits both this and a run file's bounds "
+                 "(below): lower [assembly] unit_scaling and enlarge it");
+    }
+    cdem_rule_add(log,
+                  "%s = %s units: an assembly must be at least 8 of its largest elements "
+                  "(diameter %.6g units) wide and high, i.e. >= %s units: %s",
+                  p->width < least ? "width" : "height", v1,
+                  2.0 * CDEM_LARGEST_RADIUS_UNITS * scale, v2, advice);
+}
+
+/* The bounds of a run file (file_bounds.h; docs/format.md, "Physical bounds") that the
+ * assembly's parameters decide (issue 46, item 2: unit_scaling = 1e6 passed the checks and
+ * the writer refused increment 0): its largest radius and its size. The boundaries'
+ * displacement is cdem-run's rule (solver/run/run_validate.c): it needs the time step. */
+static void file_bound_rules(const cdem_params *p, cdem_rule_log *log) {
+    char us[64], rs[64], v1[64], v2[64], v3[64], v4[64];
+    cdem_params_format_number(p->unit_scaling, us, sizeof us);
+    cdem_params_format_number(p->radius_scale, rs, sizeof rs);
+    const double rmax = largest_radius(p);
+    if (!(rmax <= CDEM_FILE_MAX_RADIUS)) {
+        const double scale = cdem_params_radius_scale(p);
+        cdem_params_format_number(rmax, v1, sizeof v1);
+        cdem_params_format_number(CDEM_FILE_MAX_RADIUS, v2, sizeof v2);
+        cdem_params_format_number(CDEM_FILE_MAX_RADIUS / (CDEM_LARGEST_RADIUS_UNITS * scale), v3,
+                                  sizeof v3);
+        cdem_params_format_number(
+            CDEM_FILE_MAX_RADIUS / (CDEM_LARGEST_RADIUS_UNITS * p->unit_scaling), v4, sizeof v4);
+        if (p->half_radii)
+            cdem_rule_add(log,
+                          "unit_scaling = %s m with half_radii = on: the largest element radius "
+                          "would be %s m (0.0625 units x unit_scaling), above the %s m a run "
+                          "file holds (docs/format.md, \"Physical bounds\"): set [assembly] "
+                          "unit_scaling <= %s m",
+                          us, v1, v2, v3);
+        else
+            cdem_rule_add(log,
+                          "unit_scaling = %s m and radius_scale = %s: the largest element "
+                          "radius would be %s m (0.125 units x radius_scale x unit_scaling), "
+                          "above the %s m a run file holds (docs/format.md, \"Physical "
+                          "bounds\"): set [assembly] unit_scaling <= %s m at this radius_scale, "
+                          "or radius_scale <= %s at this unit_scaling",
+                          us, rs, v1, v2, v3, v4);
+    }
+    const double size = model_size_units(p) * p->unit_scaling;
+    if (!(size <= CDEM_MODEL_MAX_SIZE)) {
+        const int wide = p->width >= p->height * p->wall_height_multiplier;
+        char what[160];
+        cdem_params_format_number(wide ? p->width : p->height, v1, sizeof v1);
+        if (wide)
+            snprintf(what, sizeof what, "width = %s units", v1);
+        else
+            snprintf(what, sizeof what, "height = %s units x wall_height_multiplier = %d", v1,
+                     p->wall_height_multiplier);
+        cdem_params_format_number(size, v1, sizeof v1);
+        cdem_params_format_number(CDEM_MODEL_MAX_SIZE, v2, sizeof v2);
+        cdem_params_format_number(CDEM_FILE_MAX_LENGTH, v3, sizeof v3);
+        cdem_params_format_number(CDEM_MODEL_MAX_SIZE / model_size_units(p), v4, sizeof v4);
+        cdem_rule_add(log,
+                      "%s at unit_scaling = %s m: the model would be %s m across, more than "
+                      "%s m, 0.4 of the %s m a run file holds for positions (the rest is room "
+                      "for the boundaries' displacement, the walls, a fault's ramps and growth "
+                      "strata; docs/format.md, \"Physical bounds\"): set [assembly] "
+                      "unit_scaling <= %s m at this size, or make the assembly smaller",
+                      what, us, v1, v2, v3, v4);
+    }
+}
+
 cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, cdem_error *err) {
     if (!p)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_params_validate: NULL parameters");
@@ -1330,9 +1439,7 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
     if (log.count > 0) /* ranges first: the cross rules below assume sane values */
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "%s", msg);
 
-    /* the size of the assembly against its elements (issue 33: no longer cdem's box of 10 to
-     * 100 by 2.5 to 7.5 units; the memory a run needs is checked before it starts, with the
-     * machine's own memory, by cdem-run) */
+    /* the size of the assembly against its elements, and both against a run file's bounds */
     if (p->half_radii && p->radius_scale != 1.0) {
         cdem_params_format_number(p->radius_scale, v1, sizeof v1);
         cdem_rule_add(&log,
@@ -1340,16 +1447,8 @@ cdem_status cdem_params_validate(const cdem_params *p, cdem_params_rules more, c
                       "radius_scale = 0.5)",
                       v1);
     } else {
-        const double scale = cdem_params_radius_scale(p), least = 8.0 * 2.0 * 0.125 * scale;
-        cdem_params_format_number(least, v2, sizeof v2);
-        if (p->width < least || p->height < least) {
-            cdem_params_format_number(p->width < least ? p->width : p->height, v1, sizeof v1);
-            cdem_rule_add(&log,
-                          "%s = %s units: an assembly must be at least 8 of its largest elements "
-                          "(diameter %.6g units) wide and high, i.e. >= %s units: enlarge it or "
-                          "make the elements smaller ([assembly] radius_scale)",
-                          p->width < least ? "width" : "height", v1, 0.25 * scale, v2);
-        }
+        size_rule(p, &log);
+        file_bound_rules(p, &log);
     }
     /* a file-name prefix, not a path (issue 35, item 8: "../../etc/x" was accepted) */
     if (!cdem_params_prefix_ok(p->prefix))

@@ -216,9 +216,10 @@ static void test_cli_any_size(void **state) {
     o = slurp(c, "out.txt");
     assert_has(o, "radii:                       0.005-0.0125 units (0.1 x the full radii)");
     free(o);
-    /* too large for any machine: refused by its memory, named */
+    /* too large for any machine: refused by its memory, named (at 10 m a unit, within a run
+     * file's bounds: 1e6 m across) */
     assert_int_equal(run(c, "-s assembly.width=100000 -s assembly.height=100000 -s "
-                            "assembly.radius_scale=0.01 --summary"),
+                            "assembly.radius_scale=0.01 -s assembly.unit_scaling=10 --summary"),
                      1);
     char *e = slurp(c, "err.txt");
     assert_has(e, "elements and need about");

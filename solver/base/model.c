@@ -8,11 +8,14 @@
  * steps is kept unrounded so increments do not drift over long runs. */
 #include "model.h"
 
+#include "file_bounds.h"
+
 #include <limits.h>
 #include <math.h>
 #include <string.h>
 
-static const double base_radius[CDEM_NUM_RADII] = {0.05, 0.075, 0.1, 0.125}; /* model units */
+/* model units; the largest is the one the parameter checks hold to the file's radius bound */
+static const double base_radius[CDEM_NUM_RADII] = {0.05, 0.075, 0.1, CDEM_LARGEST_RADIUS_UNITS};
 
 /* Spring stiffness (N/m) used at unit scaling 1000 m or with keep_constants. */
 static const double kn_default = 1544871985.0;

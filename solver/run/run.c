@@ -435,6 +435,13 @@ cdem_status cdem_run_open(const cdem_params *p, const cdem_run_options *opt,
         if (r->w) {
             cdem_error e2;
             cdem_error_clear(&e2);
+            /* A fresh file the run could not start (increment 0 refused, issue 46 item 2)
+             * records why: left "running", info called it a killed run to run again. */
+            if (!resume && st != CDEM_ERR_INTERRUPTED)
+                (void)cdem_h5_writer_set_stop_reason(r->w,
+                                                     st == CDEM_ERR_IO ? "write-failure" : "error",
+                                                     err ? err->msg : cdem_status_str(st), &e2);
+            cdem_error_clear(&e2);
             (void)cdem_h5_writer_close(r->w, &e2);
         }
         run_release(r);

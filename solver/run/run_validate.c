@@ -11,15 +11,46 @@
 #include "process.h"
 #include "sediment.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
+
+/* The boundaries' displacement over the run against a run file's bound (file_bounds.h; the
+ * model's size and radius are the table's rules, common/params.c): the net displacement of
+ * every increment, and the positions of what moves, stay within it. */
+static void displacement_rule(const cdem_params *p, cdem_rule_log *log) {
+    cdem_model m;
+    cdem_error err;
+    if (cdem_bc_derive_model(p, &m, &err) != CDEM_OK)
+        return; /* the mode's rules, or cdem-run's derivation, say what is wrong */
+    if (!(m.total_displacement > CDEM_MODEL_MAX_DISPLACEMENT))
+        return;
+    char v1[64], v2[64], v3[64], v4[64], v5[64];
+    cdem_params_format_number(p->runtime, v1, sizeof v1);
+    cdem_params_format_number(p->unit_scaling, v2, sizeof v2);
+    cdem_params_format_number(CDEM_MODEL_MAX_DISPLACEMENT, v3, sizeof v3);
+    cdem_params_format_number(CDEM_FILE_MAX_LENGTH, v4, sizeof v4);
+    /* the displacement grows with the steps after equilibration */
+    const double runtime_max = p->equilibration + (p->runtime - p->equilibration) *
+                                                      CDEM_MODEL_MAX_DISPLACEMENT /
+                                                      m.total_displacement;
+    cdem_params_format_number(floor(runtime_max - m.dt), v5, sizeof v5); /* a step for rounding */
+    cdem_rule_add(log,
+                  "runtime = %s s at unit_scaling = %s m: the boundaries would move %.4g m "
+                  "(%.4g m/s, the boundary speed of this model), more than %s m, 0.4 of the %s m "
+                  "a run file holds for the net displacement and positions (docs/format.md, "
+                  "\"Physical bounds\"): set [time] runtime <= %s s, or a smaller "
+                  "[assembly] unit_scaling",
+                  v1, v2, m.total_displacement, m.boundary_speed, v3, v4, v5);
+}
 
 /* The rules of the solver's modules, after the table's. */
 static void solver_rules(const cdem_params *p, cdem_rule_log *log) {
     cdem_bc_rules(p, log);
     cdem_sediment_rules(p, log);
     cdem_processes_rules(p, log);
+    displacement_rule(p, log);
 }
 
 cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err) {

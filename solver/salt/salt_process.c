@@ -48,8 +48,11 @@ static void salt_describe(const cdem_params *p, const cdem_model *m, FILE *f) {
     line(f, "salt density", "%g kg/m^3 (smallest salt mass %.6g kg/m)", sm->density, sm->mass[0]);
     line(f, "viscosity", "%g Pa s geological = %.4g Pa s in the model (/ time scale)",
          sm->viscosity_geological, sm->viscosity);
-    line(f, "geological rate", "%g mm/yr = %.4g m/s, shown by the model's %.6g m/s", p->salt_rate,
-         sm->rate, m->boundary_speed);
+    if (isnan(p->salt_time_scale))
+        line(f, "geological rate", "%g mm/yr = %.4g m/s, shown by the model's %.6g m/s",
+             p->salt_rate, sm->rate, m->boundary_speed);
+    else /* only without a moving boundary (salt_rules.c refuses it with one: issue 46) */
+        line(f, "geological rate", "none: no boundary moves (salt.rate is not used)");
     line(f, "time scale S", "%.4g (1 model s = %.4g yr%s)", sm->time_scale,
          sm->time_scale / CDEM_SECONDS_PER_YEAR,
          isnan(p->salt_time_scale) ? "; boundary speed / geological rate" : "; salt.time_scale");

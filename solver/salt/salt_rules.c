@@ -61,6 +61,36 @@ void cdem_salt_time_map(const cdem_params *p, const cdem_model *m, cdem_salt_tim
     t->deformation_yr = (p->runtime - p->equilibration) * sm->time_scale / CDEM_SECONDS_PER_YEAR;
 }
 
+/* An explicit salt.time_scale with a moving boundary (issue 46, item 4): it overrode salt.rate
+ * silently (the summary showed "5 mm/yr" beside a time scale that meant 0.02 mm/yr). With a
+ * moving boundary the time scale is the rate's, S = boundary speed / rate: the pair is
+ * refused, naming the rate the time scale stands for and, when the table allows it, the rate
+ * that gives that time scale. */
+static void time_scale_rule(const cdem_params *p, const cdem_model *m, cdem_rule_log *log) {
+    char ts[64], rate[64], implied[64], range[200];
+    const double mm_yr = 1e3 * CDEM_SECONDS_PER_YEAR; /* m/s -> mm/yr */
+    const double v = m->boundary_speed, r = v / p->salt_time_scale * mm_yr;
+    cdem_params_format_number(p->salt_time_scale, ts, sizeof ts);
+    cdem_params_format_number(p->salt_rate, rate, sizeof rate);
+    snprintf(implied, sizeof implied, "%.4g", r);
+    const cdem_param_def *d = cdem_params_find("salt", "rate");
+    if (d && r >= d->min && r <= d->max)
+        snprintf(range, sizeof range, "; for this time scale set salt.rate = %s mm/yr", implied);
+    else if (d)
+        snprintf(range, sizeof range,
+                 "; no salt.rate gives this time scale (%g to %g mm/yr give S = %.4g to %.4g)",
+                 d->min, d->max, v / (d->max / mm_yr), v / (d->min / mm_yr));
+    else
+        range[0] = '\0';
+    cdem_rule_add(log,
+                  "salt.time_scale = %s with boundary.mode = %s, whose boundary moves: the time "
+                  "scale follows from salt.rate = %s mm/yr (S = boundary speed %.4g m/s / rate "
+                  "= %.4g), and this one would override it (it stands for %s mm/yr): set "
+                  "salt.time_scale = rate (a time scale of its own is for modes without a "
+                  "moving boundary)%s",
+                  ts, cdem_mode_name(p->mode), rate, v, v / (p->salt_rate / mm_yr), implied, range);
+}
+
 void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
     if (p->granular_law == CDEM_LAW_SALT)
         cdem_rule_add(log, "material.granular_law = salt: the salt law is the pair law of salt "
@@ -91,6 +121,18 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
                       "= %s",
                       v1, v2);
     }
+    if (p->salt_layer == CDEM_SALT_INTERVAL && a <= 0.0 && b >= 1.0) {
+        /* every free element's centre lies in the band: the placement would refuse it (issue
+         * 46, item 3: the summary showed "cover above: 0 m", the run refused) */
+        cdem_params_format_number(p->salt_interval_bottom_percent, v1, sizeof v1);
+        cdem_params_format_number(p->salt_interval_top_percent, v2, sizeof v2);
+        cdem_rule_add(log,
+                      "salt.layer = interval: the salt's band, salt.interval_bottom_percent = %s "
+                      "to salt.interval_top_percent = %s %% of the span of element centres, "
+                      "holds every element: make it thinner (the salt must leave a cover): "
+                      "raise salt.interval_bottom_percent or lower salt.interval_top_percent",
+                      v1, v2);
+    }
     if (p->weak_interval != CDEM_WEAK_OFF) {
         const double t = p->weak_thickness_percent / 100.0;
         const double wa = p->weak_interval == CDEM_WEAK_LOWER ? 0.0 : 1.0 - t;
@@ -108,6 +150,9 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
     if (cdem_bc_derive_model(p, &m, &err) != CDEM_OK)
         return; /* the table's rules or the mode's say what is wrong */
     const cdem_salt_model *sm = &m.salt;
+    const int own_scale = !isnan(p->salt_time_scale);
+    if (own_scale && m.mode.moving_boundaries > 0)
+        time_scale_rule(p, &m, log);
     cdem_salt_time t;
     cdem_salt_time_map(p, &m, &t);
     if (p->damping_mode == CDEM_DAMPING_ABSOLUTE) {
@@ -122,14 +167,18 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
     }
     const double dt_viscous = t.dt_viscous, dt_pressure = t.dt_pressure;
     cdem_params_format_number(p->salt_viscosity, v1, sizeof v1);
-    cdem_params_format_number(p->salt_rate, v2, sizeof v2);
+    cdem_params_format_number(own_scale ? p->salt_time_scale : p->salt_rate, v2, sizeof v2);
+    /* the model's viscosity is viscosity / S, S = boundary speed / rate: a lower rate or a
+     * larger S makes it less viscous (the advice said "raise salt.rate", which made it worse) */
     if (!(m.dt < dt_viscous))
         cdem_rule_add(log,
-                      "salt.viscosity = %s Pa s at salt.rate = %s mm/yr is %.4g Pa s in the "
-                      "model, too viscous for its grid: the explicit limit rho phi h^2 / "
-                      "(8 eta) = %.3g s is below the time step %.3g s (the integration has no "
-                      "sub-steps): lower salt.viscosity, raise salt.rate or salt.grid_spacing",
-                      v1, v2, sm->viscosity, dt_viscous, m.dt);
+                      "salt.viscosity = %s Pa s at %s = %s%s is %.4g Pa s in the model, too "
+                      "viscous for its grid: the explicit limit rho phi h^2 / (8 eta) = %.3g s "
+                      "is below the time step %.3g s (the integration has no sub-steps): lower "
+                      "salt.viscosity, %s or raise salt.grid_spacing",
+                      v1, own_scale ? "salt.time_scale" : "salt.rate", v2,
+                      own_scale ? "" : " mm/yr", sm->viscosity, dt_viscous, m.dt,
+                      own_scale ? "raise salt.time_scale" : "lower salt.rate");
     if (!(m.dt < dt_pressure)) {
         cdem_params_format_number(p->salt_bulk_modulus, v1, sizeof v1);
         cdem_rule_add(log,
