@@ -55,16 +55,18 @@ cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
 
 cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_error *err) {
     const long n = cdem_model_estimate_elements(p);
-    if (n > CDEM_RUN_MAX_ELEMENTS)
-        return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "the model would hold about %ld elements: more than the %ld a run can "
-                         "number (its neighbour list numbers the contact pairs, up to 4 per "
-                         "element, with 32-bit integers): use larger elements ([assembly] "
-                         "radius_scale) or a smaller assembly",
-                         n, CDEM_RUN_MAX_ELEMENTS);
     const double need = cdem_run_memory_estimate(p);
-    if (have <= 0.0 || need <= have)
+    /* the memory first (the limit a user meets), then the 32-bit indices */
+    if (have <= 0.0 || need <= have) {
+        if (n > CDEM_RUN_MAX_ELEMENTS)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "the model would hold about %ld elements: more than the %ld a run can "
+                             "number (its neighbour list numbers the contact pairs, up to 4 per "
+                             "element, with 32-bit integers): use larger elements ([assembly] "
+                             "radius_scale) or a smaller assembly",
+                             n, CDEM_RUN_MAX_ELEMENTS);
         return CDEM_OK;
+    }
     return CDEM_FAIL(err, CDEM_ERR_NOMEM,
                      "the model would hold about %ld elements and need about %.3g GB of memory "
                      "(%.0f bytes per element, measured), but this machine has %.3g GB "
