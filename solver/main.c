@@ -15,6 +15,7 @@
 #include "run.h"
 #include "runlock.h"
 #include "summary.h"
+#include "estimate.h"
 #include "cli_help.h"
 #include "governor.h"
 #include "parallel.h"
@@ -472,6 +473,21 @@ static cdem_status print_summary(const cdem_params *p, const cdem_model *m, cdem
     return st;
 }
 
+/* Before the run (issue 46, item 8): an equilibration shorter than the assembly needs to come
+ * to rest (the summary's rule of thumb, solver/run/estimate.h) is said now, not when the
+ * equilibration ends (run.c warns then too, from the speeds it measures). */
+static void warn_short_equilibration(const cdem_params *p, const cdem_model *m, int quiet) {
+    const double need = cdem_estimate_equilibration_needed(m);
+    if (quiet || !(p->equilibration < need))
+        return;
+    fprintf(stderr,
+            "cdem-run: warning: time.equilibration = %g s is shorter than the about %.0f s an "
+            "assembly %.0f average diameters tall needs to settle (the summary's rule of thumb): "
+            "it will still be settling when the boundaries start to move; use "
+            "time.equilibration = %.0f or more (docs/guide.md, section 4, \"Equilibration\")\n",
+            p->equilibration, need, cdem_estimate_height_diameters(m), need);
+}
+
 /* Simulates p into out_path (NULL: no memory was left for its name). Takes file_text (the
  * model file's text, or NULL), which becomes the stored parameter text or is freed. Returns
  * the exit code; the messages are printed. */
@@ -559,6 +575,7 @@ static int run_model(const cli_args *a, cdem_error *err) {
         rc = EXIT_OK;
         goto done;
     }
+    warn_short_equilibration(&p, &m, a->quiet);
     rc = simulate(a, &p, out_path, file_text, err);
     file_text = NULL; /* taken by simulate */
     goto done;

@@ -748,7 +748,7 @@ static void test_assembly_errors(void **unused) {
     expect_error(&p, &mgood, CDEM_ERR_RANGE, "wall_height_multiplier = 0: must be 1-4");
     p = good;
     p.width = 1e7; /* far too many elements: refused, not attempted */
-    expect_error(&p, &mgood, CDEM_ERR_RANGE, "more than the limit");
+    expect_error(&p, &mgood, CDEM_ERR_RANGE, "32-bit indices can number");
     p = good;
     p.width = 0.3; /* narrower than 4 max radii */
     expect_error(&p, &mgood, CDEM_ERR_RANGE, "too small for the largest element radius");

@@ -8,6 +8,8 @@
 #include <cmocka.h>
 
 #include "bc.h"
+#include "estimate.h"
+#include "h5format.h"
 #include "model.h"
 #include "params.h"
 #include "summary.h"
@@ -238,6 +240,88 @@ static void test_summary_salt_time_mapping(void **state) {
     free(t);
 }
 
+/* Issue 46, item 8: the summary of a large model says, before any run, what it will cost:
+ * the wall time from the documented per-element cost (labelled with its CPU), the output
+ * file's size from the format's measured bytes per element, and the slip the runtime gives.
+ * cdem2D's finer assemblies (radius_scale 0.1: about 212,000 elements, 709,613 time steps; no
+ * run, no packing: the counts are given). */
+static void test_summary_large_model_estimates(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_error err;
+    cdem_params_defaults(&p);
+    assert_int_equal(cdem_params_override(&p, "assembly.radius_scale=0.1", &err), CDEM_OK);
+    cdem_model m;
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
+    assert_int_equal(m.total_steps, 709613);
+    const long n = 210000, nw = 2000;
+    char *t = summary_of(&p, n, nw, 0);
+    assert_line(t, "element-steps", "1.5e+11 (212000 elements x 709613 time steps)");
+    /* 30 increments (5 m of slip each); 212,000 x 709,613 x 15 ns + 212,000 x 30 x 1 us =
+     * 2256.6 + 6.4 s = 37.7 min; 0.6 of it on two threads */
+    assert_int_equal(m.n_increments_total + 1, 30);
+    const double wall = cdem_estimate_wall_seconds((double)(n + nw), 709613.0, 30.0);
+    assert_true(wall > 2260.0 && wall < 2265.0);
+    assert_line(t, "wall time",
+                "about 37.7 min on one thread and 22.6 min on two of an AMD EPYC "
+                "(Zen 5) at 15 ns per element-step");
+    /* the output file: 65,536 + 30 (512 + 212,000 x 13.5) bytes = 85.9 MB */
+    char want[128];
+    snprintf(want, sizeof want, "about %.3g MB (30 increments of 212000 elements)",
+             cdem_h5_estimate_file_size(212000.0, 30.0, 0) / 1e6);
+    assert_line(t, "output file", want);
+    assert_line(t, "output file",
+                "about 85.9 MB (30 increments of 212000 elements); 256 MB with "
+                "the checkpoint slots");
+    assert_line(t, "memory", "about 267 MB (1100 bytes per element)");
+    /* the slip the runtime gives: a tenth of the default's 1127.38 m (dt is a tenth) */
+    snprintf(want, sizeof want, "%.6g m in the 1600 s after equilibration", m.total_displacement);
+    assert_line(t, "slip over the runtime", want);
+    assert_line(t, "slip over the runtime", "112.738 m in the 1600 s after equilibration");
+    free(t);
+}
+
+/* Issue 46, item 8: the equilibration rule of thumb (estimate.h) warns, before the run, for
+ * an assembly too tall to settle in cdem's default 400 s (examples/inversion's 128 average
+ * diameters: it settled in about 2500 s, measured), and not for the default model (29
+ * diameters, at rest after about 200 s) nor for the inversion's own 3000 s. */
+static void test_summary_equilibration_warning(void **state) {
+    (void)state;
+    cdem_params p;
+    cdem_error err;
+    cdem_params_defaults(&p);
+    char *t = summary_of(&p, 2121, 200, 0);
+    assert_line(t, "equilibration needed", "about 300 s for an assembly 29 average diameters");
+    assert_null(strstr(t, "  warning:"));
+    free(t);
+
+    assert_int_equal(cdem_params_override(&p, "assembly.unit_scaling=125", &err), CDEM_OK);
+    assert_int_equal(cdem_params_override(&p, "assembly.height=22.4", &err), CDEM_OK);
+    assert_int_equal(cdem_params_override(&p, "assembly.width=50", &err), CDEM_OK);
+    t = summary_of(&p, 47000, 900, 0);
+    assert_line(t, "equilibration needed", "about 2800 s for an assembly 128 average diameters");
+    assert_line(t, "warning",
+                "time.equilibration = 400 s is shorter: the assembly will still "
+                "be settling when the boundaries start to move; use "
+                "time.equilibration = 2800 or more");
+    free(t);
+    assert_int_equal(cdem_params_override(&p, "time.equilibration=3000", &err), CDEM_OK);
+    assert_int_equal(cdem_params_override(&p, "time.runtime=15000", &err), CDEM_OK);
+    t = summary_of(&p, 47000, 900, 0);
+    assert_null(strstr(t, "  warning:"));
+    free(t);
+
+    /* the rule: taller (in diameters) needs longer; no gravity, nothing to settle */
+    cdem_model m;
+    cdem_params_defaults(&p);
+    assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);
+    const double base = cdem_estimate_equilibration_needed(&m);
+    m.height_m *= 2.0;
+    assert_true(cdem_estimate_equilibration_needed(&m) > base);
+    m.gravity = 0.0;
+    assert_true(cdem_estimate_equilibration_needed(&m) == 0.0);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_summary_default_model_key_lines),
@@ -245,6 +329,8 @@ int main(void) {
         cmocka_unit_test(test_summary_modes_geometry),
         cmocka_unit_test(test_summary_rejects_null),
         cmocka_unit_test(test_summary_salt_time_mapping),
+        cmocka_unit_test(test_summary_large_model_estimates),
+        cmocka_unit_test(test_summary_equilibration_warning),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -40,11 +40,22 @@ static const int bag_counts[CDEM_NUM_RADII] = CDEM_RADIUS_SHARES;
  * practice; a guard against a numerical cycle). */
 #define ASM_MAX_MOVES 1000
 
-/* Upper bound on the elements (and grid cells) of one assembly; larger requests fail. The
- * bound used is the densest possible packing of smallest discs, about 2.7 times the real
- * count, so this admits about 1.8 million real elements (the largest assembly within the
- * parameter ranges has 125,000). */
-#define ASM_MAX_ELEMENTS 5000000.0
+/* The packer numbers its discs and cells with 32-bit integers (head, next; the grid's
+ * cdem_grid_sort), so an assembly that could hold more discs or cells than ASM_MAX_INDEX is
+ * refused. The bound it is checked against is the densest packing of the smallest discs
+ * (0.9069 of the area, every disc of radius[0]): a true upper bound, but about 2.7 times the
+ * real count, since the bag's mix (4:3:2:1 of 1, 1.5, 2 and 2.5 x radius[0]) has a mean disc
+ * area of 2.5 x the smallest's and the deposition fills about 0.82 of the area. Any other
+ * limit on the size of a model is the memory of the machine (cdem_run_check_memory,
+ * solver/run/run.h), checked before the assembly is built. */
+#define ASM_MAX_INDEX 2147483647.0
+
+/* The arrays of the discs start at the expected count (the mix's mean disc area at
+ * ASM_FILL_GUESS of the box) and grow by half when it is reached. */
+#define ASM_FILL_GUESS 0.9
+/* The area fraction the deposition fills (about 0.82: cdem_assembly_info.area_fraction of the
+ * default assembly), for the expected count the refusal names. */
+#define ASM_FILL_SEEN 0.82
 
 /* Relative tolerance of a tangency, as a fraction of the contact distance. */
 #define ASM_EPS 1e-12
@@ -376,6 +387,16 @@ static int cmp_item(const void *pa, const void *pb) {
     return a->i < b->i ? -1 : (a->i > b->i);
 }
 
+/* The mean area of a disc of the bag's mix, m^2. */
+static double mean_disc_area(const cdem_model *m) {
+    double sum = 0.0;
+    for (int c = 0; c < CDEM_NUM_RADII; c++)
+        sum += bag_counts[c] * M_PI * m->radius[c] * m->radius[c];
+    return sum / ASM_BAG_SIZE;
+}
+
+static cdem_status check_geometry(const cdem_params *p, const cdem_model *m, cdem_error *err);
+
 static cdem_status check_inputs(const cdem_params *p, const cdem_model *m, const cdem_state *s,
                                 cdem_error *err) {
     if (!p || !m || !s)
@@ -386,6 +407,11 @@ static cdem_status check_inputs(const cdem_params *p, const cdem_model *m, const
                          "cdem_assembly_build: the state already holds %zu elements; it must be "
                          "initialised and empty",
                          s->n);
+    return check_geometry(p, m, err);
+}
+
+/* The sizes, radii and masses the packing needs, and the limit of its indices. */
+static cdem_status check_geometry(const cdem_params *p, const cdem_model *m, cdem_error *err) {
     if (!(isfinite(p->unit_scaling) && p->unit_scaling > 0.0))
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "assembly.unit_scaling = %g m: must be finite and > 0 (100-1000)",
@@ -424,20 +450,32 @@ static cdem_status check_inputs(const cdem_params *p, const cdem_model *m, const
                          "assembly of %g x %g m is too small for the largest element radius "
                          "%g m: width must be >= 4 and height >= 2 radii",
                          w, h, rmax);
-    /* densest disc packing (pi / sqrt 12) bounds the count */
+    /* densest disc packing (pi / sqrt 12) of the smallest discs bounds the count */
     double bound = 0.9069 * w * (h + 2.0 * rmax) / (M_PI * rmin * rmin) +
                    2.0 * (w + 2.0 * p->wall_height_multiplier * h) / rmin;
     double cells = (w / (2.0 * rmax) + 2.0) * (h / (2.0 * rmax) + 4.0);
-    if (bound > ASM_MAX_ELEMENTS || cells > ASM_MAX_ELEMENTS)
+    if (bound > ASM_MAX_INDEX || cells > ASM_MAX_INDEX)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                         "assembly of %g x %g m with smallest radius %g m could hold %.3g "
-                         "elements: more than the limit of %.0f",
-                         w, h, rmin, bound, ASM_MAX_ELEMENTS);
+                         "assembly of %g x %g m with smallest radius %g m could hold up to %.3g "
+                         "elements (the densest packing of its smallest discs; about %.3g "
+                         "expected) in %.3g grid cells: more than the %.0f the packing's 32-bit "
+                         "indices can number; use larger elements ([assembly] radius_scale) or "
+                         "a smaller assembly",
+                         w, h, rmin, bound, ASM_FILL_SEEN * w * h / mean_disc_area(m), cells,
+                         ASM_MAX_INDEX);
     return CDEM_OK;
 }
 
-static cdem_status packer_alloc(packer *pk, double w, double h, double rmin, double rmax,
+cdem_status cdem_assembly_check(const cdem_params *p, const cdem_model *m, cdem_error *err) {
+    if (!p || !m)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_assembly_check: NULL %s",
+                         !p ? "params" : "model");
+    return check_geometry(p, m, err);
+}
+
+static cdem_status packer_alloc(packer *pk, double w, double h, const cdem_model *m,
                                 cdem_error *err) {
+    const double rmax = m->radius[CDEM_NUM_RADII - 1];
     memset(pk, 0, sizeof *pk);
     pk->w = w;
     pk->h = h;
@@ -447,7 +485,7 @@ static cdem_status packer_alloc(packer *pk, double w, double h, double rmin, dou
     pk->nrows = (int)ceil((h + 2.0 * rmax) / cell) + 2;
     pk->grid = (cdem_grid){
         .x0 = 0.0, .y0 = 0.0, .cell = cell, .nx = (size_t)pk->ncols, .ny = (size_t)pk->nrows};
-    pk->cap = (long)(0.9069 * w * (h + 2.0 * rmax) / (M_PI * rmin * rmin)) + 16;
+    pk->cap = (long)(ASM_FILL_GUESS * w * (h + 2.0 * rmax) / mean_disc_area(m)) + 16;
     size_t ncell = (size_t)pk->ncols * (size_t)pk->nrows;
     pk->head = malloc(ncell * sizeof *pk->head);
     pk->coltop = malloc((size_t)pk->ncols * sizeof *pk->coltop);
@@ -469,11 +507,36 @@ static cdem_status packer_alloc(packer *pk, double w, double h, double rmin, dou
     return CDEM_OK;
 }
 
+/* Grows the disc arrays by half (0: out of memory; the arrays are kept). */
+static int packer_grow(packer *pk) {
+    const long cap = pk->cap + pk->cap / 2 + 16;
+    int *next = realloc(pk->next, (size_t)cap * sizeof *next);
+    if (next)
+        pk->next = next;
+    double *x = realloc(pk->x, (size_t)cap * sizeof *x);
+    if (x)
+        pk->x = x;
+    double *y = realloc(pk->y, (size_t)cap * sizeof *y);
+    if (y)
+        pk->y = y;
+    double *r = realloc(pk->r, (size_t)cap * sizeof *r);
+    if (r)
+        pk->r = r;
+    int *cls = realloc(pk->cls, (size_t)cap * sizeof *cls);
+    if (cls)
+        pk->cls = cls;
+    if (!next || !x || !y || !r || !cls)
+        return 0;
+    pk->cap = cap;
+    return 1;
+}
+
 /* Fills the box up to height h (centres at or below h). */
-static void pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails) {
+static cdem_status pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails,
+                        cdem_error *err) {
     long fails = 0;
     class_bag bag = {.left = 0};
-    while (fails < max_fails && pk->n < pk->cap) {
+    while (fails < max_fails) {
         int cls = draw_class(&bag, rng);
         double r = m->radius[cls];
         double x0 = r + gsl_rng_uniform(rng) * (pk->w - 2.0 * r);
@@ -487,9 +550,13 @@ static void pack(packer *pk, const cdem_model *m, gsl_rng *rng, long max_fails) 
             fails++;
             continue;
         }
+        if (pk->n == pk->cap && !packer_grow(pk))
+            return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory growing the packing to %ld discs",
+                             pk->cap + pk->cap / 2 + 16);
         packer_insert(pk, x, y, r, cls);
         fails = 0;
     }
+    return CDEM_OK;
 }
 
 /* The base's centre spacing in wall radii: assembly.base_spacing, unless the mode decides it
@@ -620,20 +687,24 @@ cdem_status cdem_assembly_build(const cdem_params *p, const cdem_model *m, cdem_
         memset(info, 0, sizeof *info);
     CDEM_TRY(check_inputs(p, m, s, err));
     double w = p->width * p->unit_scaling, h = p->height * p->unit_scaling;
-    double rmin = m->radius[0], rmax = m->radius[CDEM_NUM_RADII - 1];
+    double rmin = m->radius[0];
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     if (!rng)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory allocating the random generator");
     gsl_rng_set(rng, (unsigned long)p->seed);
     packer pk;
-    cdem_status st = packer_alloc(&pk, w, h, rmin, rmax, err);
+    cdem_status st = packer_alloc(&pk, w, h, m, err);
     if (st != CDEM_OK) {
         gsl_rng_free(rng);
         return st;
     }
     double fails = fmax(ASM_MIN_FAILS, ASM_FAILS_PER_DIAMETER * w / (2.0 * rmin));
-    pack(&pk, m, rng, (long)fails);
+    st = pack(&pk, m, rng, (long)fails, err);
     gsl_rng_free(rng);
+    if (st != CDEM_OK) {
+        packer_free(&pk);
+        return st;
+    }
     st = fill_state(&pk, p, m, s, info, err);
     packer_free(&pk);
     if (st != CDEM_OK)

@@ -42,9 +42,16 @@ typedef struct {
  * left to right, then the left wall and the right wall from bottom to top. info may be NULL (zeroed
  * on failure). Fails with CDEM_ERR_INVALID (non-empty state, NULL arguments), CDEM_ERR_RANGE (sizes
  * or radii not finite and positive, radii not ascending, an assembly too small for the largest disc
- * or too large to allocate) or CDEM_ERR_NOMEM; s is then left empty. */
+ * or too large for the packing's 32-bit indices: cdem_assembly_check) or CDEM_ERR_NOMEM; s is then
+ * left empty. */
 cdem_status cdem_assembly_build(const cdem_params *p, const cdem_model *m, cdem_state *s,
                                 cdem_assembly_info *info, cdem_error *err);
+
+/* The checks cdem_assembly_build makes of p and m before it builds anything (sizes, radii,
+ * masses, and the packing's 32-bit indices: an assembly whose densest packing of its smallest
+ * discs would number more than 2^31 - 1 discs or grid cells is refused, CDEM_ERR_RANGE);
+ * builds nothing. The memory the model needs is cdem_run_check_memory's (solver/run/run.h). */
+cdem_status cdem_assembly_check(const cdem_params *p, const cdem_model *m, cdem_error *err);
 
 /* Counts the internal and wall elements the parameters generate (builds the assembly into a
  * scratch state and frees it). Either output may be NULL. */

@@ -49,8 +49,19 @@ double cdem_run_memory_estimate(const cdem_params *p);
 
 /* A model larger than the machine can hold is refused before anything is built
  * (CDEM_ERR_NOMEM, naming the elements, the memory needed and the memory available); a
- * machine whose available memory cannot be read is not refused. */
+ * machine whose available memory cannot be read is not refused. There is no other cap on the
+ * element count but CDEM_RUN_MAX_ELEMENTS below. */
 cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err);
+
+/* The one fixed limit on the size of a model: the neighbour list numbers its pairs with
+ * 32-bit integers (step/neighbour.h: istart, jslot), and a packing has up to 4 list pairs per
+ * element (1.85-2.1 measured, docs/performance.md), so (2^31 - 1) / 4 rounded down; larger
+ * models are refused (CDEM_ERR_RANGE) whatever the memory. */
+#define CDEM_RUN_MAX_ELEMENTS 500000000L
+
+/* cdem_run_check_memory against `available` bytes instead of the machine's (<= 0: unknown,
+ * not refused), and the limit above: what tests call, with the available memory injected. */
+cdem_status cdem_run_check_memory_in(const cdem_params *p, double available, cdem_error *err);
 
 /* Runs the model. Returns CDEM_OK when it completed, CDEM_ERR_INTERRUPTED when a stop was
  * requested (the file is valid and says where it stopped), other codes on failure. */

@@ -81,14 +81,27 @@ double cdem_run_memory_estimate(const cdem_params *p) {
 }
 
 cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
-    const double need = cdem_run_memory_estimate(p), have = memory_available();
-    if (have <= 0.0 || need <= have)
+    return cdem_run_check_memory_in(p, memory_available(), err);
+}
+
+cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_error *err) {
+    const long n = cdem_model_estimate_elements(p);
+    const double need = cdem_run_memory_estimate(p);
+    /* the memory first (the limit a user meets), then the 32-bit indices */
+    if (have <= 0.0 || need <= have) {
+        if (n > CDEM_RUN_MAX_ELEMENTS)
+            return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                             "the model would hold about %ld elements: more than the %ld a run can "
+                             "number (its neighbour list numbers the contact pairs, up to 4 per "
+                             "element, with 32-bit integers): use larger elements ([assembly] "
+                             "radius_scale) or a smaller assembly",
+                             n, CDEM_RUN_MAX_ELEMENTS);
         return CDEM_OK;
+    }
     return CDEM_FAIL(err, CDEM_ERR_NOMEM,
                      "the model would hold about %ld elements and need about %.3g GB of memory "
                      "(%.0f bytes per element, measured), but this machine has %.3g GB "
                      "available: use larger elements ([assembly] radius_scale), a smaller "
                      "assembly, or a machine with more memory",
-                     cdem_model_estimate_elements(p), need / 1e9, CDEM_RUN_MEMORY_PER_ELEMENT,
-                     have / 1e9);
+                     n, need / 1e9, CDEM_RUN_MEMORY_PER_ELEMENT, have / 1e9);
 }

@@ -10,7 +10,10 @@
 #include "summary.h"
 
 #include "bc.h"
+#include "estimate.h"
+#include "h5format.h"
 #include "process.h"
+#include "run.h"
 #include "summary_line.h"
 
 #include <math.h>
@@ -33,6 +36,73 @@ static const char *on_off(int v) {
 static const char *sea_word(cdem_sea_level_rise s) {
     static const char *const words[] = {"null", "low", "mid", "high", "very high"};
     return (unsigned)s < 5 ? words[s] : "?";
+}
+
+/* A duration for a person: s, min or h, three significant digits. */
+static void duration(char *buf, size_t size, double s) {
+    if (s < 120.0)
+        snprintf(buf, size, "%.2g s", s);
+    else if (s < 7200.0)
+        snprintf(buf, size, "%.3g min", s / 60.0);
+    else
+        snprintf(buf, size, "%.3g h", s / 3600.0);
+}
+
+/* A size in bytes for a person: kB, MB, GB or TB (10^3 steps), three significant digits. */
+static void bytes(char *buf, size_t size, double b) {
+    static const char *const units[] = {"kB", "MB", "GB", "TB"};
+    int u = 0;
+    b /= 1e3;
+    while (b >= 1e3 && u < 3) {
+        b /= 1e3;
+        u++;
+    }
+    snprintf(buf, size, "%.3g %s", b, units[u]);
+}
+
+/* What the run will cost and whether its equilibration is long enough (estimate.h): constants
+ * of one CPU class and of the file format, never a measurement, so the text stays the same. */
+static void estimates_section(FILE *f, const cdem_params *p, const cdem_model *m, long n) {
+    heading(f, "Estimates before the run");
+    const double steps = (double)m->total_steps, incs = (double)m->n_increments_total + 1.0;
+    const double wall = cdem_estimate_wall_seconds((double)n, steps, incs);
+    char one[32], two[32], file[32], space[32], mem[32];
+    duration(one, sizeof one, wall);
+    duration(two, sizeof two, CDEM_ESTIMATE_TWO_THREADS * wall);
+    line(f, "element-steps", "%.3g (%ld elements x %ld time steps)", (double)n * steps, n,
+         m->total_steps);
+    line(f, "wall time",
+         "about %s on one thread and %s on two of %s at %g ns per element-step "
+         "(docs/performance.md, \"Estimates before a run\"); a busy machine or another CPU "
+         "differs",
+         one, two, CDEM_ESTIMATE_CPU, CDEM_ESTIMATE_NS_PER_ELEMENT_STEP);
+    bytes(file, sizeof file, cdem_h5_estimate_file_size((double)n, incs, p->calculate_stress));
+    bytes(space, sizeof space,
+          cdem_h5_estimate_run_space((double)n, incs, p->calculate_stress,
+                                     p->checkpoint_interval > 0));
+    line(f, "output file", "about %s (%.0f increments of %ld elements%s); %s with %s sidecar", file,
+         incs, n, p->calculate_stress ? ", with stress" : "", space,
+         p->checkpoint_interval > 0 ? "the checkpoint slots and the" : "the");
+    bytes(mem, sizeof mem, CDEM_RUN_MEMORY_FIXED + (double)n * CDEM_RUN_MEMORY_PER_ELEMENT);
+    line(f, "memory", "about %s (%.0f bytes per element)", mem, CDEM_RUN_MEMORY_PER_ELEMENT);
+    if (m->mode.moving_boundaries > 0)
+        line(f, "slip over the runtime",
+             "%.6g m in the %g s after equilibration (the boundary speed is %g m/s^2 x dt: "
+             "smaller elements have a shorter time step and move less in the same runtime)",
+             m->total_displacement, p->runtime - p->equilibration, CDEM_BOUNDARY_ACCEL);
+    const double need = cdem_estimate_equilibration_needed(m);
+    if (need <= 0.0)
+        return;
+    line(f, "equilibration needed",
+         "about %.0f s for an assembly %.0f average diameters tall (rule of thumb, "
+         "docs/performance.md, \"Estimates before a run\")",
+         need, cdem_estimate_height_diameters(m));
+    if (p->equilibration < need)
+        line(f, "warning",
+             "time.equilibration = %g s is shorter: the assembly will still be settling when "
+             "the boundaries start to move; use time.equilibration = %.0f or more (docs/guide.md, "
+             "section 4, \"Equilibration\")",
+             p->equilibration, need);
 }
 
 static void contact_line(FILE *f, const char *label, const cdem_params *p,
@@ -253,6 +323,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     } else {
         line(f, "sedimentation", "off");
     }
+
+    estimates_section(f, p, m, n_elements + n_wall_elements);
 
     if (fclose(f) != 0 || !buf) {
         free(buf);
