@@ -7,6 +7,7 @@
 
 #include <cmocka.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "colormap.h"
@@ -113,6 +114,33 @@ static void test_colormap_position(void **state) {
     assert_true(cdem_colormap_position(CDEM_COLORMAP_SIGNED, 1.0, -4.0, 1.0) == 0.625);
 }
 
+/* Issue 46: the colour bar's ticks were "%.4g", so a small range far from 0 labelled every
+ * tick alike. Labels of neighbouring ticks differ, keep 4 digits where those do (the
+ * committed pictures' "81.52", "40.76") and give "0" at 0. */
+static void test_colormap_tick_labels_differ(void **state) {
+    (void)state;
+    char l[5][CDEM_COLORMAP_TICK_CHARS];
+    const double ranges[][2] = {{1000.0001, 1000.0005}, {-81.52, 81.52}, {0.0, 2.0},
+                                {-3e-9, 3e-9},          {5e6, 5e6 + 1},  {-1e-300, 1e-300}};
+    for (size_t r = 0; r < sizeof ranges / sizeof ranges[0]; r++) {
+        cdem_colormap_tick_labels(ranges[r][0], ranges[r][1], 5, l);
+        printf("    %g .. %g: %s %s %s %s %s\n", ranges[r][0], ranges[r][1], l[0], l[1], l[2], l[3],
+               l[4]);
+        for (int k = 1; k < 5; k++)
+            assert_string_not_equal(l[k], l[k - 1]);
+    }
+    cdem_colormap_tick_labels(-81.52, 81.52, 5, l);
+    assert_string_equal(l[0], "-81.52");
+    assert_string_equal(l[1], "-40.76");
+    assert_string_equal(l[2], "0");
+    cdem_colormap_tick_labels(1000.0001, 1000.0005, 5, l);
+    assert_string_equal(l[0], "1000.0001");
+    assert_string_equal(l[4], "1000.0005");
+    /* one value: one label (the colour bar draws one tick) */
+    cdem_colormap_tick_labels(0.0, 0.0, 1, l);
+    assert_string_equal(l[0], "0");
+}
+
 static void test_colormap_parse_names(void **state) {
     (void)state;
     static const struct {
@@ -148,6 +176,7 @@ int main(void) {
         cmocka_unit_test(test_colormap_monotone_and_smooth),
         cmocka_unit_test(test_colormap_position),
         cmocka_unit_test(test_colormap_parse_names),
+        cmocka_unit_test(test_colormap_tick_labels_differ),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

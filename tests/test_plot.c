@@ -70,6 +70,77 @@ static void test_plot_layout_range_and_aspect(void **state) {
     assert_true(lay.xmin <= 0.3 && lay.xmax >= 9.2 && lay.ymin <= -0.4 && lay.ymax >= 3.7);
 }
 
+/* Issue 46: ten curves of `calibrate` (seeds x pressures) on an eight-colour cycle drew two
+ * pairs alike. Thirty series without colours of their own all differ in colour or dash; a
+ * series with its own colour keeps it, solid unless dashed. */
+static void test_plot_thirty_series_differ(void **state) {
+    (void)state;
+    cdem_plot_series s;
+    memset(&s, 0, sizeof s);
+    cdem_rgba c[30];
+    cdem_plot_dash d[30];
+    for (size_t i = 0; i < 30; i++)
+        cdem_plot_series_style(&s, i, &c[i], &d[i]);
+    for (size_t i = 0; i < 30; i++)
+        for (size_t j = 0; j < i; j++) {
+            const int same_colour = c[i].r == c[j].r && c[i].g == c[j].g && c[i].b == c[j].b;
+            if (same_colour && d[i] == d[j])
+                fail_msg("series %zu and %zu are drawn alike", j, i);
+        }
+    for (size_t i = 0; i < 10; i++) /* the first ten: ten colours, all solid */
+        assert_int_equal(d[i], CDEM_PLOT_SOLID);
+    s.colour = (cdem_rgba){0, 0, 0, 1};
+    cdem_plot_series_style(&s, 12, &c[0], &d[0]);
+    assert_true(c[0].r == 0 && c[0].a == 1 && d[0] == CDEM_PLOT_SOLID);
+    s.dashed = 1;
+    cdem_plot_series_style(&s, 0, &c[0], &d[0]);
+    assert_int_equal(d[0], CDEM_PLOT_DASHED);
+}
+
+/* Issue 46: the legend sat in the top-right corner over the high-pressure curves' peaks. It
+ * goes to the first corner that covers none of the points drawn; with every corner free it
+ * stays top right. */
+static void test_plot_legend_avoids_the_data(void **state) {
+    (void)state;
+    enum { N = 200, C = 5 };
+    double x[N], y[C][N];
+    cdem_plot_series s[C];
+    memset(s, 0, sizeof s);
+    for (int c = 0; c < C; c++) { /* stress-strain curves: rise, peak, stay high to the end */
+        for (int k = 0; k < N; k++) {
+            x[k] = 0.2 * k / (N - 1);
+            y[c][k] = (15.0 * c + 15.0) * (1.0 - exp(-x[k] / 0.03));
+        }
+        s[c] = (cdem_plot_series){.x = x, .y = y[c], .n = N, .line = 1, .label = "biaxial-x.h5"};
+    }
+    cdem_plot p = {.series = s, .n_series = C};
+    cdem_plot_layout lay;
+    cdem_error err;
+    assert_int_equal(cdem_plot_layout_compute(&p, 0, 0, 700, 560, &lay, &err), CDEM_OK);
+    double box[4];
+    assert_int_equal(cdem_plot_legend_box(&p, &lay, box), 1);
+    printf("    legend at %.0f, %.0f (%.0f x %.0f): %zu points under it\n", box[0], box[1], box[2],
+           box[3], cdem_plot_points_in_box(&p, &lay, box));
+    assert_true(box[2] > 0 && box[3] > 0);
+    assert_int_equal(cdem_plot_points_in_box(&p, &lay, box), 0);
+    /* where it was, top right, it covered the top curve */
+    double old[4] = {lay.plot_x + lay.plot_w - box[2] - 0.5 * lay.font_size,
+                     lay.plot_y + 0.5 * lay.font_size, box[2], box[3]};
+    assert_true(cdem_plot_points_in_box(&p, &lay, old) > 0);
+    /* inside the plot area */
+    assert_true(box[0] >= lay.plot_x && box[0] + box[2] <= lay.plot_x + lay.plot_w);
+    assert_true(box[1] >= lay.plot_y && box[1] + box[3] <= lay.plot_y + lay.plot_h);
+    /* one short curve in the lower left: the legend stays top right */
+    double sx[2] = {0, 1}, sy[2] = {0, 0.1};
+    cdem_plot_series one = {.x = sx, .y = sy, .n = 2, .line = 1, .label = "a"};
+    cdem_plot q = {.series = &one, .n_series = 1, .fix_y = 1, .ymin = 0, .ymax = 1};
+    assert_int_equal(cdem_plot_layout_compute(&q, 0, 0, 700, 560, &lay, &err), CDEM_OK);
+    assert_int_equal(cdem_plot_legend_box(&q, &lay, box), 1);
+    assert_true(box[0] > lay.plot_x + 0.5 * lay.plot_w && box[1] < lay.plot_y + 0.5 * lay.plot_h);
+    q.no_legend = 1;
+    assert_int_equal(cdem_plot_legend_box(&q, &lay, box), 0);
+}
+
 static void test_plot_errors_name_the_problem(void **state) {
     (void)state;
     cdem_plot p = {0};
@@ -233,6 +304,8 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plot_nice_ticks),
         cmocka_unit_test(test_plot_layout_range_and_aspect),
+        cmocka_unit_test(test_plot_thirty_series_differ),
+        cmocka_unit_test(test_plot_legend_avoids_the_data),
         cmocka_unit_test(test_plot_errors_name_the_problem),
         cmocka_unit_test(test_plot_column_extraction),
         cmocka_unit_test(test_plot_series_command_draws_the_line),

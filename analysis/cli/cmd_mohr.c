@@ -42,6 +42,7 @@ static cdem_status mohr_figure(const cdem_plot_args *a, const cdem_mohr_runs *d,
     size_t nt = d->n, runs = a->n_files;
     cdem_plot_series ser[CDEM_PLOT_MAX_FILES + 2];
     cdem_plot_series circ[CDEM_PLOT_MAX_FILES + 2];
+    char tags[CDEM_PLOT_MAX_FILES][32];
     memset(ser, 0, sizeof ser);
     memset(circ, 0, sizeof circ);
     for (size_t i = 0; i < runs; i++)
@@ -64,8 +65,11 @@ static cdem_status mohr_figure(const cdem_plot_args *a, const cdem_mohr_runs *d,
             y[k] = r * sin(t);
         }
         smax = fmax(smax, c + r);
-        circ[i] = (cdem_plot_series){
-            .x = x, .y = y, .n = MOHR_CIRCLE_POINTS, .line = 1, .colour = cdem_plot_palette(i)};
+        snprintf(tags[i], sizeof tags[i], "%.3g MPa", d->sigma3[i] / 1e6);
+        /* the circle of run i in its curve's style (no colour of its own), tagged with its
+         * confining pressure */
+        circ[i] =
+            (cdem_plot_series){.x = x, .y = y, .n = MOHR_CIRCLE_POINTS, .line = 1, .tag = tags[i]};
     }
     double *ex = pts + 2 * nc * MOHR_CIRCLE_POINTS, *ey = ex + 2;
     ex[0] = 0;
@@ -83,7 +87,7 @@ static cdem_status mohr_figure(const cdem_plot_args *a, const cdem_mohr_runs *d,
          .ylabel = "Differential stress (MPa)",
          .series = ser,
          .n_series = runs},
-        {.title = "Mohr circles at peak stress",
+        {.title = "Mohr circles at peak stress, tagged with sigma3",
          .xlabel = "Normal stress (MPa)",
          .ylabel = "Shear stress (MPa)",
          .series = circ,

@@ -140,12 +140,8 @@ static cdem_status plot_csv_figure(const char *const *files, const char *const *
     memset(panels, 0, sizeof panels);
     for (size_t j = 0; j < n_y && st == CDEM_OK; j++) {
         for (size_t f = 0; f < n_files; f++)
-            ser[j][f] = (cdem_plot_series){.x = xs[f],
-                                           .y = ys[f][j],
-                                           .n = tab[f].n_rows,
-                                           .label = names[f],
-                                           .colour = cdem_plot_palette(f),
-                                           .line = 1};
+            ser[j][f] = (cdem_plot_series){
+                .x = xs[f], .y = ys[f][j], .n = tab[f].n_rows, .label = names[f], .line = 1};
         panels[j] = (cdem_plot){.xlabel = label_of(xcol),
                                 .ylabel = label_of(ycols[j]),
                                 .series = ser[j],

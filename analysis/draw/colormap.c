@@ -5,6 +5,7 @@
 #include "colormap.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 typedef struct {
@@ -98,4 +99,23 @@ cdem_status cdem_colormap_parse(const char *name, cdem_colormap_kind *kind, cdem
 
 const char *cdem_colormap_name(cdem_colormap_kind kind) {
     return kind == CDEM_COLORMAP_SIGNED ? "signed" : "magnitude";
+}
+
+void cdem_colormap_tick_labels(double lo, double hi, int n,
+                               char (*labels)[CDEM_COLORMAP_TICK_CHARS]) {
+    if (n < 1)
+        return;
+    for (int digits = 4; digits <= 17; digits++) {
+        for (int k = 0; k < n; k++) {
+            double v = n > 1 ? lo + (double)k / (n - 1) * (hi - lo) : lo;
+            if (fabs(v) < 1e-12 * fmax(fabs(lo), fabs(hi)))
+                v = 0.0;
+            snprintf(labels[k], CDEM_COLORMAP_TICK_CHARS, "%.*g", digits, v);
+        }
+        int distinct = 1;
+        for (int k = 1; k < n && distinct; k++)
+            distinct = strcmp(labels[k], labels[k - 1]) != 0;
+        if (distinct || !(hi > lo))
+            return;
+    }
 }

@@ -38,6 +38,14 @@ void cdem_colormap_limits(cdem_colormap_kind kind, double vmin, double vmax, dou
  * range maps every value to 0 (magnitude) or 0.5 (signed). NaN v gives NaN. */
 double cdem_colormap_position(cdem_colormap_kind kind, double v, double vmin, double vmax);
 
+/* Labels of the colour bar's n >= 2 evenly spaced ticks from lo to hi (lo <= hi, finite):
+ * with the fewest significant digits, 4 to 17, that make every two neighbouring labels
+ * differ (issue 46: "%.4g" labelled a range of 1000.0001..1000.0005 m "1000" five times); a
+ * value within 1e-12 of the range of 0 is "0". lo == hi gives the one value n times. */
+#define CDEM_COLORMAP_TICK_CHARS 32
+void cdem_colormap_tick_labels(double lo, double hi, int n,
+                               char (*labels)[CDEM_COLORMAP_TICK_CHARS]);
+
 /* Parses "magnitude" / "bgr" or "signed" / "bwr" (CDEM_ERR_RANGE lists the valid names). */
 cdem_status cdem_colormap_parse(const char *name, cdem_colormap_kind *kind, cdem_error *err);
 

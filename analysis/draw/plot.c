@@ -6,17 +6,34 @@
 #include "outfile.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
-static const cdem_rgba plot_palette[] = {
+/* Ten colours (matplotlib's tab10): ten series without colours of their own differ by
+ * colour, more by dash pattern too (cdem_plot_series_style; issue 46: ten biaxial curves of
+ * `calibrate` on an eight-colour cycle drew two pairs alike). */
+static const cdem_rgba plot_palette[CDEM_PLOT_PALETTE_N] = {
     {0.12, 0.47, 0.71, 1}, {0.84, 0.15, 0.16, 1}, {0.17, 0.63, 0.17, 1}, {1.00, 0.50, 0.05, 1},
     {0.58, 0.40, 0.74, 1}, {0.55, 0.34, 0.29, 1}, {0.89, 0.47, 0.76, 1}, {0.50, 0.50, 0.50, 1},
+    {0.74, 0.74, 0.13, 1}, {0.09, 0.75, 0.81, 1},
 };
-#define PALETTE_N (sizeof plot_palette / sizeof plot_palette[0])
 
 cdem_rgba cdem_plot_palette(size_t i) {
-    return plot_palette[i % PALETTE_N];
+    return plot_palette[i % CDEM_PLOT_PALETTE_N];
+}
+
+void cdem_plot_series_style(const cdem_plot_series *s, size_t i, cdem_rgba *colour,
+                            cdem_plot_dash *dash) {
+    const int own = s->colour.a > 0;
+    *colour = own ? s->colour : cdem_plot_palette(i);
+    if (s->dashed)
+        *dash = CDEM_PLOT_DASHED;
+    else if (own)
+        *dash = CDEM_PLOT_SOLID;
+    else
+        *dash = (cdem_plot_dash)((i / CDEM_PLOT_PALETTE_N) % 3);
 }
 
 void cdem_plot_nice_ticks(double lo, double hi, int target, double *first, double *step) {
@@ -152,20 +169,28 @@ static void text_at(cairo_t *cr, const char *s, double x, double y, double ax, d
     cairo_show_text(cr, s);
 }
 
-static cdem_rgba series_colour(const cdem_plot_series *s, size_t i) {
-    return s->colour.a > 0 ? s->colour : cdem_plot_palette(i);
+/* Sets the dash pattern of a line of width lw. */
+static void set_dash(cairo_t *cr, cdem_plot_dash dash, double lw) {
+    if (dash == CDEM_PLOT_DASHED) {
+        double d[2] = {4 * lw, 3 * lw};
+        cairo_set_dash(cr, d, 2, 0);
+    } else if (dash == CDEM_PLOT_DOTTED) {
+        double d[2] = {1.2 * lw, 2.2 * lw};
+        cairo_set_dash(cr, d, 2, 0);
+    } else {
+        cairo_set_dash(cr, NULL, 0, 0);
+    }
 }
 
 static void draw_series(cairo_t *cr, const cdem_plot_layout *lay, const cdem_plot_series *s,
                         size_t i) {
-    cdem_rgba c = series_colour(s, i);
+    cdem_rgba c;
+    cdem_plot_dash dash;
+    cdem_plot_series_style(s, i, &c, &dash);
     set_rgba(cr, &c);
     double lw = fmax(1.0, lay->font_size / 7.0);
     cairo_set_line_width(cr, lw);
-    if (s->dashed) {
-        double d[2] = {4 * lw, 3 * lw};
-        cairo_set_dash(cr, d, 2, 0);
-    }
+    set_dash(cr, dash, lw);
     if (s->line || !s->markers) {
         int open = 0;
         for (size_t k = 0; k < s->n; k++) {
@@ -196,7 +221,88 @@ static void draw_series(cairo_t *cr, const cdem_plot_layout *lay, const cdem_plo
         }
 }
 
-static void draw_legend(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout *lay) {
+static int boxes_overlap(const double a[4], const double b[4]) {
+    return a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
+}
+
+static int inside(const double box[4], double x, double y) {
+    return x >= box[0] && x <= box[0] + box[2] && y >= box[1] && y <= box[1] + box[3];
+}
+
+size_t cdem_plot_points_in_box(const cdem_plot *p, const cdem_plot_layout *lay,
+                               const double box[4]) {
+    size_t count = 0;
+    for (size_t i = 0; i < p->n_series; i++) {
+        const cdem_plot_series *s = &p->series[i];
+        const int line = s->line || !s->markers;
+        double px = 0, py = 0;
+        int open = 0;
+        for (size_t k = 0; k < s->n; k++) {
+            if (!isfinite(s->x[k]) || !isfinite(s->y[k])) {
+                open = 0;
+                continue;
+            }
+            double dx, dy;
+            cdem_plot_to_device(lay, s->x[k], s->y[k], &dx, &dy);
+            count += inside(box, dx, dy);
+            if (line && open) { /* every 2 px along the segment */
+                double len = hypot(dx - px, dy - py);
+                int m = len < 1e6 ? (int)(len / 2.0) : 500000;
+                for (int j = 1; j < m; j++) {
+                    double t = (double)j / m;
+                    count += inside(box, px + t * (dx - px), py + t * (dy - py));
+                }
+            }
+            px = dx;
+            py = dy;
+            open = 1;
+        }
+    }
+    return count;
+}
+
+/* Device box of the tag of series i: centred above its highest point or below it (inside a
+ * Mohr circle), whichever covers fewer of the points drawn (above when even), and within
+ * the plot area. 0 when the series has no tag or no finite point. */
+static int tag_box(cairo_t *cr, const cdem_plot *p, size_t i, const cdem_plot_layout *lay,
+                   double box[4]) {
+    const cdem_plot_series *s = &p->series[i];
+    if (!s->tag || !s->tag[0])
+        return 0;
+    size_t top = s->n;
+    for (size_t k = 0; k < s->n; k++)
+        if (isfinite(s->x[k]) && isfinite(s->y[k]) && (top == s->n || s->y[k] > s->y[top]))
+            top = k;
+    if (top == s->n)
+        return 0;
+    double dx, dy, fs = lay->font_size;
+    cdem_plot_to_device(lay, s->x[top], s->y[top], &dx, &dy);
+    cairo_text_extents_t te;
+    cairo_text_extents(cr, s->tag, &te);
+    double w = te.x_advance + 0.4 * fs, h = 1.2 * fs;
+    double x = fmin(fmax(dx - 0.5 * w, lay->plot_x), lay->plot_x + lay->plot_w - w);
+    double above[4] = {x, fmax(dy - 0.2 * fs - h, lay->plot_y), w, h};
+    double below[4] = {x, fmin(dy + 0.2 * fs, lay->plot_y + lay->plot_h - h), w, h};
+    const int up = cdem_plot_points_in_box(p, lay, above) <= cdem_plot_points_in_box(p, lay, below);
+    memcpy(box, up ? above : below, 4 * sizeof *box);
+    return 1;
+}
+
+/* The tags drawn: drawn[i] = 1 with its box when series i's tag covers no earlier one. */
+static void place_tags(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout *lay,
+                       double (*boxes)[4], int *drawn) {
+    for (size_t i = 0; i < p->n_series; i++) {
+        drawn[i] = tag_box(cr, p, i, lay, boxes[i]);
+        for (size_t j = 0; drawn[i] && j < i; j++)
+            if (drawn[j] && boxes_overlap(boxes[i], boxes[j]))
+                drawn[i] = 0;
+    }
+}
+
+/* The legend's box (see cdem_plot_legend_box), with cr's font for the text widths; *rows
+ * gets the number of labelled series. */
+static int legend_box_cr(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout *lay,
+                         double box[4], size_t *rows) {
     double fs = lay->font_size, wmax = 0;
     size_t n = 0;
     for (size_t i = 0; i < p->n_series; i++) {
@@ -208,12 +314,79 @@ static void draw_legend(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout 
         wmax = fmax(wmax, te.x_advance);
         n++;
     }
+    *rows = n;
     if (!n || p->no_legend)
+        return 0;
+    double bw = wmax + 4.0 * fs, bh = n * 1.4 * fs + 0.6 * fs;
+    double left = lay->plot_x + 0.5 * fs, right = lay->plot_x + lay->plot_w - bw - 0.5 * fs;
+    double top = lay->plot_y + 0.5 * fs, bottom = lay->plot_y + lay->plot_h - bh - 0.5 * fs;
+    const double corner[4][2] = {{right, top}, {left, top}, {right, bottom}, {left, bottom}};
+    double(*tags)[4] = p->n_series ? malloc(p->n_series * sizeof *tags) : NULL;
+    int *drawn = p->n_series ? malloc(p->n_series * sizeof *drawn) : NULL;
+    if (tags && drawn)
+        place_tags(cr, p, lay, tags, drawn);
+    size_t best_count = SIZE_MAX;
+    for (int c = 0; c < 4; c++) {
+        double b[4] = {corner[c][0], corner[c][1], bw, bh};
+        size_t count = cdem_plot_points_in_box(p, lay, b);
+        for (size_t i = 0; tags && drawn && i < p->n_series; i++)
+            if (drawn[i] && boxes_overlap(b, tags[i]))
+                count += 1000; /* a tag weighs as much as a stretch of line */
+        if (count < best_count) {
+            best_count = count;
+            memcpy(box, b, sizeof b);
+        }
+    }
+    free(tags);
+    free(drawn);
+    return 1;
+}
+
+int cdem_plot_legend_box(const cdem_plot *p, const cdem_plot_layout *lay, double box[4]) {
+    cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
+    cairo_t *cr = cairo_create(surf);
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_font_size(cr, lay->font_size);
+    size_t rows;
+    int has = legend_box_cr(cr, p, lay, box, &rows);
+    cairo_destroy(cr);
+    cairo_surface_destroy(surf);
+    return has;
+}
+
+static void draw_tags(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout *lay) {
+    if (!p->n_series)
         return;
-    double row = 1.4 * fs, bw = wmax + 4.0 * fs, bh = n * row + 0.6 * fs;
-    double bx = lay->plot_x + lay->plot_w - bw - 0.5 * fs, by = lay->plot_y + 0.5 * fs;
+    double(*boxes)[4] = malloc(p->n_series * sizeof *boxes);
+    int *drawn = malloc(p->n_series * sizeof *drawn);
+    if (boxes && drawn) {
+        place_tags(cr, p, lay, boxes, drawn);
+        for (size_t i = 0; i < p->n_series; i++) {
+            if (!drawn[i])
+                continue;
+            cdem_rgba c;
+            cdem_plot_dash dash;
+            cdem_plot_series_style(&p->series[i], i, &c, &dash);
+            cairo_set_source_rgba(cr, 1, 1, 1, 0.85); /* lines crossing it stay behind */
+            cairo_rectangle(cr, boxes[i][0], boxes[i][1], boxes[i][2], boxes[i][3]);
+            cairo_fill(cr);
+            set_rgba(cr, &c);
+            text_at(cr, p->series[i].tag, boxes[i][0] + 0.5 * boxes[i][2],
+                    boxes[i][1] + 0.5 * boxes[i][3], 0.5, 0.5);
+        }
+    }
+    free(boxes);
+    free(drawn);
+}
+
+static void draw_legend(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout *lay) {
+    double fs = lay->font_size, box[4];
+    size_t n;
+    if (!legend_box_cr(cr, p, lay, box, &n))
+        return;
+    double row = 1.4 * fs, bx = box[0], by = box[1];
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
-    cairo_rectangle(cr, bx, by, bw, bh);
+    cairo_rectangle(cr, bx, by, box[2], box[3]);
     cairo_fill_preserve(cr);
     cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
     cairo_set_line_width(cr, 0.8);
@@ -224,13 +397,14 @@ static void draw_legend(cairo_t *cr, const cdem_plot *p, const cdem_plot_layout 
         if (!s->label || !s->label[0])
             continue;
         double cy = by + 0.3 * fs + (r + 0.5) * row;
-        cdem_rgba c = series_colour(s, i);
+        cdem_rgba c;
+        cdem_plot_dash dash;
+        cdem_plot_series_style(s, i, &c, &dash);
         set_rgba(cr, &c);
-        cairo_set_line_width(cr, fmax(1.0, fs / 7.0));
+        double lw = fmax(1.0, fs / 7.0);
+        cairo_set_line_width(cr, lw);
         if (s->line || !s->markers) {
-            double lw = fmax(1.0, fs / 7.0), d[2] = {4 * lw, 3 * lw};
-            if (s->dashed)
-                cairo_set_dash(cr, d, 2, 0);
+            set_dash(cr, dash, lw);
             cairo_move_to(cr, bx + 0.5 * fs, cy);
             cairo_line_to(cr, bx + 2.5 * fs, cy);
             cairo_stroke(cr);
@@ -293,6 +467,7 @@ cdem_status cdem_plot_draw(cairo_t *cr, const cdem_plot *p, double x, double y, 
     cairo_clip(cr);
     for (size_t i = 0; i < p->n_series; i++)
         draw_series(cr, &lay, &p->series[i], i);
+    draw_tags(cr, p, &lay);
     cairo_restore(cr);
     /* frame, labels, title, legend */
     cairo_set_source_rgb(cr, 0, 0, 0);

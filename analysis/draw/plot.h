@@ -2,7 +2,10 @@
  *
  * A figure is one or more panels side by side; a panel (cdem_plot) has a title, axis
  * labels, axes with "nice" ticks (1, 2, 5 x 10^k) and several series drawn as lines
- * and/or markers, with a legend in the top-right corner of the plot area. Axis ranges come
+ * and/or markers, with a legend in the corner of the plot area that covers the fewest of
+ * the drawn points (top right when several are free; cdem_plot_legend_box). Series without
+ * a colour of their own differ by colour and, past the palette's ten colours, by dash
+ * pattern (cdem_plot_series_style). Axis ranges come
  * from the data (extended to whole ticks) unless fixed; equal_aspect makes one unit of x as
  * long as one unit of y (Mohr circles). The margins around the plot area depend only on
  * the font size, never on the text, so cdem_plot_layout_compute tells exactly where a data
@@ -29,6 +32,9 @@ typedef struct {
     int line;          /* 1: join the points with a line */
     int markers;       /* 1: draw a small disc at every point */
     int dashed;        /* 1: dashed line */
+    const char *tag;   /* text written in the line's colour above its highest point (a Mohr
+                          circle's confining pressure); NULL or "" = none. A tag that would
+                          cover an earlier one is left out. */
 } cdem_plot_series;
 
 /* One panel. Zero-initialise, then set what applies. */
@@ -76,7 +82,31 @@ cdem_status cdem_plot_draw(cairo_t *cr, const cdem_plot *p, double x, double y, 
 cdem_status cdem_plot_to_file(const char *path, const cdem_plot *panels, size_t n_panels, int width,
                               int height, cdem_error *err);
 
-/* The i-th colour of the plot palette (cycles). */
+/* Colours in the plot palette. */
+#define CDEM_PLOT_PALETTE_N 10
+
+/* The i-th colour of the plot palette (cycles after CDEM_PLOT_PALETTE_N). */
 cdem_rgba cdem_plot_palette(size_t i);
+
+/* Line dash patterns of the series. */
+typedef enum { CDEM_PLOT_SOLID = 0, CDEM_PLOT_DASHED = 1, CDEM_PLOT_DOTTED = 2 } cdem_plot_dash;
+
+/* How series s, the i-th of its panel, is drawn: its own colour when it has one (alpha >
+ * 0), else the palette's i-th; dashed when s->dashed, else, for a palette colour, solid for
+ * the first CDEM_PLOT_PALETTE_N series, dashed for the next ten and dotted for the ten after
+ * (so 30 series without colours of their own all differ), then again. */
+void cdem_plot_series_style(const cdem_plot_series *s, size_t i, cdem_rgba *colour,
+                            cdem_plot_dash *dash);
+
+/* The legend box of panel p in layout lay (device x, y, w, h in box): the corner of the plot
+ * area (top right, top left, bottom right, bottom left: the first of those with the fewest)
+ * whose box covers the fewest of the points drawn (every data point and every 2 px along the
+ * lines) and of the tags. Returns 0 (box untouched) when the panel has no legend. */
+int cdem_plot_legend_box(const cdem_plot *p, const cdem_plot_layout *lay, double box[4]);
+
+/* How many of the points drawn in panel p (every data point and every 2 px along its lines)
+ * fall inside the device box (x, y, w, h). */
+size_t cdem_plot_points_in_box(const cdem_plot *p, const cdem_plot_layout *lay,
+                               const double box[4]);
 
 #endif

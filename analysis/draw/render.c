@@ -593,20 +593,19 @@ static void draw_colour_bar(cairo_t *cr, const cdem_render_layout *lay, const cd
     cairo_stroke(cr);
     double lo, hi;
     cdem_colormap_limits(sc->kind, sc->vmin, sc->vmax, &lo, &hi);
-    const int ticks = 5;
+    /* five ticks with labels that differ; one, in the middle, for a range of one value */
+    const int ticks = hi > lo ? 5 : 1;
+    char labels[5][CDEM_COLORMAP_TICK_CHARS];
+    cdem_colormap_tick_labels(lo, hi, ticks, labels);
     double text_w = 0;
     for (int k = 0; k < ticks; k++) {
-        double f = (double)k / (ticks - 1);
-        double v = lo + f * (hi - lo);
-        if (fabs(v) < 1e-12 * fmax(fabs(lo), fabs(hi)))
-            v = 0.0;
+        double f = ticks > 1 ? (double)k / (ticks - 1) : 0.5;
         double ty = y + h - f * h;
         cairo_new_path(cr);
         cairo_move_to(cr, x + w, ty);
         cairo_line_to(cr, x + w + 0.4 * fs, ty);
         cairo_stroke(cr);
-        char text[64];
-        snprintf(text, sizeof text, "%.4g", v);
+        const char *text = labels[k];
         cairo_text_extents_t te;
         cairo_text_extents(cr, text, &te);
         text_w = fmax(text_w, te.x_advance);
