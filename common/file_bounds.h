@@ -22,12 +22,10 @@
  * the paper's radii 0.05, 0.075, 0.1, 0.125; solver/base/model.c). */
 #define CDEM_LARGEST_RADIUS_UNITS 0.125
 
-/* What the parameters may ask of the length bound: the model's size (width, and height x
- * wall_height_multiplier, times unit_scaling) at most 0.4 of it, and the boundaries'
- * displacement over the run at most 0.4 of it, which leaves room for the elements outside
- * the box (the walls, a fault's ramps, repose's base of twice the width: 0.8 and a radius)
- * and growth strata. */
-#define CDEM_MODEL_MAX_SIZE         (0.4 * CDEM_FILE_MAX_LENGTH)
-#define CDEM_MODEL_MAX_DISPLACEMENT (0.4 * CDEM_FILE_MAX_LENGTH)
+/* What the parameters alone may ask of the length bound: the box itself (width, and height x
+ * wall_height_multiplier, times unit_scaling) within it. cdem-run's extent rule
+ * (solver/run/run_validate.c) adds what only the model knows: the mode's base beyond the
+ * walls (repose), the boundaries' displacement over the run and a largest radius. */
+#define CDEM_MODEL_MAX_SIZE CDEM_FILE_MAX_LENGTH
 
 #endif

@@ -1369,15 +1369,13 @@ static void file_bound_rules(const cdem_params *p, cdem_rule_log *log) {
                      p->wall_height_multiplier);
         cdem_params_format_number(size, v1, sizeof v1);
         cdem_params_format_number(CDEM_MODEL_MAX_SIZE, v2, sizeof v2);
-        cdem_params_format_number(CDEM_FILE_MAX_LENGTH, v3, sizeof v3);
-        cdem_params_format_number(CDEM_MODEL_MAX_SIZE / model_size_units(p), v4, sizeof v4);
+        cdem_params_format_number(0.9 * CDEM_MODEL_MAX_SIZE / model_size_units(p), v4, sizeof v4);
         cdem_rule_add(log,
                       "%s at unit_scaling = %s m: the model would be %s m across, more than "
-                      "%s m, 0.4 of the %s m a run file holds for positions (the rest is room "
-                      "for the boundaries' displacement, the walls, a fault's ramps and growth "
-                      "strata; docs/format.md, \"Physical bounds\"): set [assembly] "
-                      "unit_scaling <= %s m at this size, or make the assembly smaller",
-                      what, us, v1, v2, v3, v4);
+                      "the %s m a run file holds for positions (docs/format.md, \"Physical "
+                      "bounds\"): set [assembly] unit_scaling <= %s m at this size (room for "
+                      "the boundaries' displacement), or make the assembly smaller",
+                      what, us, v1, v2, v4);
     }
 }
 

@@ -156,9 +156,8 @@ static void test_file_bound_messages_and_their_advice(void **state) {
                         "above the 100000 m a run file holds");
     assert_has(err.msg, "set [assembly] unit_scaling <= 800000 m at this radius_scale, or "
                         "radius_scale <= 0.8 at this unit_scaling");
-    assert_has(err.msg, "width = 10 units at unit_scaling = 1000000 m: the model would be 1e+07 "
-                        "m across, more than 4000000 m, 0.4 of the 1e+07 m a run file holds");
-    assert_has(err.msg, "set [assembly] unit_scaling <= 400000 m at this size");
+    assert_has(err.msg, "at unit_scaling = 1000000 m: the model's elements would reach");
+    assert_has(err.msg, "beyond the 1e+07 m a run file holds for positions");
     const char *const us_ok[] = {"assembly.unit_scaling=400000", NULL};
     assert_int_equal(check_overrides(us_ok, &err), CDEM_OK);
 
@@ -180,16 +179,24 @@ static void test_file_bound_messages_and_their_advice(void **state) {
     assert_int_equal(check_overrides(rs100, &err), CDEM_ERR_CONFLICT);
     assert_has(err.msg, ">= 200 units: enlarge it or make the elements smaller");
 
-    const char *const far[] = {"assembly.unit_scaling=10000", "time.runtime=1000000", NULL};
+    const char *const far[] = {"assembly.unit_scaling=100000", "time.runtime=1000000", NULL};
     assert_int_equal(check_overrides(far, &err), CDEM_ERR_CONFLICT);
-    assert_has(err.msg, "runtime = 1000000 s at unit_scaling = 10000 m: the boundaries would move");
+    assert_has(err.msg, "at unit_scaling = 100000 m: the model's elements would reach");
     const char *tail = strstr(err.msg, "set [time] runtime <= ");
     assert_non_null(tail);
     char runtime[128];
     snprintf(runtime, sizeof runtime, "time.runtime=%ld", strtol(tail + 22, NULL, 10));
-    const char *const near[] = {"assembly.unit_scaling=10000", runtime, NULL};
+    const char *const near[] = {"assembly.unit_scaling=100000", runtime, NULL};
     if (check_overrides(near, &err) != CDEM_OK)
         fail_msg("%s, the advice, is refused: %s", runtime, err.msg);
+    /* the issue's wide model (issue 46, item 7: 7500 units builds): within the file's bound */
+    const char *const wide[] = {"assembly.width=8000", NULL};
+    if (check_overrides(wide, &err) != CDEM_OK)
+        fail_msg("width 8000 is refused: %s", err.msg);
+    /* a repose model's base runs on past its walls by its width on each side: its extent too */
+    const char *const repose[] = {"boundary.mode=repose", "assembly.width=5000", NULL};
+    assert_int_equal(check_overrides(repose, &err), CDEM_ERR_CONFLICT);
+    assert_has(err.msg, "the model's elements would reach");
 }
 
 /* Item 2: a run whose increment 0 the writer refuses (here the checks are bypassed: the

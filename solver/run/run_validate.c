@@ -16,33 +16,52 @@
 #include <string.h>
 #include <unistd.h>
 
-/* The boundaries' displacement over the run against a run file's bound (file_bounds.h; the
- * model's size and radius are the table's rules, common/params.c): the net displacement of
- * every increment, and the positions of what moves, stay within it. */
-static void displacement_rule(const cdem_params *p, cdem_rule_log *log) {
+/* Where the model's elements can be, against a run file's bound on positions
+ * (file_bounds.h; the box alone and the radius are the table's rules, common/params.c): the
+ * base from -beyond_left W to (1 + beyond_right) W (the mode's derive: repose's runs on past
+ * its walls), the walls up to H x wall_height_multiplier, the boundaries' displacement over
+ * the run (a wall moving out, a fault's ramps below the base) and twice the largest radius
+ * either way. The advice scales what moves: the runtime after equilibration, or the model
+ * (everything grows with unit_scaling). */
+static void extent_rule(const cdem_params *p, cdem_rule_log *log) {
     cdem_model m;
     cdem_error err;
     if (cdem_bc_derive_model(p, &m, &err) != CDEM_OK)
         return; /* the mode's rules, or cdem-run's derivation, say what is wrong */
-    if (!(m.total_displacement > CDEM_MODEL_MAX_DISPLACEMENT))
+    const double W = m.width_m, H = m.height_m * p->wall_height_multiplier;
+    const double D = m.total_displacement, r2 = 2.0 * m.max_radius;
+    const double box =
+        fmax(fmax(m.mode.base_beyond_left * W, (1.0 + m.mode.base_beyond_right) * W), H);
+    const double extent = box + D + r2;
+    if (extent <= CDEM_FILE_MAX_LENGTH)
         return;
     char v1[64], v2[64], v3[64], v4[64], v5[64];
     cdem_params_format_number(p->runtime, v1, sizeof v1);
     cdem_params_format_number(p->unit_scaling, v2, sizeof v2);
-    cdem_params_format_number(CDEM_MODEL_MAX_DISPLACEMENT, v3, sizeof v3);
-    cdem_params_format_number(CDEM_FILE_MAX_LENGTH, v4, sizeof v4);
-    /* the displacement grows with the steps after equilibration */
-    const double runtime_max = p->equilibration + (p->runtime - p->equilibration) *
-                                                      CDEM_MODEL_MAX_DISPLACEMENT /
-                                                      m.total_displacement;
-    cdem_params_format_number(floor(runtime_max - m.dt), v5, sizeof v5); /* a step for rounding */
+    cdem_params_format_number(CDEM_FILE_MAX_LENGTH, v3, sizeof v3);
+    char advice[256];
+    const double room = CDEM_FILE_MAX_LENGTH - box - r2; /* what the displacement may take */
+    if (room > 0.0 && D > 0.0) {
+        /* the displacement grows with the steps after equilibration; a step for rounding */
+        const double runtime_max = p->equilibration + (p->runtime - p->equilibration) * room / D;
+        cdem_params_format_number(floor(runtime_max - m.dt), v4, sizeof v4);
+        cdem_params_format_number(floor(p->unit_scaling * CDEM_FILE_MAX_LENGTH / extent), v5,
+                                  sizeof v5);
+        snprintf(advice, sizeof advice,
+                 "set [time] runtime <= %s s, or a smaller [assembly] unit_scaling (<= %s m)", v4,
+                 v5);
+    } else {
+        cdem_params_format_number(floor(0.9 * p->unit_scaling * CDEM_FILE_MAX_LENGTH / extent), v5,
+                                  sizeof v5);
+        snprintf(advice, sizeof advice,
+                 "set [assembly] unit_scaling <= %s m, or a smaller assembly", v5);
+    }
     cdem_rule_add(log,
-                  "runtime = %s s at unit_scaling = %s m: the boundaries would move %.4g m "
-                  "(%.4g m/s, the boundary speed of this model), more than %s m, 0.4 of the %s m "
-                  "a run file holds for the net displacement and positions (docs/format.md, "
-                  "\"Physical bounds\"): set [time] runtime <= %s s, or a smaller "
-                  "[assembly] unit_scaling",
-                  v1, v2, m.total_displacement, m.boundary_speed, v3, v4, v5);
+                  "runtime = %s s at unit_scaling = %s m: the model's elements would reach %.4g m "
+                  "from its origin (the box and base %.4g m, the boundaries' displacement %.4g m "
+                  "at %.4g m/s, two radii), beyond the %s m a run file holds for positions "
+                  "(docs/format.md, \"Physical bounds\"): %s",
+                  v1, v2, extent, box, D, m.boundary_speed, v3, advice);
 }
 
 /* The rules of the solver's modules, after the table's. */
@@ -50,7 +69,7 @@ static void solver_rules(const cdem_params *p, cdem_rule_log *log) {
     cdem_bc_rules(p, log);
     cdem_sediment_rules(p, log);
     cdem_processes_rules(p, log);
-    displacement_rule(p, log);
+    extent_rule(p, log);
 }
 
 cdem_status cdem_run_validate(const cdem_params *p, cdem_error *err) {
