@@ -19,7 +19,7 @@
 #                slowest straight run), beyond which the step is a hang.
 #
 # For each model the run is first made straight (its file is the reference, its wall time T
-# measured). Kill K runs model K mod 3 and SIGKILLs it after a delay of T x (0.01 .. 1.0),
+# measured). Kill K runs model K mod 3 and SIGKILLs it after a delay of T x (0.01 .. 0.95),
 # drawn from the seed and K. Then, each step under a time limit (a hang: 20 T + 60 s):
 #  (a) the file opens: `cdem-strain info FILE` exits 0 and says "interrupted (no writer holds
 #      it)" (a run that finished before the kill: "completed"), with no "damaged:" line;
@@ -121,12 +121,16 @@ done
 LIMIT=${LIMIT_SET:-$(awk -v t="$TMAX" 'BEGIN { printf "%d", 20 * t + 60 }')}
 echo "kill_campaign: time limit per step $LIMIT s (a step that takes longer is a hang)"
 
-# The kill moment of kill K as a fraction 0.01 .. 1.0 of the run time: an LCG (glibc's
-# constants) seeded from SEED and K, five rounds, in the shell's 64-bit arithmetic.
+# The kill moment of kill K as a fraction 0.01 .. 0.95 of the run time: a 32-bit integer hash
+# (two multiply-xorshift rounds) of SEED and K, in the shell's 64-bit arithmetic (the
+# products stay below 2^59). The runs killed late may complete first on a less loaded
+# machine; they are counted apart.
 fraction() {
-    x=$(( (SEED * 2654435761 + $1 * 40503 + 12345) % 2147483648 ))
-    for _ in 1 2 3 4 5; do x=$(( (1103515245 * x + 12345) % 2147483648 )); done
-    awk -v x="$x" 'BEGIN { printf "%.4f", 0.01 + 0.99 * x / 2147483648 }'
+    x=$(( (SEED * 1000003 + $1) & 4294967295 ))
+    x=$(( x ^ (x >> 16) )); x=$(( (x * 73244475) & 4294967295 ))
+    x=$(( x ^ (x >> 16) )); x=$(( (x * 73244475) & 4294967295 ))
+    x=$(( x ^ (x >> 16) ))
+    awk -v x="$x" 'BEGIN { printf "%.4f", 0.01 + 0.94 * x / 4294967296 }'
 }
 
 kills=0 files=0 nofile=0 opened=0 inc_total=0 inc_same=0 finished=0
@@ -282,6 +286,8 @@ if [ "$failures" -gt 0 ]; then
     echo "kill_campaign: $failures FAILED (files, logs and commands kept in $DIR):$FAILED"
     exit 1
 fi
-echo "kill_campaign: all held"
+echo "kill_campaign: all held: $kills kills, $opened/$files files open ($nofile before the file" \
+    "existed), $inc_same/$inc_total committed increments identical, $res_same/$res_possible" \
+    "resumes identical, $refusals refused (no checkpoint yet), $crashes crashes, $hangs hangs"
 if [ "$KEEP" -eq 0 ]; then cd / && rm -rf "$DIR"; fi
 exit 0
