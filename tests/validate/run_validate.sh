@@ -21,8 +21,8 @@
 #  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c), and the crash
 #     states of every write of a short run, every tenth of them resumed to the uninterrupted
 #     run's file (tests/test_crash.c; CDEM_CRASH_RESUME=all resumes every one, about 30 min).
-#  8a. the kill campaign of issue 46 (tests/validate/kill_campaign.sh, KILLS=20 here, about
-#     3 minutes; docs/reliability.md, "Audit re-run"): three small models (plain, salt and
+#  8a. the kill campaign of issue 46 (tests/validate/kill_campaign.sh, KILLS=20 here, 1-2
+#     minutes; docs/reliability.md, "Audit re-run"): three small models (plain, salt and
 #     detachment, two boundary actors) SIGKILLed at seeded moments; every file left opens, its
 #     committed increments read back identical to the straight run's, and --resume ends with
 #     the straight run's file or refuses for want of a checkpoint; no crash, no hang.
