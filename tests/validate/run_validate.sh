@@ -21,6 +21,11 @@
 #  8. kill survival: 200 SIGKILLs of a short run (tests/test_kill_survival.c), and the crash
 #     states of every write of a short run, every tenth of them resumed to the uninterrupted
 #     run's file (tests/test_crash.c; CDEM_CRASH_RESUME=all resumes every one, about 30 min).
+#  8a. the kill campaign of issue 46 (tests/validate/kill_campaign.sh, KILLS=20 here, 1-2
+#     minutes; docs/reliability.md, "Audit re-run"): three small models (plain, salt and
+#     detachment, two boundary actors) SIGKILLed at seeded moments; every file left opens, its
+#     committed increments read back identical to the straight run's, and --resume ends with
+#     the straight run's file or refuses for want of a checkpoint; no crash, no hang.
 #  8b. ParaView (Debian's, headless under xvfb-run) opens the XDMF sidecars of the default
 #     run, of the stress run, of a compute --format h5 file and an --xdmf2 sidecar, reads
 #     every time step and array, compares them with the HDF5 files and renders a picture
@@ -184,6 +189,10 @@ fi
 #    left behind opens and every increment it lists loads (docs/reliability.md).
 check kill-survival env CDEM_KILLS=200 CDEM_BUILD="$BUILD" CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_kill_survival"
+# 8a. the kill campaign (issue 46): N kills over three models, each file opened, compared
+#     increment by increment with the straight run and resumed (docs/reliability.md).
+check kill-campaign sh tests/validate/kill_campaign.sh -n "${KILLS:-20}" --build "$BUILD" \
+    --dir "$TMP/kill-campaign"
 check crash-states env CDEM_CRASH_RESUME=${CDEM_CRASH_RESUME:-10} CDEM_TEST_TMP="$TMP" \
     "$BUILD/tests/test_crash"
 check examples-quick make -j2 -C examples quick BUILD="$(pwd)/$BUILD" EXAMPLES_OUT="$TMP/examples"
