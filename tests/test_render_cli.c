@@ -81,6 +81,17 @@ static void read_head(const char *path, char *buf, size_t n) {
     assert_true(got > 0);
 }
 
+/* Width and height of a PNG (big-endian at bytes 16 and 20 of the IHDR chunk). */
+static void png_size(const char *path, unsigned *w, unsigned *h) {
+    unsigned char ihdr[24];
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
+    fclose(f);
+    *w = (unsigned)ihdr[16] << 24 | (unsigned)ihdr[17] << 16 | (unsigned)ihdr[18] << 8 | ihdr[19];
+    *h = (unsigned)ihdr[20] << 24 | (unsigned)ihdr[21] << 16 | (unsigned)ihdr[22] << 8 | ihdr[23];
+}
+
 static void test_render_cli_formats(void **state) {
     (void)state;
     assert_true(g_increments >= 10);
@@ -99,17 +110,36 @@ static void test_render_cli_formats(void **state) {
         read_head(path, head, sizeof head);
         assert_non_null(strstr(head, cases[i].magic));
     }
-    /* The PNG is as wide as asked: width is big-endian at byte 16 of the IHDR chunk. */
+    /* The PNG is as wide as asked. */
     char path[1200];
-    unsigned char ihdr[24];
+    unsigned width, height;
     snprintf(path, sizeof path, "%s/shear.png", g_scratch.dir);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
-    fclose(f);
-    unsigned width =
-        (unsigned)ihdr[16] << 24 | (unsigned)ihdr[17] << 16 | (unsigned)ihdr[18] << 8 | ihdr[19];
+    png_size(path, &width, &height);
     assert_int_equal(width, 600);
+}
+
+/* --colour-bar-space: a picture in layer colours of one --zoom box and --width gets the
+ * height of the picture coloured by a quantity (the same layout, so the same scale: the
+ * montage of examples/inversion); without it the plot area is wider and the picture taller. */
+static void test_render_cli_colour_bar_space(void **state) {
+    (void)state;
+    static const char *const args[] = {"--color uplift", "--colour-bar-space",
+                                       "--color uplift --no-colour-bar --colour-bar-space", ""};
+    unsigned w[4], h[4];
+    for (int i = 0; i < 4; i++) {
+        char cmd[4096], out[4096], path[1200];
+        snprintf(path, sizeof path, "%s/space%d.png", g_scratch.dir, i);
+        snprintf(cmd, sizeof cmd,
+                 "'%s' render '%s' --zoom 0,10000,-200,2800 --width 500 %s -o '%s'", g_strain,
+                 g_run, args[i], path);
+        if (run(cmd, out, sizeof out) != 0)
+            fail_msg("%s: %s", cmd, out);
+        png_size(path, &w[i], &h[i]);
+        assert_int_equal(w[i], 500);
+    }
+    assert_int_equal(h[1], h[0]);
+    assert_int_equal(h[2], h[0]);
+    assert_true(h[3] > h[0]);
 }
 
 static void test_render_cli_all_increments(void **state) {
@@ -207,6 +237,7 @@ static void test_render_cli_errors(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_cli_formats),
+        cmocka_unit_test(test_render_cli_colour_bar_space),
         cmocka_unit_test(test_render_cli_all_increments),
         cmocka_unit_test(test_render_cli_gif),
         cmocka_unit_test(test_render_cli_errors),
