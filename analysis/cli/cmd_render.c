@@ -294,8 +294,14 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
     d->sc.state = s;
     if (q) {
         cdem_limits lim;
-        CDEM_TRY(cdem_analysis_values(an, index, q, &s, &d->values, err));
+        /* The limits first: they may read other increments (total displacement at the last
+         * one with every deposit's reference, stress at every one), which can evict this
+         * increment from the analysis cache and leave a state pointer taken before them
+         * pointing at another increment's elements (the uplift of Fig. 14's first stages was
+         * drawn on the positions of an earlier increment). The state the values come with is
+         * then current. */
         CDEM_TRY(cdem_analysis_limits(an, index, q, &lim, err));
+        CDEM_TRY(cdem_analysis_values(an, index, q, &s, &d->values, err));
         d->sc.state = s;
         d->sc.values = d->values;
         d->sc.vmin = lim.vmin;
@@ -331,6 +337,11 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
         d->sc.n_axes = d->axes.n;
         d->sc.axis_perpendicular = 1;
     }
+    /* The state once more, after every call that may read other increments (the axes
+     * too): the same increment's elements in the file's order, so the values and vectors
+     * stay aligned with it. */
+    CDEM_TRY(cdem_analysis_state(an, index, &s, err));
+    d->sc.state = s;
     cdem_render_increment_label(an, index, d->label, sizeof d->label);
     d->sc.label = d->label;
     return CDEM_OK;
