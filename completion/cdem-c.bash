@@ -70,7 +70,7 @@ _cdem_strain() {
             --delay) return ;;
             --interval) return ;;
         esac
-        opts="--increment --color --colour --above-tenth-max --vectors --axes --shear-axes --no-fill --no-colours --no-colors --no-scale-bar --no-colour-bar --no-color-bar --no-label --width --height --zoom --highlight --color-walls --colour-walls --color-layers --colour-layers -o --output --prefix --format --gif --backward --odd --gif-scale --delay --follow --interval -h --help" ;;
+        opts="--increment --color --colour --above-tenth-max --vectors --axes --shear-axes --no-fill --no-colours --no-colors --no-scale-bar --no-colour-bar --no-color-bar --colour-bar-space --color-bar-space --no-label --width --height --zoom --highlight --color-walls --colour-walls --color-layers --colour-layers -o --output --prefix --format --gif --backward --odd --gif-scale --delay --follow --interval -h --help" ;;
     series)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;

@@ -203,7 +203,8 @@ static void test_man_completion_fresh_and_working(void **state) {
                               program's own option spellings, checked below) */
     } cases[] = {
         {"cdem-strain ren", "render"},
-        {"cdem-strain render run.h5 --col", "--color --colour --color-walls --colour-walls "
+        {"cdem-strain render run.h5 --col", "--color --colour --colour-bar-space --color-bar-space "
+                                            "--color-walls --colour-walls "
                                             "--color-layers --colour-layers"},
         {"cdem-strain render run.h5 --color total-max-s", "total-max-shear"},
         {"cdem-strain render run.h5 --vectors ''", "incr total"},

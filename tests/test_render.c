@@ -306,6 +306,58 @@ static void test_render_signed_colour_bar(void **state) {
     cdem_state_free(&s);
 }
 
+/* colour_bar_space: a picture in layer colours keeps the colour bar's room, so it gets the
+ * layout (plot area, scale, model position, automatic height) of the same view coloured
+ * by a quantity with its colour bar; the room stays background. Without it the plot area
+ * is wider and the model larger. */
+static void test_render_colour_bar_space(void **state) {
+    (void)state;
+    cdem_state s;
+    make_state(&s);
+    cdem_render_options o;
+    make_options(&o);
+    double v[E_N];
+    for (int i = 0; i < E_N; i++)
+        v[i] = (double)i;
+    cdem_render_scene coloured = {0}, layers = {0};
+    coloured.state = layers.state = &s;
+    coloured.values = v;
+    coloured.vmin = 0;
+    coloured.vmax = E_N - 1;
+    coloured.kind = CDEM_COLORMAP_MAGNITUDE;
+    coloured.quantity = "Value";
+    coloured.label = layers.label = "Increment 1";
+    cdem_error err;
+    int h_coloured, h_layers, h_plain;
+    assert_int_equal(cdem_render_auto_height(&coloured, &o, &h_coloured, &err), CDEM_OK);
+    assert_int_equal(cdem_render_auto_height(&layers, &o, &h_plain, &err), CDEM_OK);
+    cdem_render_layout plain;
+    assert_int_equal(cdem_render_layout_compute(&layers, &o, 600, h_plain, &plain, &err), CDEM_OK);
+    o.colour_bar_space = 1;
+    assert_int_equal(cdem_render_auto_height(&layers, &o, &h_layers, &err), CDEM_OK);
+    assert_int_equal(h_layers, h_coloured);
+    assert_true(h_plain > h_coloured); /* o.height = 0: 1200 wide, the wider plot is taller */
+    image a, b;
+    render_image(&a, &coloured, &o, 600, 300);
+    render_image(&b, &layers, &o, 600, 300);
+    const cdem_render_layout *A = &a.lay, *B = &b.lay;
+    assert_true(A->bar_w > 0 && B->bar_w == 0);
+    assert_true(A->plot_x == B->plot_x && A->plot_y == B->plot_y && A->plot_w == B->plot_w &&
+                A->plot_h == B->plot_h);
+    assert_true(A->scale == B->scale && A->ox == B->ox && A->oy == B->oy);
+    assert_true(plain.scale > A->scale); /* without the room: a larger model */
+    int px[4];
+    model_pixel(&b, 3, 1, px); /* layer 1: yellow */
+    assert_near_colour(px, o.pregrowth[0], 2);
+    pixel_at(&a, A->bar_x + 0.5 * A->bar_w, A->bar_y + 0.5 * A->bar_h, px);
+    assert_near_colour(px, cdem_colormap_eval(CDEM_COLORMAP_MAGNITUDE, 0.5), 12);
+    pixel_at(&b, A->bar_x + 0.5 * A->bar_w, A->bar_y + 0.5 * A->bar_h, px);
+    assert_near_colour(px, o.background, 0);
+    cairo_surface_destroy(a.surf);
+    cairo_surface_destroy(b.surf);
+    cdem_state_free(&s);
+}
+
 static void test_render_vectors_axes_outline(void **state) {
     (void)state;
     cdem_state s;
@@ -660,6 +712,7 @@ static void test_render_options_view(void **state) {
     assert_non_null(strstr(text, "render.height = 0 (automatic)\n"));
     assert_non_null(strstr(text, "render.pregrowth_layers = 24\n"));
     assert_non_null(strstr(text, "render.highlight = 5..8\n"));
+    assert_non_null(strstr(text, "render.colour_bar_space = 0\n"));
     assert_non_null(strstr(text, "render.colour.wall = #8b5a2bff\n"));
     assert_non_null(strstr(text, "render.colour.undefined = #999999ff\n"));
     /* every colour line reads back (within rounding) with cdem_render_parse_colour */
@@ -842,6 +895,7 @@ int main(void) {
         cmocka_unit_test(test_render_salt_colours),
         cmocka_unit_test(test_render_values_colours_and_undefined),
         cmocka_unit_test(test_render_signed_colour_bar),
+        cmocka_unit_test(test_render_colour_bar_space),
         cmocka_unit_test(test_render_vectors_axes_outline),
         cmocka_unit_test(test_render_raster_matches_cairo_path),
         cmocka_unit_test(test_render_scale_bar_and_label),

@@ -49,10 +49,12 @@ static int setup(void **state) {
     snprintf(g_strain, sizeof g_strain, "%s/cdem-strain", g_bin);
     snprintf(g_run, sizeof g_run, "%s/run.h5", g_scratch.dir);
     char cmd[4096], out[8192];
-    /* A 10 x 2.5 unit planar normal fault, 200 s equilibration and 100 s of faulting. */
+    /* A 10 x 2.5 unit planar normal fault, 200 s equilibration and 100 s of faulting, with
+     * stress (whose colour limits read every increment). */
     snprintf(cmd, sizeof cmd,
              "'%s/cdem-run' -q -s assembly.height=2.5 -s time.equilibration=200 "
-             "-s time.runtime=300 -s time.display_interval=20 -o '%s'",
+             "-s time.runtime=300 -s time.display_interval=20 -s physics.calculate_stress=on "
+             "-o '%s'",
              g_bin, g_run);
     if (run(cmd, out, sizeof out) != 0) {
         fprintf(stderr, "cdem-run failed: %s\n", out);
@@ -81,6 +83,17 @@ static void read_head(const char *path, char *buf, size_t n) {
     assert_true(got > 0);
 }
 
+/* Width and height of a PNG (big-endian at bytes 16 and 20 of the IHDR chunk). */
+static void png_size(const char *path, unsigned *w, unsigned *h) {
+    unsigned char ihdr[24];
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
+    fclose(f);
+    *w = (unsigned)ihdr[16] << 24 | (unsigned)ihdr[17] << 16 | (unsigned)ihdr[18] << 8 | ihdr[19];
+    *h = (unsigned)ihdr[20] << 24 | (unsigned)ihdr[21] << 16 | (unsigned)ihdr[22] << 8 | ihdr[23];
+}
+
 static void test_render_cli_formats(void **state) {
     (void)state;
     assert_true(g_increments >= 10);
@@ -99,17 +112,70 @@ static void test_render_cli_formats(void **state) {
         read_head(path, head, sizeof head);
         assert_non_null(strstr(head, cases[i].magic));
     }
-    /* The PNG is as wide as asked: width is big-endian at byte 16 of the IHDR chunk. */
+    /* The PNG is as wide as asked. */
     char path[1200];
-    unsigned char ihdr[24];
+    unsigned width, height;
     snprintf(path, sizeof path, "%s/shear.png", g_scratch.dir);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    assert_int_equal(fread(ihdr, 1, sizeof ihdr, f), sizeof ihdr);
-    fclose(f);
-    unsigned width =
-        (unsigned)ihdr[16] << 24 | (unsigned)ihdr[17] << 16 | (unsigned)ihdr[18] << 8 | ihdr[19];
+    png_size(path, &width, &height);
     assert_int_equal(width, 600);
+}
+
+/* Colouring by a quantity draws the increment's own elements: a picture coloured by sxx
+ * (whose limits read every increment, evicting the one drawn from the analysis cache) with
+ * --no-colours is the picture in layer colours, byte for byte; with total displacement
+ * vectors as well it is drawn (the vectors' state is the values'). Before, the state taken
+ * with the values and kept across the limits pointed at another increment's elements
+ * (Fig. 14's uplift at its first stages was drawn on an earlier increment's positions) and
+ * the vectors were refused as "vectors and values refer to different states". */
+static void test_render_cli_colour_keeps_the_increments_elements(void **state) {
+    (void)state;
+    static const struct {
+        const char *args;
+        int same; /* 1: the same picture as the layer colours' */
+    } cases[] = {{"", 1},
+                 {"--color sxx --no-colours", 1},
+                 {"--color uplift --no-colours", 1},
+                 {"--color sxx --vectors total", 0}};
+    char first[1200] = "";
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char cmd[4096], out[4096], path[1200];
+        snprintf(path, sizeof path, "%s/same%zu.png", g_scratch.dir, i);
+        snprintf(cmd, sizeof cmd, "'%s' render '%s' --increment 3 --width 400 %s -o '%s'", g_strain,
+                 g_run, cases[i].args, path);
+        if (run(cmd, out, sizeof out) != 0)
+            fail_msg("%s: %s", cmd, out);
+        if (i == 0) {
+            snprintf(first, sizeof first, "%s", path);
+            continue;
+        }
+        snprintf(cmd, sizeof cmd, "cmp '%s' '%s'", first, path);
+        if (cases[i].same && run(cmd, out, sizeof out) != 0)
+            fail_msg("render %s differs from the layer colours: %s", cases[i].args, out);
+    }
+}
+
+/* --colour-bar-space: a picture in layer colours of one --zoom box and --width gets the
+ * height of the picture coloured by a quantity (the same layout, so the same scale: the
+ * montage of examples/inversion); without it the plot area is wider and the picture taller. */
+static void test_render_cli_colour_bar_space(void **state) {
+    (void)state;
+    static const char *const args[] = {"--color uplift", "--colour-bar-space",
+                                       "--color uplift --no-colour-bar --colour-bar-space", ""};
+    unsigned w[4], h[4];
+    for (int i = 0; i < 4; i++) {
+        char cmd[4096], out[4096], path[1200];
+        snprintf(path, sizeof path, "%s/space%d.png", g_scratch.dir, i);
+        snprintf(cmd, sizeof cmd,
+                 "'%s' render '%s' --zoom 0,10000,-200,2800 --width 500 %s -o '%s'", g_strain,
+                 g_run, args[i], path);
+        if (run(cmd, out, sizeof out) != 0)
+            fail_msg("%s: %s", cmd, out);
+        png_size(path, &w[i], &h[i]);
+        assert_int_equal(w[i], 500);
+    }
+    assert_int_equal(h[1], h[0]);
+    assert_int_equal(h[2], h[0]);
+    assert_true(h[3] > h[0]);
 }
 
 static void test_render_cli_all_increments(void **state) {
@@ -207,6 +273,8 @@ static void test_render_cli_errors(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_cli_formats),
+        cmocka_unit_test(test_render_cli_colour_bar_space),
+        cmocka_unit_test(test_render_cli_colour_keeps_the_increments_elements),
         cmocka_unit_test(test_render_cli_all_increments),
         cmocka_unit_test(test_render_cli_gif),
         cmocka_unit_test(test_render_cli_errors),

@@ -48,7 +48,8 @@ typedef struct {
 static const char *const render_forms[] = {
     "RUN.h5 [--increment K|last|first|equil|all] [--color QUANTITY] [--vectors incr|total] "
     "[--axes incr-strain|total-strain|stress] [--shear-axes] [--above-tenth-max] [--no-fill] "
-    "[--no-colours] [--no-scale-bar] [--no-colour-bar] [--no-label] [--width N] [--height N] "
+    "[--no-colours] [--no-scale-bar] [--no-colour-bar] [--colour-bar-space] [--no-label] "
+    "[--width N] [--height N] "
     "[--zoom XMIN,XMAX,YMIN,YMAX] [--highlight FIRST-LAST] [--color-walls #RRGGBB] "
     "[--color-layers #RRGGBB,#RRGGBB] -o OUT.png|.pdf|.svg",
     "RUN.h5 --increment all [OPTIONS] -o DIR [--prefix P] [--format png|pdf|svg]",
@@ -70,6 +71,10 @@ static const cdem_cli_option render_options[] = {
     {"--no-colours, --no-colors", NULL, "no colours by value"},
     {"--no-scale-bar", NULL, "no scale bar"},
     {"--no-colour-bar, --no-color-bar", NULL, "no colour bar"},
+    {"--colour-bar-space, --color-bar-space", NULL,
+     "keep the colour bar's room empty when there is no colour bar (layer colours, "
+     "--no-colour-bar): with the same --zoom and --width such a picture has the scale and "
+     "the place of the model of one with a colour bar"},
     {"--no-label", NULL, "no increment label"},
     {"--width", "N", "pixels (PNG) or points (PDF, SVG), 16 to 20000 (default 1200)"},
     {"--height", "N", "as --width (default: from the aspect ratio)"},
@@ -175,6 +180,8 @@ static int parse_args(int argc, char **argv, render_args *a) {
             a->ro.show_scale_bar = 0;
         } else if (cdem_cli_option_is(o, "--no-colour-bar")) {
             a->ro.show_colour_bar = 0;
+        } else if (cdem_cli_option_is(o, "--colour-bar-space")) {
+            a->ro.colour_bar_space = 1;
         } else if (cdem_cli_option_is(o, "--no-label")) {
             a->ro.show_label = 0;
         } else if (cdem_cli_option_is(o, "--width")) {
@@ -287,8 +294,14 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
     d->sc.state = s;
     if (q) {
         cdem_limits lim;
-        CDEM_TRY(cdem_analysis_values(an, index, q, &s, &d->values, err));
+        /* The limits first: they may read other increments (total displacement at the last
+         * one with every deposit's reference, stress at every one), which can evict this
+         * increment from the analysis cache and leave a state pointer taken before them
+         * pointing at another increment's elements (the uplift of Fig. 14's first stages was
+         * drawn on the positions of an earlier increment). The state the values come with is
+         * then current. */
         CDEM_TRY(cdem_analysis_limits(an, index, q, &lim, err));
+        CDEM_TRY(cdem_analysis_values(an, index, q, &s, &d->values, err));
         d->sc.state = s;
         d->sc.values = d->values;
         d->sc.vmin = lim.vmin;
@@ -324,6 +337,11 @@ static cdem_status build_scene(cdem_analysis *an, size_t index, const render_arg
         d->sc.n_axes = d->axes.n;
         d->sc.axis_perpendicular = 1;
     }
+    /* The state once more, after every call that may read other increments (the axes
+     * too): the same increment's elements in the file's order, so the values and vectors
+     * stay aligned with it. */
+    CDEM_TRY(cdem_analysis_state(an, index, &s, err));
+    d->sc.state = s;
     cdem_render_increment_label(an, index, d->label, sizeof d->label);
     d->sc.label = d->label;
     return CDEM_OK;

@@ -88,6 +88,12 @@ static int has_colour_bar(const cdem_render_scene *sc, const cdem_render_options
     return has_values(sc, o) && o->show_colour_bar;
 }
 
+/* The layout makes room for a colour bar: one is drawn, or its room is kept empty
+ * (colour_bar_space: pictures with and without one then share the plot area). */
+static int colour_bar_room(const cdem_render_scene *sc, const cdem_render_options *o) {
+    return has_colour_bar(sc, o) || o->colour_bar_space;
+}
+
 /* Checks everything the drawing relies on, so bad input fails with a message. */
 static cdem_status validate(const cdem_render_scene *sc, const cdem_render_options *o,
                             cdem_error *err) {
@@ -186,13 +192,14 @@ static double font_size_for(const cdem_render_options *o, double width) {
     return fmax(9.0, width / 70.0);
 }
 
-/* Bands around the plot area: top (label), bottom (scale bar), right (colour bar). */
+/* Bands around the plot area: top (label), bottom (scale bar), right (colour bar or its
+ * room). */
 static void bands(const cdem_render_scene *sc, const cdem_render_options *o, double fs, double *pad,
                   double *top, double *bottom, double *right) {
     *pad = 0.8 * fs;
     *top = (o->show_label && sc->label && sc->label[0]) ? 2.2 * fs : *pad;
     *bottom = o->show_scale_bar ? 3.4 * fs : *pad;
-    *right = has_colour_bar(sc, o) ? 10.0 * fs : *pad;
+    *right = colour_bar_room(sc, o) ? 10.0 * fs : *pad;
 }
 
 cdem_status cdem_render_auto_height(const cdem_render_scene *sc, const cdem_render_options *o,
@@ -207,7 +214,7 @@ cdem_status cdem_render_auto_height(const cdem_render_scene *sc, const cdem_rend
     bands(sc, o, fs, &pad, &top, &bottom, &right);
     double pw = fmax(1.0, o->width - pad - right);
     double ph = pw * (box[3] - box[2]) / (box[1] - box[0]);
-    if (has_colour_bar(sc, o))
+    if (colour_bar_room(sc, o))
         ph = fmax(ph, 8.0 * fs);
     double h = ceil(top + ph + bottom);
     if (!(h >= 16))

@@ -5,7 +5,8 @@
  * toggles, layer banding, size, zoom); cdem_render_options_default gives the manual's
  * defaults. Elements are discs at their true radii in a y-up frame with equal x/y scale,
  * fitted into the plot area; the label sits above it, the scale bar below it and the
- * colour bar on its right. See docs/rendering.md for the colour rules and layout.
+ * colour bar on its right (or, with colour_bar_space, the colour bar's room). See
+ * docs/rendering.md for the colour rules and layout.
  * Ownership: nothing is kept; all inputs are borrowed for the duration of a call (the
  * caller keeps arrays alive). Scratch memory (O(n)) is allocated per call and freed.
  * Thread safety: no shared state; separate calls may run in parallel on separate surfaces.
@@ -72,14 +73,17 @@ typedef struct {
     int highlight_first;  /* first layer of the highlighted range; 0 = no highlight */
     int highlight_last;   /* last highlighted layer, >= highlight_first */
 
-    int show_fill;       /* 1: fill the discs; 0: outlines only */
-    int show_outline;    /* 1: thin outline around every disc (always on when !show_fill) */
-    int show_colours;    /* 1: colour by values when given; 0: layer colours only */
-    int show_vectors;    /* 1: draw displacement vectors when given */
-    int show_axes;       /* 1: draw axes when given */
-    int show_scale_bar;  /* 1: draw the scale bar */
-    int show_colour_bar; /* 1: draw the colour bar (only when values are given) */
-    int show_label;      /* 1: draw the label (only when given) */
+    int show_fill;        /* 1: fill the discs; 0: outlines only */
+    int show_outline;     /* 1: thin outline around every disc (always on when !show_fill) */
+    int show_colours;     /* 1: colour by values when given; 0: layer colours only */
+    int show_vectors;     /* 1: draw displacement vectors when given */
+    int show_axes;        /* 1: draw axes when given */
+    int show_scale_bar;   /* 1: draw the scale bar */
+    int show_colour_bar;  /* 1: draw the colour bar (only when values are given) */
+    int colour_bar_space; /* 1: keep the colour bar's room on the right (and its least plot
+                             height) also when no colour bar is drawn, so that a picture
+                             without one has the layout, hence the scale, of one with it */
+    int show_label;       /* 1: draw the label (only when given) */
 
     double font_size;     /* text height, px or pt; <= 0: width / 70, at least 9 */
     double outline_width; /* outline line width, px or pt, > 0; default 0.5 */

@@ -100,6 +100,7 @@ void cdem_render_options_view(const cdem_render_options *o, FILE *f) {
             "colour_bar %d, label %d\n",
             o->show_fill, o->show_outline, o->show_colours, o->show_vectors, o->show_axes,
             o->show_scale_bar, o->show_colour_bar, o->show_label);
+    fprintf(f, "render.colour_bar_space = %d\n", o->colour_bar_space);
     fprintf(f, "render.font_size = %g%s\n", o->font_size, o->font_size <= 0 ? " (automatic)" : "");
     fprintf(f, "render.outline_width = %g\n", o->outline_width);
     fprintf(f, "render.line_width = %g\n", o->line_width);

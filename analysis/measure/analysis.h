@@ -81,7 +81,9 @@ cdem_h5_reader *cdem_analysis_reader(const cdem_analysis *a);
 cdem_status cdem_analysis_find(const cdem_analysis *a, const char *spec, size_t *index,
                                cdem_error *err);
 
-/* The state of increment `index` (borrowed). */
+/* The state of increment `index` (borrowed: valid until the next call on a that reads
+ * another increment, which may evict it from the cache; values, limits, vectors and axes
+ * may read several). */
 cdem_status cdem_analysis_state(cdem_analysis *a, size_t index, const cdem_state **s,
                                 cdem_error *err);
 

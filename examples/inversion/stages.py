@@ -11,9 +11,17 @@ Stages, from the run's increments (`cdem-strain info --json`):
          the maximum;
   full   100 % inversion: the first increment after it whose net displacement is at most 0
          (or the last increment, with the inversion reached, when the run ends before).
-Writes OUTDIR/fig14-stages.txt ("max K", "half K", "full K": the increments, for make) and,
-on stdout, a Markdown section: each stage's increment, net displacement and element count
-beside the paper's, and the null point at each.
+Writes OUTDIR/fig14-stages.txt ("max K", "half K", "full K": the increments, and "zoom
+XMIN,XMAX,YMIN,YMAX": the view box of the pictures, for make) and, on stdout, a Markdown
+section: each stage's increment, net displacement and element count beside the paper's,
+and the null point at each.
+
+The view box (`cdem-strain render --zoom`, m) holds every free element (layer > 0: neither
+wall, base nor fault; `cdem-strain export-sspx`) of the three stages, grown by MARGIN of its
+larger side (the walls beside and below them show): one box for the four pictures of the
+montage, so that they share the scale (the layers picture keeps the colour bar's room,
+`--colour-bar-space`), and not the box of every element, which holds the fault line
+running about 2.4 km below the model (40 % of each picture).
 
 The null point (Williams et al., 1989): along the fault, where the hanging-wall beds pass
 from net subsidence (below) to net uplift (above). The fault at a height is the left edge of
@@ -32,9 +40,11 @@ import math
 import os
 import subprocess
 import sys
+import tempfile
 
 BAND = 300.0  # m, the hanging-wall band along the fault plane
 BIN = 100.0   # m, height of a slice
+MARGIN = 0.02  # of the view box's larger side (cdem-strain render's own fit margin)
 PAPER = {"initial": 46335, "max": 54288, "half": 55665, "full": 55855}
 
 
@@ -64,6 +74,30 @@ def elements(strain, h5, inc, quantity):
     for r in rows[1:]:
         out[int(r[ii])] = (float(r[ix]), float(r[iy]), float(r[iv]))
     return out
+
+
+def view_box(strain, h5, numbers):
+    """The box (xmin, xmax, ymin, ymax, m) of the free elements' discs (layer > 0) of the
+    given increments, grown by MARGIN of its larger side (`cdem-strain export-sspx`: id x y
+    radius layer; layer 0 is a wall, base or fault element)."""
+    x0 = y0 = math.inf
+    x1 = y1 = -math.inf
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in numbers:
+            run([strain, "export-sspx", h5, "--increments", "%d-%d" % (k, k), "--prefix",
+                 "view", tmp])
+            with open(os.path.join(tmp, "view%d.txt" % k)) as f:
+                for line in f:
+                    _, x, y, r, layer = line.split()
+                    if int(layer) <= 0:
+                        continue
+                    x, y, r = float(x), float(y), float(r)
+                    x0, x1 = min(x0, x - r), max(x1, x + r)
+                    y0, y1 = min(y0, y - r), max(y1, y + r)
+    if not x1 > x0:
+        sys.exit("stages.py: no free elements in increments %s" % numbers)
+    m = MARGIN * max(x1 - x0, y1 - y0)
+    return x0 - m, x1 + m, y0 - m, y1 + m
 
 
 def null_point(hanging, initial, growth, now):
@@ -135,6 +169,8 @@ def main(argv):
     with open(os.path.join(outdir, "fig14-stages.txt"), "w") as f:
         for name, k in stages.items():
             f.write("%s %d\n" % (name, incs[k]["number"]))
+        f.write("zoom %.1f,%.1f,%.1f,%.1f\n" % view_box(
+            strain, h5, [incs[k]["number"] for k in stages.values()]))
     print("## Fig. 14: the three stages (stages.py, from %s)" % os.path.basename(h5))
     print()
     print("| stage | increment | net displacement (m) | inversion | elements | paper | ours / paper |")
