@@ -819,6 +819,25 @@ static void test_params_format_value(void **state) {
     assert_string_equal(buf, "");
 }
 
+/* The text of docs/<name> (malloc'd), from the tests' data folder or the working directory. */
+static char *read_doc(const char *name) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/../../docs/%s", data_dir(), name);
+    FILE *doc = fopen(path, "rb");
+    if (!doc) {
+        snprintf(path, sizeof path, "docs/%s", name);
+        doc = fopen(path, "rb");
+    }
+    assert_non_null(doc);
+    const size_t cap = 1 << 21;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    size_t got = fread(text, 1, cap - 1, doc);
+    fclose(doc);
+    text[got] = '\0';
+    return text;
+}
+
 static void test_params_markdown_and_docs_current(void **state) {
     (void)state;
     char *md = NULL;
@@ -840,17 +859,7 @@ static void test_params_markdown_and_docs_current(void **state) {
     assert_int_equal(rows, n - fixtures + 2);
     /* docs/parameters.md must contain the current table (regenerate it with
      * `build/cdem-run --params-markdown` when the table changes) */
-    char path[1200];
-    snprintf(path, sizeof path, "%s/../../docs/parameters.md", data_dir());
-    FILE *doc = fopen(path, "rb");
-    if (!doc)
-        doc = fopen("docs/parameters.md", "rb");
-    assert_non_null(doc);
-    char *text = malloc(1 << 20);
-    assert_non_null(text);
-    size_t got = fread(text, 1, (1 << 20) - 1, doc);
-    fclose(doc);
-    text[got] = '\0';
+    char *text = read_doc("parameters.md");
     if (!strstr(text, md))
         print_error("docs/parameters.md is stale: regenerate its table with "
                     "`build/cdem-run --params-markdown`\n");
@@ -866,17 +875,7 @@ static void test_params_registry_tables_in_docs(void **state) {
     void (*writers[2])(FILE *) = {cdem_params_write_laws_markdown,
                                   cdem_params_write_modes_markdown};
     const char *flags[2] = {"--laws-markdown", "--modes-markdown"};
-    char path[1200];
-    snprintf(path, sizeof path, "%s/../../docs/solver.md", data_dir());
-    FILE *doc = fopen(path, "rb");
-    if (!doc)
-        doc = fopen("docs/solver.md", "rb");
-    assert_non_null(doc);
-    char *text = malloc(1 << 21);
-    assert_non_null(text);
-    size_t got = fread(text, 1, (1 << 21) - 1, doc);
-    fclose(doc);
-    text[got] = '\0';
+    char *text = read_doc("solver.md");
     for (int k = 0; k < 2; k++) {
         char *md = NULL;
         size_t len = 0;
