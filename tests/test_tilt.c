@@ -1,5 +1,5 @@
 /* The regional tilt (solver/tilt/, issue 47 item 3): the whole model rotates rigidly relative to
- * gravity, gravity turning in the model's frame, by [tilt] angle over [tilt] start and
+ * gravity, gravity turning in the model's frame, by [tilt] angle over [tilt] onset and
  * duration of deformation time. The runs use the tests' still mode (nothing moves: the tilt
  * alone) at small sizes, in memory.
  *   tilt-1 parameters: off by default (no process, no [tilt] in a run's parameter record);
@@ -126,7 +126,7 @@ static void test_tilt_parameters(void **state) {
     (void)state;
     cdem_params p;
     cdem_params_defaults(&p);
-    assert_true(p.tilt_angle == 0.0 && p.tilt_start == 0.0 && isnan(p.tilt_duration));
+    assert_true(p.tilt_angle == 0.0 && p.tilt_onset == 0.0 && isnan(p.tilt_duration));
     cdem_processes ps;
     cdem_error err;
     assert_int_equal(cdem_processes_init(&ps, &p, &err), CDEM_OK);
@@ -148,7 +148,7 @@ static void test_tilt_parameters(void **state) {
     assert_non_null(strstr(text, "[tilt]"));
     assert_non_null(strstr(text, "\nangle = 2\n"));
     assert_non_null(strstr(text, "\nduration = 50\n"));
-    assert_null(strstr(text, "\nstart = ")); /* left at its default */
+    assert_null(strstr(text, "\nonset = ")); /* left at its default */
     free(text);
     assert_string_equal(validate_message(&q, &err), "");
     /* beyond 45 degrees, either way */
@@ -160,14 +160,14 @@ static void test_tilt_parameters(void **state) {
     assert_int_equal(cdem_params_override(&o, "tilt.angle=50", &err), CDEM_ERR_RANGE);
     assert_non_null(strstr(err.msg, "tilt.angle=50"));
     assert_non_null(strstr(err.msg, "must be between -45 and 45 degrees"));
-    /* a window past the runtime, and past it by its start alone */
+    /* a window past the runtime, and past it by its onset alone */
     q = tilt_params(2.0, 80.0);
-    q.tilt_start = 30.0;
-    expect_refused(&q, "[tilt] start + duration = 30 + 80 s: the tilting would end after the "
+    q.tilt_onset = 30.0;
+    expect_refused(&q, "[tilt] onset + duration = 30 + 80 s: the tilting would end after the "
                        "run's");
-    q.tilt_start = 150.0;
+    q.tilt_onset = 150.0;
     q.tilt_duration = NAN;
-    expect_refused(&q, "[tilt] start = 150 s: the tilting would begin after the run's");
+    expect_refused(&q, "[tilt] onset = 150 s: the tilting would begin after the run's");
     /* levels and loads horizontal in the model's frame */
     q = tilt_params(2.0, 50.0);
     q.erosion = 1;
@@ -392,7 +392,7 @@ static void test_tilt_resumed_bit_identical(void **state) {
 static void test_tilt_summary_and_schedule(void **state) {
     (void)state;
     cdem_params p = tilt_params(-2.0, 40.0);
-    p.tilt_start = 20.0;
+    p.tilt_onset = 20.0;
     cdem_model m;
     cdem_error err;
     assert_int_equal(cdem_bc_derive_model(&p, &m, &err), CDEM_OK);

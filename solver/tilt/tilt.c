@@ -17,14 +17,14 @@
 void cdem_tilt_schedule_of(const cdem_params *p, const cdem_model *m, cdem_tilt_schedule *t) {
     t->angle = p->tilt_angle;
     t->k_run = m->total_steps - m->equil_steps;
-    t->k_begin = lround(p->tilt_start / m->dt);
+    t->k_begin = lround(p->tilt_onset / m->dt);
     if (isnan(p->tilt_duration))
         t->k_end = t->k_run;
     else {
         const long k = lround(p->tilt_duration / m->dt);
         t->k_end = t->k_begin + (k > 1 ? k : 1);
     }
-    if (t->k_end <= t->k_begin) /* rest from a start at the run's end: the rules refuse it */
+    if (t->k_end <= t->k_begin) /* rest from an onset at the run's end: the rules refuse it */
         t->k_end = t->k_begin + 1;
 }
 
@@ -74,18 +74,18 @@ void cdem_tilt_rules(const cdem_params *p, cdem_rule_log *log) {
                       "would turn past the horizontal",
                       p->tilt_angle, cdem_mode_name(p->mode), m.mode.gravity_tilt);
     const double run = (double)(m.total_steps - m.equil_steps) * m.dt;
-    if (!(p->tilt_start < run))
+    if (!(p->tilt_onset < run))
         cdem_rule_add(log,
-                      "[tilt] start = %g s: the tilting would begin after the run's %.6g s of "
-                      "deformation ([time] runtime - equilibration): lower [tilt] start or "
+                      "[tilt] onset = %g s: the tilting would begin after the run's %.6g s of "
+                      "deformation ([time] runtime - equilibration): lower [tilt] onset or "
                       "raise [time] runtime",
-                      p->tilt_start, run);
-    else if (!isnan(p->tilt_duration) && p->tilt_start + p->tilt_duration > run + 0.5 * m.dt)
+                      p->tilt_onset, run);
+    else if (!isnan(p->tilt_duration) && p->tilt_onset + p->tilt_duration > run + 0.5 * m.dt)
         cdem_rule_add(log,
-                      "[tilt] start + duration = %g + %g s: the tilting would end after the "
+                      "[tilt] onset + duration = %g + %g s: the tilting would end after the "
                       "run's %.6g s of deformation ([time] runtime - equilibration): shorten "
                       "[tilt] duration (rest: to the run's end) or raise [time] runtime",
-                      p->tilt_start, p->tilt_duration, run);
+                      p->tilt_onset, p->tilt_duration, run);
 }
 
 typedef struct {

@@ -24,7 +24,7 @@ typedef struct {
     long k_run;   /* the run's deformation steps */
 } cdem_tilt_schedule;
 
-/* The schedule of p on the model m: k_begin = round(start / dt), k_end = k_begin +
+/* The schedule of p on the model m: k_begin = round(onset / dt), k_end = k_begin +
  * max(1, round(duration / dt)) or, with duration = rest, the run's last deformation step. */
 void cdem_tilt_schedule_of(const cdem_params *p, const cdem_model *m, cdem_tilt_schedule *t);
 
