@@ -85,7 +85,9 @@ INC_analysis_export  := $(INC_analysis_measure) -Ianalysis/export
 INC_analysis_draw    := $(INC_analysis) -Ianalysis/draw
 INC_analysis_cli     := $(INC_analysis) -Ianalysis/measure -Ianalysis/input -Ianalysis/export \
                         -Ianalysis/draw -Ianalysis/cli
-INC_tests    := $(INC_solver) $(filter-out -Icommon,$(INC_analysis_cli))
+# the tests see every layer, the processes' own folders (solver/<id>/) included
+INC_tests    := $(INC_solver) $(filter-out $(INC_solver),$(patsubst %/,-I%,$(wildcard solver/*/))) \
+                $(filter-out -Icommon,$(INC_analysis_cli))
 path_words = $(subst /, ,$(1))
 # A solver folder without a line above is a process's (solver/process/process.h): it sees the
 # processes' interface, the stepper below it and itself, so a new process adds no line here.

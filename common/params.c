@@ -1055,6 +1055,20 @@ static void write_actors(const cdem_params *p, FILE *out) {
                 j + 1, j + 1, p->actor_keys[j - 1]);
 }
 
+/* 1 when a record leaves section out: every key of it is recorded only when set (a section
+ * added since, such as a process's [tilt]) and p sets none of them, so that the records of
+ * runs that leave it alone stay as they were. */
+static int record_leaves_out(const cdem_params *p, const char *section) {
+    for (size_t i = 0; i < N_PARAMS; i++) {
+        const cdem_param_def *d = &param_table[i];
+        if (strcmp(d->section, section) != 0)
+            continue;
+        if (!(d->recorded_when_set || d->fixture) || cdem_params_recorded(p, d))
+            return 0;
+    }
+    return 1;
+}
+
 /* cdem_params_write (every key) or, with record, cdem_params_write_record. */
 static void write_params(const cdem_params *p, FILE *out, int record) {
     if (!p || !out)
@@ -1070,7 +1084,8 @@ static void write_params(const cdem_params *p, FILE *out, int record) {
         if (strcmp(d->section, cur) != 0) {
             if (strcmp(cur, "boundary") == 0)
                 write_actors(p, out);
-            fprintf(out, "\n[%s]\n", d->section);
+            if (!(record && record_leaves_out(p, d->section)))
+                fprintf(out, "\n[%s]\n", d->section);
             cur = d->section;
         }
         if (record && !cdem_params_recorded(p, d))

@@ -12,7 +12,10 @@
  * (CDEM_PARAM_FIELDS, in its section's place: a law's in [material], a mode's in
  * [boundary], a process's in its own section, CDEM_PARAM_SECTIONS), the words of its enum
  * keys (CDEM_PARAM_WORDS) and its rows (CDEM_PARAM_ROWS, written as the table's, with
- * P_OFF(field) and NOMAX). Adding one touches no line here or in params.c. The fields keep
+ * P_OFF(field) and NOMAX). Adding one touches no line here or in params.c. A new section
+ * whose keys are all recorded only when set (a process's [tilt]) is left out of the
+ * parameter record of a run that sets none of them, so that existing records stay as they
+ * were. The fields keep
  * flat names (p->fault_dip), so a key's owner can change without its readers changing.
  * Parameter files are INI ("[section]" then "key = value"; '#' or ';' start comments;
  * CRLF accepted). Values are SI units (m, s, kg/m^3, N, N/m) unless the unit says otherwise.

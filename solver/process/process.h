@@ -12,12 +12,14 @@
  *   set-up, in this order: place (after the assembly is built and the weak interval flagged:
  *   the elements it takes; its log line), configure (after the stepper is set up: its forces
  *   join the step through cdem_viscous_add, integrate.h / viscous.h);
+ *   each deformation step: gravity (turns gravity in the model's frame: a tilting margin);
  *   output: increment (before an increment is written: its elements' stress when the run
  *   stores stress; its own measures), sample (a time-series sample: its columns);
  *   the end: finish (its last log line), free.
  * A process's state is its context (state_size bytes, calloc'd): a resumed run sets the same
  * process up again on the same assembly, so what it places and measures is the same; what
- * evolves lives in the element state (the salt's area ratio J) and is checkpointed with it.
+ * evolves lives in the element state (the salt's area ratio J) or the stepper (gravity's
+ * direction) and is checkpointed with it.
  * Ownership: cdem_processes owns the contexts. Thread safety: one per run. Units: SI. */
 #ifndef CDEM_PROCESS_H
 #define CDEM_PROCESS_H
@@ -44,6 +46,12 @@ typedef struct {
                          FILE *log, cdem_error *err);
     cdem_status (*configure)(void *ctx, const cdem_params *p, const cdem_model *m,
                              cdem_integrator *it, cdem_error *err);
+    /* deformation step k >= 1, after the boundary mode's gravity hook (bc.h): turns gravity's
+     * acceleration (*gx, *gy, m/s^2, the model's frame; the mode's, or the model's direction
+     * when the mode has no hook) in place. A function of k and the context only, so that a
+     * resumed run turns it alike; what it sets holds through the steps that are not
+     * deformation steps, and the stepper's checkpoint keeps it */
+    void (*gravity)(const void *ctx, long k, double *gx, double *gy);
     void (*increment)(void *ctx, cdem_state *s);
     void (*sample)(const void *ctx, const cdem_state *s, cdem_series_sample *q);
     void (*finish)(const void *ctx, FILE *log);
@@ -71,6 +79,9 @@ cdem_status cdem_processes_place(cdem_processes *ps, const cdem_params *p, const
                                  cdem_state *s, FILE *log, cdem_error *err);
 cdem_status cdem_processes_configure(cdem_processes *ps, const cdem_params *p, const cdem_model *m,
                                      cdem_integrator *it, cdem_error *err);
+/* Gravity of deformation step k turned by each process's gravity hook in order: 1 when one
+ * has the hook (*gx, *gy then hold the result), 0 when none has (untouched). */
+int cdem_processes_gravity(const cdem_processes *ps, long k, double *gx, double *gy);
 void cdem_processes_increment(cdem_processes *ps, cdem_state *s);
 void cdem_processes_sample(const cdem_processes *ps, const cdem_state *s, cdem_series_sample *q);
 void cdem_processes_finish(const cdem_processes *ps, FILE *log);

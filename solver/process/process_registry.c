@@ -70,6 +70,16 @@ cdem_status cdem_processes_configure(cdem_processes *ps, const cdem_params *p, c
     return CDEM_OK;
 }
 
+int cdem_processes_gravity(const cdem_processes *ps, long k, double *gx, double *gy) {
+    int turned = 0;
+    for (int j = 0; j < ps->n; j++)
+        if (ps->ops[j]->gravity) {
+            ps->ops[j]->gravity(ps->ctx[j], k, gx, gy);
+            turned = 1;
+        }
+    return turned;
+}
+
 void cdem_processes_increment(cdem_processes *ps, cdem_state *s) {
     for (int k = 0; k < ps->n; k++)
         if (ps->ops[k]->increment)

@@ -124,6 +124,11 @@ static cdem_status check_unstable(const run_ctx *r, cdem_error *err) {
                      (int)s->id[i], sqrt(d2), s->radius[i], r->step);
 }
 
+/* The stepper's gravity_turn (integrate.h): the run's processes' gravity hooks (process.h). */
+static int processes_gravity(const void *procs, long k, double *gx, double *gy) {
+    return cdem_processes_gravity(procs, k, gx, gy);
+}
+
 /* Everything before the first step, for a fresh run and a resumed one alike: the model, the
  * assembly (regenerated from the seed), the mode, the stepper and the summary. No file yet. */
 static cdem_status setup(run_ctx *r, cdem_error *err) {
@@ -159,6 +164,8 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     CDEM_TRY(cdem_bc_init(&r->bc, p, &r->m, &r->s, err));
     CDEM_TRY(cdem_integrator_init(&r->it, p, &r->m, err));
     CDEM_TRY(cdem_processes_configure(&r->procs, p, &r->m, &r->it, err));
+    r->it.gravity_turn = processes_gravity; /* a process may turn the frame (a tilting margin) */
+    r->it.gravity_turn_ctx = &r->procs;
     r->it.unstable_guard = 1;    /* check_unstable */
     r->ckpt.boundary_forces = 1; /* the forces of the first evaluation are current */
     r->it.equilibrating = 1;     /* the packing phase's law until the end of equilibration */

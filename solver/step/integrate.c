@@ -288,8 +288,13 @@ cdem_status cdem_integrator_step(cdem_integrator *it, cdem_state *s, cdem_bc *bc
         drift(it, s);
     it->step++;
     cdem_loads_begin_step(&it->loads, it->step);
-    double gx, gy; /* a mode whose frame turns sets gravity for this step (bc.h) */
-    if (cdem_bc_gravity(bc, k, it->loads.gravity, &gx, &gy))
+    /* a mode whose frame turns sets gravity for this step (bc.h), a process turns it further
+     * (gravity_turn) */
+    double gx = it->loads.model_gx, gy = it->loads.model_gy;
+    int gravity_set = cdem_bc_gravity(bc, k, it->loads.gravity, &gx, &gy);
+    if (k >= 1 && it->gravity_turn && it->gravity_turn(it->gravity_turn_ctx, k, &gx, &gy))
+        gravity_set = 1;
+    if (gravity_set)
         cdem_loads_set_gravity(&it->loads, gx, gy);
     /* a split mode's per-element moves go into the pass's region too (bc.h step_move) */
     const cdem_bc_move_fn move = drift_in_pass ? cdem_bc_step_move_of(bc, k) : NULL;

@@ -78,6 +78,12 @@ typedef struct {
     cdem_removal removal;   /* escapes, erosion, the mode's removals and their record
                                (removal.h) */
     cdem_viscous viscous;   /* contact damping and salt (viscous.h; off: nothing changes) */
+    /* may be NULL (gravity as the mode sets it): on every deformation step k >= 1, after the
+     * mode's gravity hook, turns gravity (*gx, *gy: the mode's, else the model's direction) in
+     * the model's frame and returns 1, or returns 0 to leave it; the run sets it to its
+     * processes' (process.h, the gravity hook: a tilting margin) */
+    int (*gravity_turn)(const void *ctx, long k, double *gx, double *gy);
+    const void *gravity_turn_ctx;
 } cdem_integrator;
 
 /* The viscous coefficient in force on the current step, N s/m: damping x damping_factor. */

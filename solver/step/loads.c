@@ -13,6 +13,8 @@ void cdem_loads_init(cdem_loads *l, double gravity, double tilt_deg, double max_
     memset(l, 0, sizeof *l);
     l->gravity = gravity;
     cdem_model_gravity_vector(gravity, tilt_deg, &l->gravity_x, &l->gravity_y);
+    l->model_gx = l->gravity_x;
+    l->model_gy = l->gravity_y;
     l->column_width = 2.0 * max_radius;
 }
 

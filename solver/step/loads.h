@@ -19,6 +19,8 @@ typedef struct {
     double gravity;              /* m/s^2, the magnitude (>= 0): checked on resume */
     double gravity_x, gravity_y; /* m/s^2, the acceleration of this step in the model's frame:
                                     (0, -gravity) unless a mode tilts it (set_gravity) */
+    double model_gx, model_gy;   /* m/s^2, the model's direction (init's): what a process turns
+                                    when the mode sets none (integrate.h, gravity_turn) */
     double column_width; /* m, width of the surface columns and edge bands = 2 x max radius */
 
     /* overburden (on when overburden_force > 0) */
