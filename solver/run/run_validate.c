@@ -94,9 +94,13 @@ static double memory_available(void) {
     return pages > 0 && size > 0 ? (double)pages * (double)size : 0.0;
 }
 
+/* The bytes a run of about n elements needs. */
+static double memory_for(long n) {
+    return CDEM_RUN_MEMORY_FIXED + (double)n * CDEM_RUN_MEMORY_PER_ELEMENT;
+}
+
 double cdem_run_memory_estimate(const cdem_params *p) {
-    const double n = (double)cdem_model_estimate_elements(p);
-    return CDEM_RUN_MEMORY_FIXED + n * CDEM_RUN_MEMORY_PER_ELEMENT;
+    return memory_for(cdem_model_estimate_elements(p));
 }
 
 cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
@@ -105,7 +109,7 @@ cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
 
 cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_error *err) {
     const long n = cdem_model_estimate_elements(p);
-    const double need = cdem_run_memory_estimate(p);
+    const double need = memory_for(n);
     /* the memory first (the limit a user meets), then the 32-bit indices */
     if (have <= 0.0 || need <= have) {
         if (n > CDEM_RUN_MAX_ELEMENTS)
