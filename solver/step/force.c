@@ -99,7 +99,8 @@ typedef struct {
     const uint8_t *cls;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
-    int nchunk;                                      /* chunks of this pass */
+    double *slots; /* the law's history slots (cdem_force_pairs says what stands in for none) */
+    int nchunk;    /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
     const cdem_force_kernels *vec;   /* the vector path's kernels (force.h, "Paths"), or NULL */
@@ -158,7 +159,7 @@ static void cross_eval(const force_pass *fp, int c) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
         cdem_force_pair(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                        fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+                        fp->cls, fp->hist, fp->xs, fp->slots, fp->pfx, fp->pfy, fp->dt);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
@@ -210,7 +211,7 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
             cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                            fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+                            fp->cls, fp->hist, fp->xs, fp->slots, pfx, pfy, dt);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
             fx[i] += pfx[p];
@@ -538,6 +539,9 @@ static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cde
     cdem_contact_law_phase(in->law, in->equilibrating, &lawc);
     const int kick = in->kick, check_moved = in->check_moved;
     const long n = (long)s->n;
+    /* the law's history slots; a law without any has no array, and the list's xs stands in
+     * (the kernels never read or write through it: 0 slots a pair) */
+    double *slots = nb->slot_count > 0 ? nb->slots : nb->xs;
     force_pass fp = {
         .law = &lawc,
         .dt = in->dt,
@@ -564,6 +568,7 @@ static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cde
         .cls = nb->cls,
         .hist = nb->hist,
         .xs = nb->xs,
+        .slots = slots,
         .pfx = nb->pfx,
         .pfy = nb->pfy,
         .fx = s->fx,
@@ -588,6 +593,7 @@ static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cde
                                   .cls = nb->cls,
                                   .hist = nb->hist,
                                   .xs = nb->xs,
+                                  .slots = slots,
                                   .pfx = nb->pfx,
                                   .pfy = nb->pfy,
                                   .pos4 = f->pos4};

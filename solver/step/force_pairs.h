@@ -29,6 +29,9 @@ typedef struct {
     const uint8_t *cls;
     uint8_t *hist;
     double *xs, *pfx, *pfy;
+    /* the law's history slots, law->slot_count per pair (the pair list's); never NULL (a law
+     * without slots: any valid pointer, never read) */
+    double *slots;
     /* the vector paths' packed elements: pos4[4e .. 4e+3] = x, y, vx, vy of element e, 32-byte
      * aligned, current for every element whose pairs a vector kernel evaluates (the kernels
      * read both elements of a pair with one 256-bit load each, where gathers of the four
@@ -139,10 +142,14 @@ static CDEM_INLINE void cdem_force_pair(const cdem_contact_law *restrict law, lo
                                         double dy, double dvx, double dvy,
                                         const double *restrict Rp, const uint8_t *restrict cls,
                                         uint8_t *restrict hist, double *restrict xs,
-                                        double *restrict pfx, double *restrict pfy, double dt) {
+                                        double *restrict slots, double *restrict pfx,
+                                        double *restrict pfy, double dt) {
     const double R = Rp[p];
     const uint8_t h = hist[p];
     const double r2 = dx * dx + dy * dy;
+    /* the pair's history slots are at slots + p * law->slot_count (slots is never NULL, so this
+     * is defined for a law without any): only a kernel with slots reads them, so for the others
+     * the compiler computes nothing; separation does not touch them (law.h) */
     if (!(h & CDEM_PAIR_BONDED)) {
         if (r2 >= R * R || r2 <= 0.0) {
             /* separated: xs != 0 only with h != 0 */
@@ -154,18 +161,20 @@ static CDEM_INLINE void cdem_force_pair(const cdem_contact_law *restrict law, lo
             }
             return;
         }
-        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
-                              &pfy[p]);
+        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p],
+                              slots + p * law->slot_count, &pfx[p], &pfy[p]);
         return;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p],
+                      slots + p * law->slot_count, &pfx[p], &pfy[p]);
 }
 
 /* cdem_force_pair for pair p of the arrays a. */
 static CDEM_INLINE void cdem_force_pair_at(const cdem_force_pairs *a, long p) {
     const int32_t i = a->pi[p], j = a->pj[p];
     cdem_force_pair(a->law, p, a->x[j] - a->x[i], a->y[j] - a->y[i], a->vx[j] - a->vx[i],
-                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, a->pfx, a->pfy, a->dt);
+                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, a->slots, a->pfx, a->pfy,
+                    a->dt);
 }
 
 /* The kernels of a vector path (force.h, "Paths"). Each gives the bits of the scalar code
