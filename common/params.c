@@ -61,229 +61,187 @@ static const char *const cohesive_words[] = {"equilibrated", "formed", "initial"
 static const char *const as_wall_words[] = {"wall", NULL};
 /* The modes' words, in enum order (the users' modes), and every mode's word. */
 static const char *const mode_words[] = {
-#define CDEM_MODE(ID, id, word) word,
+#define CDEM_MODE(ID, id, word, clock, description) word,
 #include "modes.def"
 #undef CDEM_MODE
     NULL};
 _Static_assert(sizeof mode_words / sizeof mode_words[0] == CDEM_MODE_WORDS + 1,
                "one word per mode of parameter files (modes.def)");
-static const char *const mode_names[CDEM_MODE_COUNT] = {
-#define CDEM_MODE(ID, id, word) [CDEM_MODE_##ID] = word,
-#define CDEM_TEST_MODE          CDEM_MODE
+static const struct {
+    const char *word, *description;
+    cdem_mode_clock clock;
+} mode_rows[CDEM_MODE_COUNT] = {
+#define CDEM_MODE(ID, id, word, clock, description) [CDEM_MODE_##ID] = {word, description, clock},
+#define CDEM_TEST_MODE                              CDEM_MODE
 #include "modes.def"
 #undef CDEM_MODE
 #undef CDEM_TEST_MODE
 };
-static const char *const sense_words[] = {"normal", "reverse", NULL};
-static const char *const kin_words[] = {"ch", "cd", NULL};
-static const char *const vert_words[] = {"caldera", "piston", NULL};
 static const char *const walls_words[] = {"right", "both", NULL};
-static const char *const detach_sense_words[] = {"shortening", "extension", NULL};
 static const char *const weak_words[] = {"off", "lower", "upper", NULL};
 static const char *const flex_words[] = {"layer-contacts", "weak-layers", NULL};
 static const char *const sea_words[] = {"null", "low", "mid", "high", "very-high", NULL};
 static const char *const damping_words[] = {"absolute", "contact", NULL};
-static const char *const salt_layer_words[] = {"off", "basal", "interval", NULL};
-static const char *const salt_contact_words[] = {"no-slip", "free-slip", NULL};
-/* salt.time_scale's word: the time scale follows from salt.rate */
-static const char *const from_rate_words[] = {"rate", NULL};
+/* The words of the laws', the modes' and the processes' own enum keys (params.h). */
+#define CDEM_PARAM_WORDS
+#include "laws/laws.def"
+#include "modes.def"
+#include "processes.def"
+#undef CDEM_PARAM_WORDS
 
 /* Boolean spellings: bool_true_words[i] and bool_false_words[i] are a pair. */
 static const char *const bool_true_words[] = {"true", "yes", "on", "1", NULL};
 static const char *const bool_false_words[] = {"false", "no", "off", "0", NULL};
 
 /* Sections in file order. */
+/* Sections in file order: a process's own section comes before [output]. */
 static const char *const section_names[] = {"assembly",      "time",     "physics", "material",
-                                            "heterogeneity", "boundary", "surface", "salt",
+                                            "heterogeneity", "boundary", "surface",
+#define CDEM_PARAM_SECTIONS
+#include "processes.def"
+#undef CDEM_PARAM_SECTIONS
                                             "output",        NULL};
 
 /* clang-format off */
 static const cdem_param_def param_table[] = {
     /* section, key, type, offset, size, unit, default, min, max, min_excl, max_excl, choices, help,
-       recorded_when_set */
+       recorded_when_set, fixture */
     {"assembly", "width", CDEM_PTYPE_DOUBLE, P_OFF(width), 0, "units", "10", 0, 1e6, 1, 0, NULL,
-     "assembly width in model units (cdem's box: 10 to 100; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0},
+     "assembly width in model units (cdem's box: 10 to 100; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0, 0},
     {"assembly", "height", CDEM_PTYPE_DOUBLE, P_OFF(height), 0, "units", "5", 0, 1e6, 1, 0, NULL,
-     "assembly height in model units (cdem's box: 2.5 to 7.5; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0},
+     "assembly height in model units (cdem's box: 2.5 to 7.5; beyond it, bounded by the memory the run needs, at least 8 largest diameters)", 0, 0},
     {"assembly", "unit_scaling", CDEM_PTYPE_DOUBLE, P_OFF(unit_scaling), 0, "m", "1000", 1, 1e6, 0, 0, NULL,
-     "length of one model unit (cdem: 100 to 1000; the contact constants scale with the radius below 1000 m, docs/solver.md)", 0},
+     "length of one model unit (cdem: 100 to 1000; the contact constants scale with the radius below 1000 m, docs/solver.md)", 0, 0},
     {"assembly", "half_radii", CDEM_PTYPE_BOOL, P_OFF(half_radii), 0, "", "off", 0, 1, 0, 0, NULL,
-     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step); radius_scale = 0.5 is the same", 0},
+     "use radii 0.025-0.0625 units instead of 0.05-0.125 (4x the elements, half the time step); radius_scale = 0.5 is the same", 0, 0},
     {"assembly", "radius_scale", CDEM_PTYPE_DOUBLE, P_OFF(radius_scale), 0, "", "1", 0.001, 1000, 0, 0, NULL,
-     "the four element radii 0.05, 0.075, 0.1, 0.125 units times this (the paper's distribution kept): 0.5 is cdem's half radii, 0.1 cdem2D's finer assemblies; elements per area grow as 1/radius_scale^2, the time step shrinks with radius_scale", 0},
+     "the four element radii 0.05, 0.075, 0.1, 0.125 units times this (the paper's distribution kept): 0.5 is cdem's half radii, 0.1 cdem2D's finer assemblies; elements per area grow as 1/radius_scale^2, the time step shrinks with radius_scale", 0, 0},
     {"assembly", "wall_height_multiplier", CDEM_PTYPE_INT, P_OFF(wall_height_multiplier), 0, "", "1", 1, 4, 0, 0, NULL,
-     "lateral wall height as a multiple of the assembly height", 0},
+     "lateral wall height as a multiple of the assembly height", 0, 0},
     {"assembly", "base_spacing", CDEM_PTYPE_DOUBLE, P_OFF(base_spacing), 0, "wall radii", "2", 1, 2, 0, 0, NULL,
-     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base); the biaxial test's platens are always smooth (1)", 0},
+     "centre spacing of the base wall's discs in wall radii: 2 touching (a rough base, which resists sliding even without friction), 1 overlapping (a nearly smooth base); the biaxial test's platens are always smooth (1)", 0, 0},
     {"assembly", "seed", CDEM_PTYPE_LONG, P_OFF(seed), 0, "", "1", 0, 2147483647.0, 0, 0, NULL,
-     "random seed of the packing and of all other randomness", 0},
+     "random seed of the packing and of all other randomness", 0, 0},
 
     {"time", "runtime", CDEM_PTYPE_DOUBLE, P_OFF(runtime), 0, "s", "2000", 100, 1e6, 0, 0, NULL,
-     "total simulated time (simulation time, not geological time)", 0},
+     "total simulated time (simulation time, not geological time)", 0, 0},
     {"time", "equilibration", CDEM_PTYPE_DOUBLE, P_OFF(equilibration), 0, "s", "400", 100, 1e6, 0, 0, NULL,
-     "equilibration time before any boundary moves; must be shorter than runtime", 0},
+     "equilibration time before any boundary moves; must be shorter than runtime", 0, 0},
     {"time", "display_interval", CDEM_PTYPE_DOUBLE, P_OFF(display_interval), 0, "m", "5", 0.1, 1000, 0, 0, NULL,
-     "boundary displacement between display increments (seconds for mode = repose)", 0},
+     "boundary displacement between display increments (seconds for mode = repose)", 0, 0},
 
     {"physics", "gravity", CDEM_PTYPE_DOUBLE, P_OFF(gravity), 0, "m/s^2", "9.81", 0.5, 25, 0, 0, NULL,
-     "gravitational acceleration (not applied in the biaxial test)", 0},
+     "gravitational acceleration (not applied in the biaxial test)", 0, 0},
     {"physics", "density", CDEM_PTYPE_DOUBLE, P_OFF(density), 0, "kg/m^3", "2500", 1500, 3500, 0, 0, NULL,
-     "element density", 0},
+     "element density", 0, 0},
     {"physics", "keep_constants", CDEM_PTYPE_BOOL, P_OFF(keep_constants), 0, "", "off", 0, 1, 0, 0, NULL,
-     "keep the 1000 m spring and damping constants whatever the unit scaling", 0},
+     "keep the 1000 m spring and damping constants whatever the unit scaling", 0, 0},
     {"physics", "deformation_damping", CDEM_PTYPE_DOUBLE, P_OFF(deformation_damping), 0, "", "1", 0, 1, 0, 0, NULL,
-     "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)", 0},
+     "multiplier of the viscous damping on deformation steps (1 = the paper's; equilibration and sediment settling keep it whole)", 0, 0},
     {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
-     "store per-element stress in every increment", 0},
+     "store per-element stress in every increment", 0, 0},
     {"physics", "damping_mode", CDEM_PTYPE_ENUM, P_OFF(damping_mode), 0, "", "absolute", 0, 0, 0, 0, damping_words,
-     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)", 0},
+     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)", 0, 0},
     {"physics", "contact_damping", CDEM_PTYPE_DOUBLE, P_OFF(contact_damping), 0, "", "0.2", 0, 1, 0, 0, NULL,
-     "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))", 0},
+     "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))", 0, 0},
 
     {"material", "material", CDEM_PTYPE_ENUM, P_OFF(material), 0, "", "granular", 0, 0, 0, 0, material_words,
-     "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)", 0},
+     "granular (frictional-cohesive) or bonded (elastic bonds with a breaking strain)", 0, 0},
     {"material", "first_slip", CDEM_PTYPE_BOOL, P_OFF(first_slip), 0, "", "on", 0, 1, 0, 0, NULL,
-     "granular: cohesion lost at the first slip (on) or when the pair separates (off)", 0},
+     "granular: cohesion lost at the first slip (on) or when the pair separates (off)", 0, 0},
     {"material", "granular_law", CDEM_PTYPE_ENUM, P_OFF(granular_law), 0, "", "normal-cohesion", 0, 0, 0, 0, law_words,
      "granular: how the cohesion C0 enters a contact's shear strength"
 #define CDEM_LAW(ID, word, description, scalar, lanes) "; " word ": " description
 #include "laws/laws.def"
 #undef CDEM_LAW
-     , 0},
+     , 0, 0},
     {"material", "cohesive_contacts", CDEM_PTYPE_ENUM, P_OFF(cohesive_contacts), 0, "", "initial", 0, 0, 0, 0, cohesive_words,
-     "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)", 0},
+     "granular: C0 on the contacts of the end of equilibration (equilibrated), also on every contact formed later (formed), or only on those that were contacts of the built assembly and never separated (initial)", 0, 0},
     {"material", "settling_friction", CDEM_PTYPE_DOUBLE, P_OFF(settling_friction), 0, "", "0", 0, 1, 0, 0, NULL,
-     "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on", 0},
+     "granular: friction multiplier during equilibration (0: a dense, frictionless settling); the full friction acts from deformation on", 0, 0},
     {"material", "element_friction", CDEM_PTYPE_DOUBLE, P_OFF(element.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-element friction coefficient", 0},
+     "element-element friction coefficient", 0, 0},
     {"material", "element_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(element.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-element cohesion force", 0},
+     "element-element cohesion force", 0, 0},
     {"material", "element_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(element.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-element bond breaks when r - R >= breaking_strain * R", 0},
+     "bonded: element-element bond breaks when r - R >= breaking_strain * R", 0, 0},
     {"material", "wall_friction", CDEM_PTYPE_DOUBLE, P_OFF(wall.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-wall friction coefficient (lateral walls, biaxial platens; the base too unless base_friction is set)", 0},
+     "element-wall friction coefficient (lateral walls, biaxial platens; the base too unless base_friction is set)", 0, 0},
     {"material", "wall_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(wall.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-wall cohesion force", 0},
+     "element-wall cohesion force", 0, 0},
     {"material", "wall_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(wall.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-wall breaking strain", 0},
+     "bonded: element-wall breaking strain", 0, 0},
     {"material", "base_friction", CDEM_PTYPE_DOUBLE, P_OFF(base.friction), 0, "", "wall", 0, 10, 0, 0, as_wall_words,
-     "element-base friction coefficient (the base row; biaxial: the bottom platen); wall = wall_friction", 0},
+     "element-base friction coefficient (the base row; biaxial: the bottom platen); wall = wall_friction", 0, 0},
     {"material", "base_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(base.cohesion), 0, "N", "wall", 0, 1e15, 0, 0, as_wall_words,
-     "element-base cohesion force; wall = wall_cohesion", 0},
+     "element-base cohesion force; wall = wall_cohesion", 0, 0},
     {"material", "base_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(base.breaking_strain), 0, "", "wall", 0, 1, 1, 0, as_wall_words,
-     "bonded: element-base breaking strain; wall = wall_breaking_strain", 0},
+     "bonded: element-base breaking strain; wall = wall_breaking_strain", 0, 0},
     {"material", "fault_friction", CDEM_PTYPE_DOUBLE, P_OFF(fault.friction), 0, "", "0.25", 0, 10, 0, 0, NULL,
-     "element-fault friction coefficient (set 0 for CH kinematics)", 0},
+     "element-fault friction coefficient (set 0 for CH kinematics)", 0, 0},
     {"material", "fault_cohesion", CDEM_PTYPE_DOUBLE, P_OFF(fault.cohesion), 0, "N", "5e9", 0, 1e15, 0, 0, NULL,
-     "element-fault cohesion force (set 0 for CH kinematics)", 0},
+     "element-fault cohesion force (set 0 for CH kinematics)", 0, 0},
     {"material", "fault_breaking_strain", CDEM_PTYPE_DOUBLE, P_OFF(fault.breaking_strain), 0, "", "0.02", 0, 1, 1, 0, NULL,
-     "bonded: element-fault breaking strain", 0},
+     "bonded: element-fault breaking strain", 0, 0},
+    /* the laws' own coefficients, in laws.def's order */
+#define CDEM_PARAM_ROWS
+#include "laws/laws.def"
+#undef CDEM_PARAM_ROWS
 
     {"heterogeneity", "flexural_slip", CDEM_PTYPE_BOOL, P_OFF(flexural_slip), 0, "", "off", 0, 1, 0, 0, NULL,
-     "contacts between different pre-growth layers have no friction/cohesion (or no bond)", 0},
+     "contacts between different pre-growth layers have no friction/cohesion (or no bond)", 0, 0},
     {"heterogeneity", "flexural_slip_style", CDEM_PTYPE_ENUM, P_OFF(flexural_slip_style), 0, "", "layer-contacts", 0, 0, 0, 0, flex_words,
-     "which contacts flexural slip makes strengthless: every contact between two different pre-growth layers (layer-contacts, the manual's and the paper's), or every contact of an element of layers 4, 8, 12, 16 and 20 (weak-layers, the original's versions 4.1-4.2)", 0},
+     "which contacts flexural slip makes strengthless: every contact between two different pre-growth layers (layer-contacts, the manual's and the paper's), or every contact of an element of layers 4, 8, 12, 16 and 20 (weak-layers, the original's versions 4.1-4.2)", 0, 0},
     {"heterogeneity", "weak_interval", CDEM_PTYPE_ENUM, P_OFF(weak_interval), 0, "", "off", 0, 0, 0, 0, weak_words,
-     "weak and/or light interval at the bottom (lower) or top (upper) of the assembly", 0},
+     "weak and/or light interval at the bottom (lower) or top (upper) of the assembly", 0, 0},
     {"heterogeneity", "weak_thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_thickness_percent), 0, "%", "50", 0, 100, 0, 0, NULL,
-     "thickness of the weak interval, % of the assembly height", 0},
+     "thickness of the weak interval, % of the assembly height", 0, 0},
     {"heterogeneity", "weak_strength_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_strength_percent), 0, "%", "0", 0, 100, 0, 0, NULL,
-     "strength kept in the weak interval, % of the material values (0 = frictionless/unbonded)", 0},
+     "strength kept in the weak interval, % of the material values (0 = frictionless/unbonded)", 0, 0},
     {"heterogeneity", "weak_density_percent", CDEM_PTYPE_DOUBLE, P_OFF(weak_density_percent), 0, "%", "100", 50, 100, 0, 0, NULL,
-     "density of the weak interval, % of the density", 0},
+     "density of the weak interval, % of the density", 0, 0},
     {"heterogeneity", "layered_friction", CDEM_PTYPE_BOOL, P_OFF(layered_friction), 0, "", "off", 0, 1, 0, 0, NULL,
-     "layers 5-8, 13-16 and 21-24 take layered_friction_value (granular only)", 0},
+     "layers 5-8, 13-16 and 21-24 take layered_friction_value (granular only)", 0, 0},
     {"heterogeneity", "layered_friction_value", CDEM_PTYPE_DOUBLE, P_OFF(layered_friction_value), 0, "", "0.1", 0, 10, 0, 0, NULL,
-     "friction coefficient of layers 5-8, 13-16 and 21-24", 0},
+     "friction coefficient of layers 5-8, 13-16 and 21-24", 0, 0},
 
     {"boundary", "mode", CDEM_PTYPE_ENUM, P_OFF(mode), 0, "", "planar-fault", 0, 0, 0, 0, mode_words,
-     "boundary / faulting mode", 0},
-    {"boundary", "fault_sense", CDEM_PTYPE_ENUM, P_OFF(fault_sense), 0, "", "normal", 0, 0, 0, 0, sense_words,
-     "planar/listric/irregular fault: normal or reverse displacement", 0},
-    {"boundary", "fault_location", CDEM_PTYPE_DOUBLE, P_OFF(fault_location), 0, "", "0.5", 0, 1, 1, 1, NULL,
-     "fault location at the base, fraction of the base length", 0},
-    {"boundary", "fault_dip", CDEM_PTYPE_DOUBLE, P_OFF(fault_dip), 0, "degrees", "30", 0, 90, 1, 0, NULL,
-     "planar: fault dip; listric: dip of the lowest segment (it steepens to 90)", 0},
-    {"boundary", "inversion", CDEM_PTYPE_BOOL, P_OFF(inversion), 0, "", "off", 0, 1, 0, 0, NULL,
-     "invert the fault sense during the run (planar/listric/irregular)", 0},
-    {"boundary", "inversion_percent", CDEM_PTYPE_DOUBLE, P_OFF(inversion_percent), 0, "%", "50", 0, 100, 1, 1, NULL,
-     "% of the total displacement at which the sense inverts", 0},
-    {"boundary", "kinematics", CDEM_PTYPE_ENUM, P_OFF(kinematics), 0, "", "ch", 0, 0, 0, 0, kin_words,
-     "listric/irregular: constant heave (ch) or constant displacement (cd, mylar sheet)", 0},
-    {"boundary", "fault_file", CDEM_PTYPE_STRING, P_OFF(fault_file), CDEM_PATH_MAX, "", "", 0, 0, 0, 0, NULL,
-     "irregular fault: text file of x y vertices in m, from the base up-dip", 0},
-    {"boundary", "vertical_fault_location", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_location), 0, "", "0.35", 0, 1, 1, 1, NULL,
-     "two vertical faults: first fault, fraction of the base length", 0},
-    {"boundary", "vertical_fault_spacing", CDEM_PTYPE_DOUBLE, P_OFF(vertical_fault_spacing), 0, "", "0.3", 0, 1, 1, 1, NULL,
-     "two vertical faults: distance to the second fault, fraction of the base length", 0},
-    {"boundary", "vertical_sense", CDEM_PTYPE_ENUM, P_OFF(vertical_sense), 0, "", "caldera", 0, 0, 0, 0, vert_words,
-     "two vertical faults: caldera (block down, extension) or piston (block up, compression)", 0},
-    {"boundary", "detachment_walls", CDEM_PTYPE_ENUM, P_OFF(detachment_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
-     "detachment: right wall moving, or both walls moving inward (each at the boundary speed)", 0},
-    {"boundary", "detachment_sense", CDEM_PTYPE_ENUM, P_OFF(detachment_sense), 0, "", "shortening", 0, 0, 0, 0, detach_sense_words,
-     "detachment: the moving walls go inward (shortening) or outward (extension)", 0},
-    {"boundary", "repose_walls", CDEM_PTYPE_ENUM, P_OFF(repose_walls), 0, "", "right", 0, 0, 0, 0, walls_words,
-     "repose-collapse: right wall removed, or both, after equilibration", 0},
-    {"boundary", "confining_pressure", CDEM_PTYPE_DOUBLE, P_OFF(confining_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
-     "biaxial: confining pressure on the free edges (Pa in 3-D; 0 = uniaxial)", 0},
+     "boundary / faulting mode", 0, 0},
+    /* the modes' own keys, in modes.def's order */
+#define CDEM_PARAM_ROWS
+#include "modes.def"
+#undef CDEM_PARAM_ROWS
     {"boundary", "start", CDEM_PTYPE_DOUBLE, P_OFF(window_start), 0, "m", "0", 0, 1e9, 0, 0, NULL,
-     "the run's boundary displacement (the display interval's clock) before this boundary moves", 1},
+     "the run's boundary displacement (the display interval's clock) before this boundary moves", 1, 0},
     {"boundary", "stop", CDEM_PTYPE_DOUBLE, P_OFF(window_stop), 0, "m", "0", 0, 1e9, 0, 0, NULL,
-     "the run's boundary displacement at which this boundary stops (0 = the end of the run)", 1},
+     "the run's boundary displacement at which this boundary stops (0 = the end of the run)", 1, 0},
 
     {"surface", "overburden_pressure", CDEM_PTYPE_DOUBLE, P_OFF(overburden_pressure), 0, "N/m", "0", 0, 1e9, 0, 0, NULL,
-     "vertical pressure on the top surface (0 = off)", 0},
+     "vertical pressure on the top surface (0 = off)", 0, 0},
     {"surface", "erosion", CDEM_PTYPE_BOOL, P_OFF(erosion), 0, "", "off", 0, 1, 0, 0, NULL,
-     "remove elements above the erosion base level", 0},
+     "remove elements above the erosion base level", 0, 0},
     {"surface", "erosion_base_level", CDEM_PTYPE_DOUBLE, P_OFF(erosion_base_level), 0, "", "1", 1, 10, 0, 0, NULL,
-     "erosion base level, multiple of the assembly height", 0},
+     "erosion base level, multiple of the assembly height", 0, 0},
     {"surface", "sedimentation", CDEM_PTYPE_BOOL, P_OFF(sedimentation), 0, "", "off", 0, 1, 0, 0, NULL,
-     "syn-tectonic sedimentation below sea level (growth strata)", 0},
+     "syn-tectonic sedimentation below sea level (growth strata)", 0, 0},
     {"surface", "sea_level_rise", CDEM_PTYPE_ENUM, P_OFF(sea_level_rise), 0, "", "null", 0, 0, 0, 0, sea_words,
-     "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0", 0},
+     "sea-level rise per boundary displacement: factor 0, 0.25, 0.5, 0.75, 1.0", 0, 0},
     {"surface", "growth_sequence1_layers", CDEM_PTYPE_INT, P_OFF(growth_sequence1_layers), 0, "", "10", 1, 1000, 0, 0, NULL,
-     "growth layers coloured as growth sequence 1 (the rest are sequence 2)", 0},
+     "growth layers coloured as growth sequence 1 (the rest are sequence 2)", 0, 0},
 
-    {"salt", "layer", CDEM_PTYPE_ENUM, P_OFF(salt_layer), 0, "", "off", 0, 0, 0, 0, salt_layer_words,
-     "viscous salt: none (off), the lowest part of the assembly (basal) or an interval of the pre-growth layers (interval), fixed at assembly", 0},
-    {"salt", "thickness_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_thickness_percent), 0, "%", "25", 0, 100, 1, 1, NULL,
-     "basal: the salt's thickness, % of the span of element centres (it must leave a cover)", 0},
-    {"salt", "interval_bottom_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_bottom_percent), 0, "%", "20", 0, 100, 0, 0, NULL,
-     "interval: the salt's base, % of the span of element centres above the lowest", 0},
-    {"salt", "interval_top_percent", CDEM_PTYPE_DOUBLE, P_OFF(salt_interval_top_percent), 0, "%", "40", 0, 100, 0, 0, NULL,
-     "interval: the salt's top, % of the span of element centres above the lowest", 0},
-    {"salt", "viscosity", CDEM_PTYPE_DOUBLE, P_OFF(salt_viscosity), 0, "Pa s", "1e18", 1e15, 1e21, 0, 0, NULL,
-     "the salt's geological (Newtonian) viscosity; the model's is viscosity / time_scale", 0},
-    {"salt", "salt_density", CDEM_PTYPE_DOUBLE, P_OFF(salt_density), 0, "kg/m^3", "2200", 1000, 3500, 0, 0, NULL,
-     "the salt's density (halite 2160)", 0},
-    {"salt", "rate", CDEM_PTYPE_DOUBLE, P_OFF(salt_rate), 0, "mm/yr", "1", 0.01, 100, 0, 0, NULL,
-     "the geological speed the boundary speed stands for: time_scale = boundary speed / rate", 0},
-    {"salt", "time_scale", CDEM_PTYPE_DOUBLE, P_OFF(salt_time_scale), 0, "", "rate", 1, 1e16, 0, 0, from_rate_words,
-     "geological seconds per model second (modes without a moving boundary); rate = from salt.rate", 0},
-    {"salt", "bulk_modulus", CDEM_PTYPE_DOUBLE, P_OFF(salt_bulk_modulus), 0, "Pa", "2.5e10", 1e8, 1e12, 0, 0, NULL,
-     "the salt's bulk modulus K: pressure K (1/J - 1) for an area ratio J; halite's, about 25 GPa, "
-     "by default (the salt's area changes by p / K: 0.4 % under 4 km of cover)", 0},
-    {"salt", "grid_spacing", CDEM_PTYPE_DOUBLE, P_OFF(salt_grid_spacing), 0, "mean radii", "4.5", 3, 8, 0, 0, NULL,
-     "node spacing of the grid that carries the salt's stress", 0},
-    {"salt", "reach", CDEM_PTYPE_DOUBLE, P_OFF(salt_reach), 0, "", "1.5", 1, 2, 0, 0, NULL,
-     "the salt's pair dashpots act up to reach x (r_i + r_j)", 0},
-    {"salt", "dashpot_fraction", CDEM_PTYPE_DOUBLE, P_OFF(salt_dashpot_fraction), 0, "", "0.1", 0, 1, 0, 0, NULL,
-     "the salt's pair dashpots (which damp the element motions the grid cannot see), as a fraction of a dashpot network of the salt's viscosity", 0},
-    {"salt", "cover_contact", CDEM_PTYPE_ENUM, P_OFF(salt_cover_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "no-slip: cover elements next to the salt join its grid (the salt sticks to them); free-slip: only the pair law", 0},
-    {"salt", "base_contact", CDEM_PTYPE_ENUM, P_OFF(salt_base_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "the same for the base and the fault elements", 0},
-    {"salt", "wall_contact", CDEM_PTYPE_ENUM, P_OFF(salt_wall_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
-     "the same for the lateral walls", 0},
+    /* the processes' own sections, in processes.def's order */
+#define CDEM_PARAM_ROWS
+#include "processes.def"
+#undef CDEM_PARAM_ROWS
 
     {"output", "prefix", CDEM_PTYPE_STRING, P_OFF(prefix), sizeof(((cdem_params *)0)->prefix), "", "cdem", 0, 0, 0, 0, NULL,
-     "prefix of per-increment export files (cdem282.txt)", 0},
+     "prefix of per-increment export files (cdem282.txt)", 0, 0},
     {"output", "total_strain_max", CDEM_PTYPE_DOUBLE, P_OFF(total_strain_max), 0, "", "2", 0.1, 5, 0, 0, NULL,
-     "colour-bar maximum for total strain", 0},
+     "colour-bar maximum for total strain", 0, 0},
     {"output", "series_interval", CDEM_PTYPE_INT, P_OFF(series_interval), 0, "steps", "100", 1, 1000000, 0, 0, NULL,
-     "time steps between time-series samples", 0},
+     "time steps between time-series samples", 0, 0},
     {"output", "checkpoint_interval", CDEM_PTYPE_INT, P_OFF(checkpoint_interval), 0, "increments", "10", 0, 1000000, 0, 0, NULL,
-     "display increments between checkpoints that cdem-run --resume continues from (0 = none)", 0},
+     "display increments between checkpoints that cdem-run --resume continues from (0 = none)", 0, 0},
 };
 /* clang-format on */
 
@@ -313,7 +271,16 @@ const char *cdem_law_description(cdem_granular_law law) {
 }
 
 const char *cdem_mode_name(cdem_mode mode) {
-    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_names[mode] : "unknown";
+    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_rows[mode].word : "unknown";
+}
+
+cdem_mode_clock cdem_mode_clock_of(cdem_mode mode) {
+    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_rows[mode].clock
+                                                    : CDEM_CLOCK_DISPLACEMENT;
+}
+
+const char *cdem_mode_description(cdem_mode mode) {
+    return (int)mode >= 0 && mode < CDEM_MODE_COUNT ? mode_rows[mode].description : "?";
 }
 
 int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base) {
@@ -1067,7 +1034,7 @@ void cdem_params_format_value(const cdem_params *p, const cdem_param_def *def, c
 }
 
 int cdem_params_recorded(const cdem_params *p, const cdem_param_def *d) {
-    if (!d->recorded_when_set)
+    if (!d->recorded_when_set && !d->fixture)
         return 1;
     cdem_params def;
     memset(&def, 0, sizeof def);
@@ -1098,6 +1065,8 @@ static void write_params(const cdem_params *p, FILE *out, int record) {
     const char *cur = "";
     for (size_t i = 0; i < N_PARAMS; i++) {
         const cdem_param_def *d = &param_table[i];
+        if (d->fixture && !(record && cdem_params_recorded(p, d)))
+            continue; /* a fixture's key: in a record when set, else nowhere */
         if (strcmp(d->section, cur) != 0) {
             if (strcmp(cur, "boundary") == 0)
                 write_actors(p, out);
@@ -1167,7 +1136,8 @@ cdem_status cdem_params_actor(const cdem_params *p, int j, cdem_params *out, cde
         return CDEM_OK;
     /* the window is the actor's own: start and stop from its section, else their defaults */
     for (size_t i = 0; i < N_PARAMS; i++)
-        if (param_table[i].recorded_when_set && strcmp(param_table[i].section, "boundary") == 0)
+        if (param_table[i].offset == P_OFF(window_start) ||
+            param_table[i].offset == P_OFF(window_stop))
             CDEM_TRY(assign_value(out, &param_table[i], param_table[i].def, "defaults", err));
     char where[32];
     snprintf(where, sizeof where, "[boundary.%d]", j + 1);
@@ -1224,6 +1194,8 @@ void cdem_params_write_markdown(FILE *out) {
                  "|---|---|---|---|---|---|---|\n");
     for (size_t i = 0; i < N_PARAMS; i++) {
         const cdem_param_def *d = &param_table[i];
+        if (d->fixture)
+            continue; /* no user's key */
         char allowed[256];
         describe_allowed(d, allowed, sizeof allowed);
         fprintf(out, "| %s | `%s` | %s | ", d->section, d->key, type_name(d->type));
@@ -1240,6 +1212,28 @@ void cdem_params_write_markdown(FILE *out) {
         md_cell(out, allowed);
         fputs(" | ", out);
         md_cell(out, d->help);
+        fputs(" |\n", out);
+    }
+}
+
+void cdem_params_write_laws_markdown(FILE *out) {
+    if (!out)
+        return;
+    fprintf(out, "| `material.granular_law` | what it does |\n|---|---|\n");
+    for (int law = 0; law < CDEM_LAW_WORDS; law++) {
+        fprintf(out, "| `%s` | ", law_rows[law].word);
+        md_cell(out, law_rows[law].description);
+        fputs(" |\n", out);
+    }
+}
+
+void cdem_params_write_modes_markdown(FILE *out) {
+    if (!out)
+        return;
+    fprintf(out, "| `boundary.mode` | what it does |\n|---|---|\n");
+    for (int mode = 0; mode < CDEM_MODE_WORDS; mode++) {
+        fprintf(out, "| `%s` | ", mode_rows[mode].word);
+        md_cell(out, mode_rows[mode].description);
         fputs(" |\n", out);
     }
 }

@@ -5,6 +5,15 @@
  * default, range or allowed words, one-line help, offset into cdem_params) is the single
  * source of truth: parsing, validation, --print-defaults, docs/parameters.md, the
  * parameter record stored in every output file and the summary all read it.
+ * Gathered into it: a law, a mode or a process that has parameters of its own declares them
+ * in its own file (common/laws/law_<name>.h, common/modes/<id>.h, common/processes/<id>.h),
+ * in four parts that this header and params.c include through the registries (laws.def,
+ * modes.def, processes.def): its enums (CDEM_PARAM_TYPES), its fields of cdem_params
+ * (CDEM_PARAM_FIELDS, in its section's place: a law's in [material], a mode's in
+ * [boundary], a process's in its own section, CDEM_PARAM_SECTIONS), the words of its enum
+ * keys (CDEM_PARAM_WORDS) and its rows (CDEM_PARAM_ROWS, written as the table's, with
+ * P_OFF(field) and NOMAX). Adding one touches no line here or in params.c. The fields keep
+ * flat names (p->fault_dip), so a key's owner can change without its readers changing.
  * Parameter files are INI ("[section]" then "key = value"; '#' or ';' start comments;
  * CRLF accepted). Values are SI units (m, s, kg/m^3, N, N/m) unless the unit says otherwise.
  * Ownership: cdem_params is a plain value (no pointers except fault_file, a fixed buffer);
@@ -50,47 +59,39 @@ typedef enum {
     CDEM_COHESIVE_INITIAL = 2,      /* contacts of the built assembly still touching then */
 } cdem_cohesive_contacts;
 
+/* What an increment of a mode's run is measured by (its row in common/modes/<id>.h): the
+ * boundary displacement (m), the time (s: a mode without moving boundaries, whose display
+ * interval is in seconds) or the axial strain (the biaxial test). The analysis labels an
+ * increment with it. */
+typedef enum {
+    CDEM_CLOCK_DISPLACEMENT = 0,
+    CDEM_CLOCK_TIME = 1,
+    CDEM_CLOCK_AXIAL_STRAIN = 2,
+} cdem_mode_clock;
+
 /* Boundary (faulting) modes, one CDEM_MODE_<ID> per row of common/modes.def (docs/solver.md
  * section 4): the modes of parameter files first, then the tests' fixtures. */
 typedef enum {
-#define CDEM_MODE(ID, id, word) CDEM_MODE_##ID,
+#define CDEM_MODE(ID, id, word, clock, description) CDEM_MODE_##ID,
 #include "modes.def"
 #undef CDEM_MODE
     CDEM_MODE_WORDS, /* the number of modes a parameter file can name */
     CDEM_MODE_TESTS_BEFORE = CDEM_MODE_WORDS - 1,
-#define CDEM_TEST_MODE(ID, id, word) CDEM_MODE_##ID,
+#define CDEM_TEST_MODE(ID, id, word, clock, description) CDEM_MODE_##ID,
 #include "modes.def"
 #undef CDEM_TEST_MODE
     CDEM_MODE_COUNT /* every registered mode, the tests' included */
 } cdem_mode;
 
-typedef enum { CDEM_SENSE_NORMAL = 0, CDEM_SENSE_REVERSE = 1 } cdem_fault_sense;
-typedef enum {
-    CDEM_KIN_CH = 0,
-    CDEM_KIN_CD = 1
-} cdem_fault_kinematics; /* constant heave / displacement */
-typedef enum { CDEM_VERT_CALDERA = 0, CDEM_VERT_PISTON = 1 } cdem_vertical_sense;
+/* Which lateral walls a mode moves or removes: the right one, or both (a word several modes'
+ * keys share). */
 typedef enum { CDEM_WALLS_RIGHT = 0, CDEM_WALLS_BOTH = 1 } cdem_walls_choice;
-/* detachment: the moving walls go inward (shortening) or outward (extension, thin-skinned
- * extension of a cover spreading over its detachment, e.g. salt) */
-typedef enum { CDEM_DETACH_SHORTENING = 0, CDEM_DETACH_EXTENSION = 1 } cdem_detachment_sense;
 typedef enum { CDEM_WEAK_OFF = 0, CDEM_WEAK_LOWER = 1, CDEM_WEAK_UPPER = 2 } cdem_weak_interval;
 /* What damps the elements' motion (docs/solver.md, "Damping"). */
 typedef enum {
     CDEM_DAMPING_ABSOLUTE = 0, /* the paper's: a drag c v on each free element's velocity */
     CDEM_DAMPING_CONTACT = 1,  /* a normal dashpot on each contact: relative motion only */
 } cdem_damping_mode;
-/* Where the viscous salt is (salt.layer; solver/step/salt.h). */
-typedef enum {
-    CDEM_SALT_OFF = 0,
-    CDEM_SALT_BASAL = 1,    /* the lowest salt.thickness_percent of the assembly */
-    CDEM_SALT_INTERVAL = 2, /* between salt.interval_bottom_percent and _top_percent */
-} cdem_salt_layer_choice;
-/* How the salt meets a neighbour that is not salt (salt.*_contact). */
-typedef enum {
-    CDEM_SALT_NO_SLIP = 0,   /* the neighbour joins the salt's grid: the salt sticks to it */
-    CDEM_SALT_FREE_SLIP = 1, /* only the pair law (repulsion and a normal dashpot) */
-} cdem_salt_contact;
 /* Which contacts flexural slip makes strengthless. */
 typedef enum {
     CDEM_FLEX_LAYER_CONTACTS = 0, /* every contact between two different pre-growth layers */
@@ -103,6 +104,14 @@ typedef enum {
     CDEM_SEA_HIGH,     /* factor 0.75 */
     CDEM_SEA_VERY_HIGH /* factor 1.0 */
 } cdem_sea_level_rise;
+
+/* The enums of the parameters that laws, modes and processes own (their files' part
+ * CDEM_PARAM_TYPES; modes.def says what the parts are). */
+#define CDEM_PARAM_TYPES
+#include "laws/laws.def"
+#include "modes.def"
+#include "processes.def"
+#undef CDEM_PARAM_TYPES
 
 /* Per-contact-class material values (element-element, element-wall, element-fault). */
 typedef struct {
@@ -148,6 +157,10 @@ typedef struct {
     cdem_contact_material wall;    /* element-wall contacts (lateral walls, platens, the base) */
     cdem_contact_material base;    /* element-base contacts; NaN = the wall value (word "wall") */
     cdem_contact_material fault;   /* element-fault contacts */
+    /* the laws' own coefficients (their files' part CDEM_PARAM_FIELDS) */
+#define CDEM_PARAM_FIELDS
+#include "laws/laws.def"
+#undef CDEM_PARAM_FIELDS
 
     /* [heterogeneity] */
     int flexural_slip; /* 0/1: contacts between different pre-growth layers have no strength */
@@ -160,21 +173,11 @@ typedef struct {
     double layered_friction_value; /* friction coefficient of those layers, >= 0 */
 
     /* [boundary] */
-    cdem_mode mode;                         /* faulting / boundary mode */
-    cdem_fault_sense fault_sense;           /* planar/listric/irregular: normal or reverse */
-    double fault_location;                  /* fraction of the base length, 0-1 (exclusive) */
-    double fault_dip;                       /* degrees, planar: dip; listric: basal dip */
-    int inversion;                          /* 0/1: reverse the sense during the run */
-    double inversion_percent;               /* % of total displacement at which it inverts, 0-100 */
-    cdem_fault_kinematics kinematics;       /* listric/irregular: CH or CD */
-    char fault_file[CDEM_PATH_MAX];         /* irregular: text file of x y vertices in m */
-    double vertical_fault_location;         /* two vertical faults: first fault, fraction of base */
-    double vertical_fault_spacing;          /* distance to the second fault, fraction of base */
-    cdem_vertical_sense vertical_sense;     /* caldera (block down) or piston (block up) */
-    cdem_walls_choice detachment_walls;     /* right wall moving, or both */
-    cdem_detachment_sense detachment_sense; /* walls inward (shortening) or outward */
-    cdem_walls_choice repose_walls;         /* right wall removed, or both */
-    double confining_pressure;              /* biaxial: N/m on the free edges, >= 0 */
+    cdem_mode mode; /* faulting / boundary mode */
+    /* the modes' own keys (their files' part CDEM_PARAM_FIELDS, common/modes/) */
+#define CDEM_PARAM_FIELDS
+#include "modes.def"
+#undef CDEM_PARAM_FIELDS
     double window_start; /* m of the run's boundary displacement before the actor moves, >= 0 */
     double window_stop;  /* m of it at which the actor stops; 0: the end of the run */
 
@@ -192,19 +195,10 @@ typedef struct {
     cdem_sea_level_rise sea_level_rise; /* null, low, mid, high, very-high */
     int growth_sequence1_layers;        /* growth layers in growth sequence 1, >= 1 */
 
-    /* [salt] (docs/solver.md, "Salt") */
-    cdem_salt_layer_choice salt_layer; /* off, basal or interval */
-    double salt_thickness_percent;     /* basal: % of the span of element centres, (0, 100) */
-    double salt_interval_bottom_percent, salt_interval_top_percent; /* interval: % of the span */
-    double salt_viscosity;        /* Pa s, geological (Newtonian) */
-    double salt_density;          /* kg/m^3 */
-    double salt_rate;             /* mm/yr: the geological speed of the model's boundary speed */
-    double salt_time_scale;       /* S, geological s per model s; NaN = from salt_rate ("rate") */
-    double salt_bulk_modulus;     /* Pa: p = K (1/J - 1) */
-    double salt_grid_spacing;     /* node spacing of the salt's grid, in mean radii */
-    double salt_reach;            /* the pair dashpots reach reach x (r_i + r_j) */
-    double salt_dashpot_fraction; /* the pair dashpots' coefficient, x beta x viscosity */
-    cdem_salt_contact salt_cover_contact, salt_base_contact, salt_wall_contact;
+    /* the processes' sections (their files' part CDEM_PARAM_FIELDS, common/processes/) */
+#define CDEM_PARAM_FIELDS
+#include "processes.def"
+#undef CDEM_PARAM_FIELDS
 
     /* [output] */
     char prefix[64];         /* prefix for per-increment exports (cdem282.txt) */
@@ -238,6 +232,10 @@ typedef struct {
     int recorded_when_set;      /* 1: a run file's parameter record holds it only when it
                                    differs from its default (keys added since, so that the
                                    records of runs that leave them alone stay as they were) */
+    int fixture;                /* 1: a key of a tests' fixture (a CDEM_TEST_MODE's, ...): it
+                                   parses and is recorded when set (as recorded_when_set),
+                                   but --print-defaults, docs/parameters.md, the man page
+                                   and the completion do not list it */
 } cdem_param_def;
 
 /* The table, in file order. */
@@ -322,6 +320,12 @@ cdem_status cdem_params_actor(const cdem_params *p, int j, cdem_params *out, cde
  * range/values, help) for docs/parameters.md. Added for `cdem-run --params-markdown`. */
 void cdem_params_write_markdown(FILE *out);
 
+/* The registries' tables for docs/solver.md, from their rows' descriptions: the granular
+ * laws a parameter file can name (`cdem-run --laws-markdown`) and the boundary modes
+ * (`--modes-markdown`); the tests' fixtures are not listed. */
+void cdem_params_write_laws_markdown(FILE *out);
+void cdem_params_write_modes_markdown(FILE *out);
+
 /* The element-base material in force: material.base_* where set, the wall's value where a
  * base key is the word "wall" (stored as NaN). Returns 1 when any base key has a value of its
  * own, 0 when the base is the wall throughout. */
@@ -329,6 +333,11 @@ int cdem_params_base_material(const cdem_params *p, cdem_contact_material *base)
 
 /* A mode's word (a test fixture's too), from its row; "unknown" for a value that is none. */
 const char *cdem_mode_name(cdem_mode mode);
+/* What an increment of a mode's run is measured by, from its row (a value that is no mode:
+ * the displacement). */
+cdem_mode_clock cdem_mode_clock_of(cdem_mode mode);
+/* A mode's one-line description, from its row; "?" for a value that is no mode. */
+const char *cdem_mode_description(cdem_mode mode);
 
 /* A law's word (a test fixture's too) and its one-line description, from its row; "?" for
  * a value that is no law. */

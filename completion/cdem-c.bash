@@ -12,7 +12,7 @@ _cdem_run() {
         --par-min) return ;;
     esac
     if [[ "$cur" == -* ]]; then
-        COMPREPLY=($(compgen -W "-o --force -s -q --quiet --summary --dry-run --print-defaults --params-markdown --max-steps --resume --threads --par-min --ignore-free-space --no-fsync -V --version -h --help -" -- "$cur"))
+        COMPREPLY=($(compgen -W "-o --force -s -q --quiet --summary --dry-run --print-defaults --params-markdown --laws-markdown --modes-markdown --max-steps --resume --threads --par-min --ignore-free-space --no-fsync -V --version -h --help -" -- "$cur"))
     else
         COMPREPLY=($(compgen -f -- "$cur"))
     fi

@@ -7,7 +7,8 @@
  * output file is still valid and records where it stopped). An existing output is never
  * replaced without --force, and a file that is not a cdem run file never. Messages go to stderr as
  * "cdem-run: <message>", one line per problem; the summary and the --print-defaults /
- * --params-markdown texts go to stdout so they can be redirected into files. */
+ * --params-markdown (--laws-markdown, --modes-markdown) texts go to stdout so they can be
+ * redirected into files. */
 #include "bc.h"
 #include "h5format.h"
 #include "model.h"
@@ -55,7 +56,8 @@ static void on_signal(int sig) {
  * every option in it appears in the synopsis and is accepted by parse_args. */
 static const char *const run_forms[] = {
     "[MODEL.ini|-] [-o OUT.h5] [-s section.key=value]... [-q] [--summary] [--dry-run] "
-    "[--print-defaults] [--params-markdown] [--max-steps N] [--threads N] [--par-min N] [--force] "
+    "[--print-defaults] [--params-markdown] [--laws-markdown] [--modes-markdown] [--max-steps N] "
+    "[--threads N] [--par-min N] [--force] "
     "[--ignore-free-space] [--no-fsync]",
     "--resume RUN.h5 [-q] [--max-steps N] [--threads N] [--par-min N] [--no-fsync]",
     "-V|--version | -h|--help", NULL};
@@ -78,6 +80,10 @@ static const cdem_cli_option run_options[] = {
      "print a complete commented parameter file of the effective values (defaults + file + "
      "overrides) and exit"},
     {"--params-markdown", NULL, "print the parameter table in markdown (docs/parameters.md)"},
+    {"--laws-markdown", NULL,
+     "print the table of the granular contact laws in markdown (docs/solver.md, section 1)"},
+    {"--modes-markdown", NULL,
+     "print the table of the boundary modes in markdown (docs/solver.md, section 4)"},
     {"--max-steps", "N",
      "stop after N time steps (tests, benchmarks); the file records \"stopped-early\""},
     {"--resume", "RUN.h5",
@@ -147,6 +153,8 @@ typedef struct {
     int dry_run;             /* --dry-run */
     int print_defaults;      /* --print-defaults */
     int params_markdown;     /* --params-markdown */
+    int laws_markdown;       /* --laws-markdown */
+    int modes_markdown;      /* --modes-markdown */
     int help, version;       /* -h/--help, --version */
     long max_steps;          /* --max-steps, 0 = no limit */
     const char *resume_path; /* --resume RUN.h5, or NULL */
@@ -193,6 +201,10 @@ static int parse_args(int argc, char **argv, cli_args *a) {
             a->print_defaults = 1;
         } else if (strcmp(arg, "--params-markdown") == 0) {
             a->params_markdown = 1;
+        } else if (strcmp(arg, "--laws-markdown") == 0) {
+            a->laws_markdown = 1;
+        } else if (strcmp(arg, "--modes-markdown") == 0) {
+            a->modes_markdown = 1;
         } else if (strcmp(arg, "-o") == 0) {
             if (i + 1 >= argc)
                 return usage_error("option %s needs a file name", arg, NULL);
@@ -407,7 +419,7 @@ static int resume(const cli_args *a, cdem_error *err) {
     return st == CDEM_ERR_INTERRUPTED ? EXIT_INTERRUPTED : EXIT_ERROR;
 }
 
-/* --help, --version and --params-markdown: the texts that need no model. Returns 1 when
+/* --help, --version and the markdown tables: the texts that need no model. Returns 1 when
  * one of them was asked for (and printed), else 0. */
 static int print_info(const cli_args *a) {
     if (a->help) {
@@ -420,6 +432,14 @@ static int print_info(const cli_args *a) {
     }
     if (a->params_markdown) {
         cdem_params_write_markdown(stdout);
+        return 1;
+    }
+    if (a->laws_markdown) {
+        cdem_params_write_laws_markdown(stdout);
+        return 1;
+    }
+    if (a->modes_markdown) {
+        cdem_params_write_modes_markdown(stdout);
         return 1;
     }
     return 0;

@@ -115,8 +115,8 @@ static void test_actors_parse_write_read(void **state) {
     const cdem_param_def *t = cdem_params_table(&n);
     int left_out = 0;
     for (size_t i = 0; i < n; i++)
-        left_out += !cdem_params_recorded(&d, &t[i]);
-    assert_int_equal(left_out, 2); /* start and stop */
+        left_out += !t[i].fixture && !cdem_params_recorded(&d, &t[i]);
+    assert_int_equal(left_out, 2); /* start and stop (a tests' fixture's keys aside) */
     rec = written(&p, 1);
     assert_non_null(strstr(rec, "\nstop = 15\n")); /* set: recorded */
     free(rec);

@@ -100,6 +100,8 @@ static void test_cli_print_defaults_round_trip(void **state) {
     const cdem_param_def *t = cdem_params_table(&n);
     for (size_t i = 0; i < n; i++) {
         char a[1100], b[1100];
+        if (t[i].fixture)
+            continue; /* a tests' fixture's key: listed nowhere (params.h) */
         cdem_params_format_value(&p, &t[i], a, sizeof a);
         cdem_params_format_value(&d, &t[i], b, sizeof b);
         assert_string_equal(a, b);

@@ -747,6 +747,18 @@ static void test_params_write_round_trip_defaults(void **state) {
     memset(&q, 0, sizeof q); /* parse over zeros: every key must be present in the text */
     q.mode = CDEM_MODE_BIAXIAL;
     assert_int_equal(cdem_params_parse_text(&q, text, "written.ini", &err), CDEM_OK);
+    /* but a fixture's (params.h): listed nowhere, so it keeps what the parse started from */
+    size_t n;
+    const cdem_param_def *t = cdem_params_table(&n);
+    for (size_t i = 0; i < n; i++)
+        if (t[i].fixture) {
+            assert_null(strstr(text, t[i].key));
+            memcpy((char *)&q + t[i].offset, (char *)&p + t[i].offset,
+                   t[i].type == CDEM_PTYPE_STRING   ? t[i].size
+                   : t[i].type == CDEM_PTYPE_DOUBLE ? sizeof(double)
+                   : t[i].type == CDEM_PTYPE_LONG   ? sizeof(long)
+                                                    : sizeof(int));
+        }
     assert_true(params_equal(&p, &q));
     free(text);
 }
@@ -762,6 +774,8 @@ static void test_params_write_round_trip_changed_values(void **state) {
     for (size_t i = 0; i < n; i++) {
         const cdem_param_def *d = &t[i];
         char *f = (char *)&p + d->offset;
+        if (d->fixture)
+            continue; /* a fixture's key is not written (params.h): it keeps its default */
         if (d->type == CDEM_PTYPE_DOUBLE) {
             double v = d->min + (d->max - d->min) / 3.0;
             memcpy(f, &v, sizeof v);
@@ -805,6 +819,25 @@ static void test_params_format_value(void **state) {
     assert_string_equal(buf, "");
 }
 
+/* The text of docs/<name> (malloc'd), from the tests' data folder or the working directory. */
+static char *read_doc(const char *name) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/../../docs/%s", data_dir(), name);
+    FILE *doc = fopen(path, "rb");
+    if (!doc) {
+        snprintf(path, sizeof path, "docs/%s", name);
+        doc = fopen(path, "rb");
+    }
+    assert_non_null(doc);
+    const size_t cap = 1 << 21;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    size_t got = fread(text, 1, cap - 1, doc);
+    fclose(doc);
+    text[got] = '\0';
+    return text;
+}
+
 static void test_params_markdown_and_docs_current(void **state) {
     (void)state;
     char *md = NULL;
@@ -816,31 +849,49 @@ static void test_params_markdown_and_docs_current(void **state) {
     assert_non_null(strstr(md, "| physics | `gravity` | real | `9.81` | m/s^2 | 0.5 to 25 |"));
     assert_non_null(
         strstr(md, "| boundary | `fault_dip` | real | `30` | degrees | > 0 and <= 90 |"));
-    size_t n;
-    cdem_params_table(&n);
+    size_t n, fixtures = 0;
+    const cdem_param_def *t = cdem_params_table(&n);
+    for (size_t i = 0; i < n; i++)
+        fixtures += t[i].fixture != 0; /* not a user's key: not listed */
     size_t rows = 0;
     for (const char *c = md; *c; c++)
         rows += *c == '\n';
-    assert_int_equal(rows, n + 2);
+    assert_int_equal(rows, n - fixtures + 2);
     /* docs/parameters.md must contain the current table (regenerate it with
      * `build/cdem-run --params-markdown` when the table changes) */
-    char path[1200];
-    snprintf(path, sizeof path, "%s/../../docs/parameters.md", data_dir());
-    FILE *doc = fopen(path, "rb");
-    if (!doc)
-        doc = fopen("docs/parameters.md", "rb");
-    assert_non_null(doc);
-    char *text = malloc(1 << 20);
-    assert_non_null(text);
-    size_t got = fread(text, 1, (1 << 20) - 1, doc);
-    fclose(doc);
-    text[got] = '\0';
+    char *text = read_doc("parameters.md");
     if (!strstr(text, md))
         print_error("docs/parameters.md is stale: regenerate its table with "
                     "`build/cdem-run --params-markdown`\n");
     assert_non_null(strstr(text, md));
     free(text);
     free(md);
+}
+
+/* docs/solver.md holds the laws' and the modes' tables as the program prints them from the
+ * registries' rows (regenerate with `build/cdem-run --laws-markdown` / `--modes-markdown`). */
+static void test_params_registry_tables_in_docs(void **state) {
+    (void)state;
+    void (*writers[2])(FILE *) = {cdem_params_write_laws_markdown,
+                                  cdem_params_write_modes_markdown};
+    const char *flags[2] = {"--laws-markdown", "--modes-markdown"};
+    char *text = read_doc("solver.md");
+    for (int k = 0; k < 2; k++) {
+        char *md = NULL;
+        size_t len = 0;
+        FILE *f = open_memstream(&md, &len);
+        assert_non_null(f);
+        writers[k](f);
+        fclose(f);
+        /* every word of the registry a file can name is a row; no fixture is */
+        assert_non_null(strstr(md, k == 0 ? "| `coulomb` | " : "| `planar-fault` | "));
+        assert_null(strstr(md, "test-"));
+        if (!strstr(text, md))
+            fail_msg("docs/solver.md is stale: regenerate its table with `build/cdem-run %s`",
+                     flags[k]);
+        free(md);
+    }
+    free(text);
 }
 
 int main(void) {
@@ -871,6 +922,7 @@ int main(void) {
         cmocka_unit_test(test_params_write_round_trip_changed_values),
         cmocka_unit_test(test_params_format_value),
         cmocka_unit_test(test_params_markdown_and_docs_current),
+        cmocka_unit_test(test_params_registry_tables_in_docs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -153,6 +153,13 @@ static void test_registry_boundary_modes(void **state) {
             fail_msg("boundary.mode = %s moves no boundary but does not say what happens", word);
         if (mm.input && !mm.input_what)
             fail_msg("boundary.mode = %s names an input file without saying what it is", word);
+        /* its row's clock (what the analysis labels an increment with) is time exactly when it
+         * moves no boundary, its display interval then being in seconds */
+        if ((cdem_mode_clock_of(mode) == CDEM_CLOCK_TIME) != (mm.moving_boundaries == 0))
+            fail_msg("boundary.mode = %s: its row's clock is %s but it moves %d boundaries", word,
+                     cdem_mode_clock_of(mode) == CDEM_CLOCK_TIME ? "time" : "not time",
+                     mm.moving_boundaries);
+        assert_true(strcmp(cdem_mode_description(mode), "?") != 0);
     }
     assert_documented_and_tested("boundary.mode", modes, n, "CDEM_MODE_");
 }

@@ -277,9 +277,9 @@ void cdem_render_increment_label(const cdem_analysis *an, size_t index, char *bu
         /* a cdem2D folder gives positions per increment, no displacement or time: a label
          * "Net displacement 0.0 m" on every increment would be false */
         snprintf(buf, n, "Increment %d", (int)info->number);
-    else if (p->mode == CDEM_MODE_BIAXIAL)
+    else if (cdem_mode_clock_of(p->mode) == CDEM_CLOCK_AXIAL_STRAIN)
         snprintf(buf, n, "Increment %d   Axial strain %.4f", (int)info->number, info->axial_strain);
-    else if (p->mode == CDEM_MODE_REPOSE)
+    else if (cdem_mode_clock_of(p->mode) == CDEM_CLOCK_TIME)
         snprintf(buf, n, "Increment %d   Time %.0f s", (int)info->number, info->time);
     else
         snprintf(buf, n, "Increment %d   Net displacement %.1f m", (int)info->number,

@@ -251,7 +251,7 @@ static inline int cdem_bc_is_base(const cdem_bc_walls *w, const cdem_state *s, s
 }
 
 /* The modes, one pointer each (bc_<id>.c), by the rows of common/modes.def. */
-#define CDEM_MODE(ID, id, word) extern const cdem_bc_ops *const cdem_bc_##id;
+#define CDEM_MODE(ID, id, word, clock, description) extern const cdem_bc_ops *const cdem_bc_##id;
 #define CDEM_TEST_MODE          CDEM_MODE
 #include "modes.def"
 #undef CDEM_MODE

@@ -12,7 +12,7 @@
 #include <string.h>
 
 static const cdem_bc_ops *const *const registry[CDEM_MODE_COUNT] = {
-#define CDEM_MODE(ID, id, word) [CDEM_MODE_##ID] = &cdem_bc_##id,
+#define CDEM_MODE(ID, id, word, clock, description) [CDEM_MODE_##ID] = &cdem_bc_##id,
 #define CDEM_TEST_MODE          CDEM_MODE
 #include "modes.def"
 #undef CDEM_MODE
