@@ -435,7 +435,6 @@ static void test_integrate_vector_paths_leave_upper_clean(void **st) {
                                 .cls = it.nb.cls,
                                 .hist = it.nb.hist,
                                 .xs = it.nb.xs,
-                                .slots = it.nb.xs, /* the default law has no slots (force.c) */
                                 .pfx = it.nb.pfx,
                                 .pfy = it.nb.pfy,
                                 .pos4 = it.force.pos4};

@@ -13,13 +13,10 @@
  * slots-1], doubles that persist from step to step, as LAMMPS's granular sub-models declare
  * num_coeffs and size_history). The machinery carries the slots as it carries Xs: the pair
  * list keeps them across list rebuilds, re-sorting and element removal, and a checkpoint
- * stores them. A contact's slots are its own: they start at 0 when it forms (the first
- * evaluation of a pair that did not touch at the last one), and what a pair holds once it
- * has separated means nothing (a list rebuild may drop it). So a law has no memory of
- * separated contacts: one that outlived the contact would last only while the pair stays
- * in the list, i.e. it would depend on the list's skin. Separation itself costs nothing
- * (the separated-pair branches of the force pass, which most pairs take, do not look at
- * the slots).
+ * stores them. A contact's slots are its own: 0 when the pair enters the list, set back to
+ * 0 with Xs when the pair separates, so a new contact of the pair starts from 0. A law has
+ * no memory of separated contacts: one that outlived the contact would last only while the
+ * pair stays in the list, i.e. it would depend on the list's skin.
  * A law is one file, common/laws/law_<name>.h, listed by one line in laws.def. The file has
  * up to five parts, each compiled only where it is asked for:
  *   CDEM_LAW_SCALAR  its scalar kernel (the contact kernel of both force paths), in one of
@@ -91,35 +88,36 @@ typedef cdem_shear cdem_law_kernel_with_state(double spring, double fn, double m
 
 static CDEM_INLINE cdem_shear cdem_law_call_plain(cdem_law_kernel *kernel, double spring, double fn,
                                                   double mu, double c0, const double *coef,
-                                                  double *slots, int slot_count, int forming) {
+                                                  double *slots, int stateful) {
     (void)coef;
     (void)slots;
-    (void)slot_count;
-    (void)forming;
+    (void)stateful;
     return kernel(spring, fn, mu, c0);
 }
 
 static CDEM_INLINE cdem_shear cdem_law_call_with_state(cdem_law_kernel_with_state *kernel,
                                                        double spring, double fn, double mu,
                                                        double c0, const double *coef, double *slots,
-                                                       int slot_count, int forming) {
-    if (forming) /* a new contact: its history starts here */
-        for (int k = 0; k < slot_count; k++)
-            slots[k] = 0.0;
+                                                       int stateful) {
+    if (!stateful) /* never: see CDEM_LAW_CALL */
+        __builtin_unreachable();
     return kernel(spring, fn, mu, c0, coef, slots);
 }
 
 /* Calls a law's scalar kernel in its form, chosen by the kernel's type at compile time (a
  * kernel of neither form does not compile): a kernel with state gets coef and the contact's
- * slot_count slots, set to 0 first when the contact is forming (it did not touch at the last
- * evaluation). Inlined, so a kernel of the short form runs exactly as when it was called
- * directly: nothing reads the other arguments, so the compiler computes none of them. */
+ * slots. Inlined, so a kernel of the short form runs exactly as when it was called directly:
+ * nothing reads the other arguments, so the compiler computes none of them. stateful is a
+ * constant of the caller: 0 in the force pass's loops of the laws without state, where the
+ * cases of the laws with state are then unreachable and compiled away (they run in a loop
+ * of their own), so that these loops are the same instructions as before any law had state;
+ * 1 everywhere else. */
 /* clang-format off */
-#define CDEM_LAW_CALL(kernel, spring, fn, mu, c0, coef, slots, slot_count, forming)                \
+#define CDEM_LAW_CALL(kernel, spring, fn, mu, c0, coef, slots, stateful)                           \
     _Generic(&(kernel),                                                                            \
              cdem_law_kernel *: cdem_law_call_plain,                                               \
              cdem_law_kernel_with_state *: cdem_law_call_with_state)                               \
-        (kernel, spring, fn, mu, c0, coef, slots, slot_count, forming)
+        (kernel, spring, fn, mu, c0, coef, slots, stateful)
 /* clang-format on */
 
 #endif

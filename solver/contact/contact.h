@@ -18,8 +18,8 @@
  * row, law.h); the pair history (flags, Xs and the law's history slots, law->slot_count
  * doubles per pair) is owned by the pair list (neighbour.h), keyed by the element ids, so it
  * survives list rebuilds, re-sorting and element removal. Separation ends a contact: its Xs
- * goes back to 0 then, its slots when the next contact of the pair forms (law.h says why).
- * Evaluation is inline and pure, thread-safe for distinct pairs (one writer per pair slot).
+ * and its slots go back to 0 (cdem_contact_forget_slots). Evaluation is inline and pure,
+ * thread-safe for distinct pairs (one writer per pair slot).
  * Sign convention: n = (xj - xi)/r, t = (-ny, nx); the returned force acts on i (j gets
  * minus it). Normal force on i = Kn (r - R) n (negative along n = repulsion when r < R).
  * Tangential: Xs += ((vj - vi) . t) dt; force on i = +Fs t, Fs from the law (the spring
@@ -175,22 +175,27 @@ static CDEM_INLINE uint8_t cdem_contact_separated(uint8_t h, double r2, double R
                          : 0);
 }
 
-/* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
- * for the granular material, the tangential spring limited by the pair's law. The one
- * kernel of the granular laws: the integrator, the tests and everything else call it (or
- * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
-static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2,
-                                              double dx, double dy, double R, double dvx,
-                                              double dvy, double dt, double *xs, uint8_t *hist,
-                                              double *slots, double *fx, double *fy) {
+/* A separated pair's history slots (law->slot_count at slots) go back to 0, with its Xs: the
+ * next contact of the pair is a new one (law.h). */
+static CDEM_INLINE void cdem_contact_forget_slots(const cdem_contact_law *law, double *slots) {
+    for (int k = 0; k < law->slot_count; k++)
+        slots[k] = 0.0;
+}
+
+/* cdem_contact_touching; stateful: a constant, 0 only in the force pass's loops of the laws
+ * without state (law.h, CDEM_LAW_CALL: the laws with state are not compiled into them). */
+static CDEM_INLINE void cdem_contact_touching_of(const cdem_contact_law *law, int cls, double r2,
+                                                 double dx, double dy, double R, double dvx,
+                                                 double dvy, double dt, double *xs, uint8_t *hist,
+                                                 double *slots, double *fx, double *fy,
+                                                 int stateful) {
     uint8_t h = *hist;
     const double r = sqrt(r2);
     const double inv = 1.0 / r;
     const double nx = dx * inv, ny = dy * inv;
     const double fn = law->kn * (R - r); /* compressive normal force magnitude, > 0 */
     double ftx = 0.0, fty = 0.0;
-    const int forming = !(h & CDEM_PAIR_TOUCH); /* a contact forming now (it did not touch) */
-    if (forming && law->cohesive_new)
+    if (!(h & CDEM_PAIR_TOUCH) && law->cohesive_new)
         h |= CDEM_PAIR_COHESIVE; /* a contact forming now (cohesive_contacts = formed) */
     h |= CDEM_PAIR_TOUCH;
     if (law->model == CDEM_MATERIAL_GRANULAR && law->ks > 0.0) {
@@ -203,8 +208,7 @@ static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int c
         switch (law->granular) { /* one case per row of laws.def */
 #define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
     case CDEM_LAW_##ID:                                                                            \
-        sh =                                                                                       \
-            CDEM_LAW_CALL(scalar, spring, fn, mu, c0, law->coef, slots, law->slot_count, forming); \
+        sh = CDEM_LAW_CALL(scalar, spring, fn, mu, c0, law->coef, slots, stateful);                \
         break;
 #define CDEM_TEST_LAW CDEM_LAW
 #include "laws/laws.def"
@@ -225,6 +229,17 @@ static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int c
     *fx = -fn * nx + ftx;
     *fy = -fn * ny + fty;
     *hist = h;
+}
+
+/* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
+ * for the granular material, the tangential spring limited by the pair's law. The one
+ * kernel of the granular laws: the integrator, the tests and everything else call it (or
+ * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
+static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2,
+                                              double dx, double dy, double R, double dvx,
+                                              double dvy, double dt, double *xs, uint8_t *hist,
+                                              double *slots, double *fx, double *fy) {
+    cdem_contact_touching_of(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, slots, fx, fy, 1);
 }
 
 /* Evaluates one pair. dx, dy = xj - xi; R = ri + rj; dvx, dvy = vj - vi (mid-step velocities,
@@ -258,6 +273,7 @@ static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, doubl
         *fx = 0.0;
         *fy = 0.0;
         *xs = 0.0;
+        cdem_contact_forget_slots(law, slots);
         *hist = cdem_contact_separated(h, r2, R); /* a broken bond never comes back */
         return;
     }

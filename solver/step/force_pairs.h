@@ -29,9 +29,6 @@ typedef struct {
     const uint8_t *cls;
     uint8_t *hist;
     double *xs, *pfx, *pfy;
-    /* the law's history slots, law->slot_count per pair (the pair list's); never NULL (a law
-     * without slots: any valid pointer, never read) */
-    double *slots;
     /* the vector paths' packed elements: pos4[4e .. 4e+3] = x, y, vx, vy of element e, 32-byte
      * aligned, current for every element whose pairs a vector kernel evaluates (the kernels
      * read both elements of a pair with one 256-bit load each, where gathers of the four
@@ -137,44 +134,51 @@ static CDEM_INLINE int cdem_force_drift_one(const cdem_force_drift_args *d, long
 /* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
  * the common case of a list pair that does not touch is settled here, everything else by
  * the one contact kernel (contact.h); a branch-free evaluation of every list pair is slower
- * (docs/performance.md, "Choices in the force pass"). */
+ * (docs/performance.md, "Choices in the force pass"). stateful: a constant, 1 in the loop of
+ * the laws with state (coefficients or history slots; slots: the list's, law->slot_count a
+ * pair, or NULL), 0 in the loops of all the others, which then have no code of the laws with
+ * state (CDEM_LAW_CALL) and are the instructions they were before laws had state: with it
+ * (a slot pointer computed and kept in every loop, the laws with state in the kernel's
+ * switch) the scalar path ran 0.5-1 % more instructions. */
 static CDEM_INLINE void cdem_force_pair(const cdem_contact_law *restrict law, long p, double dx,
                                         double dy, double dvx, double dvy,
                                         const double *restrict Rp, const uint8_t *restrict cls,
                                         uint8_t *restrict hist, double *restrict xs,
                                         double *restrict slots, double *restrict pfx,
-                                        double *restrict pfy, double dt) {
+                                        double *restrict pfy, double dt, int stateful) {
     const double R = Rp[p];
     const uint8_t h = hist[p];
     const double r2 = dx * dx + dy * dy;
-    /* the pair's history slots are at slots + p * law->slot_count (slots is never NULL, so this
-     * is defined for a law without any): only a kernel with slots reads them, so for the others
-     * the compiler computes nothing; separation does not touch them (law.h) */
+    /* the pair's history slots (only a kernel with slots reads them) */
+    double *const own = stateful && slots ? slots + p * law->slot_count : NULL;
     if (!(h & CDEM_PAIR_BONDED)) {
         if (r2 >= R * R || r2 <= 0.0) {
-            /* separated: xs != 0 only with h != 0 */
+            /* separated: xs and the slots != 0 only with h != 0 */
             pfx[p] = 0.0;
             pfy[p] = 0.0;
             if (h) {
                 hist[p] = cdem_contact_separated(h, r2, R);
                 xs[p] = 0.0;
+                if (own)
+                    cdem_contact_forget_slots(law, own);
             }
             return;
         }
-        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p],
-                              slots + p * law->slot_count, &pfx[p], &pfy[p]);
+        cdem_contact_touching_of(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], own,
+                                 &pfx[p], &pfy[p], stateful);
         return;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p],
-                      slots + p * law->slot_count, &pfx[p], &pfy[p]);
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], own, &pfx[p],
+                      &pfy[p]);
 }
 
-/* cdem_force_pair for pair p of the arrays a. */
+/* cdem_force_pair for pair p of the arrays a, for a law without state (the vector paths':
+ * a law with state is evaluated by the scalar loop of its own, force.c). */
 static CDEM_INLINE void cdem_force_pair_at(const cdem_force_pairs *a, long p) {
     const int32_t i = a->pi[p], j = a->pj[p];
     cdem_force_pair(a->law, p, a->x[j] - a->x[i], a->y[j] - a->y[i], a->vx[j] - a->vx[i],
-                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, a->slots, a->pfx, a->pfy,
-                    a->dt);
+                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, NULL, a->pfx, a->pfy, a->dt,
+                    0);
 }
 
 /* The kernels of a vector path (force.h, "Paths"). Each gives the bits of the scalar code
