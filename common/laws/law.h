@@ -18,7 +18,7 @@
  * no memory of separated contacts: one that outlived the contact would last only while the
  * pair stays in the list, i.e. it would depend on the list's skin.
  * A law is one file, common/laws/law_<name>.h, listed by one line in laws.def. The file has
- * up to five parts, each compiled only where it is asked for:
+ * up to six parts, each compiled only where it is asked for:
  *   CDEM_LAW_SCALAR  its scalar kernel (the contact kernel of both force paths), in one of
  *                    two forms: cdem_law_<name>(spring, fn, mu, c0) -> cdem_shear for a law
  *                    without coefficients or slots, or cdem_law_<name>(spring, fn, mu, c0,
@@ -40,7 +40,12 @@
  *                    (NULL without coefficients), which cdem_contact_law_init calls once. A
  *                    law without this row has none of either;
  *   CDEM_LAW_SETUP   that setup function (compiled in solver/contact/contact.c, where
- *                    cdem_params and the error helpers are known).
+ *                    cdem_params and the error helpers are known);
+ *   CDEM_PARAM_*     the parameters its coefficients come from, if it has any: its fields of
+ *                    cdem_params and its rows of the table, in [material] (common/params.h
+ *                    says how these parts are gathered; a fixture's rows are marked so).
+ * A law without coefficients or slots is its kernels and its row CDEM_LAW; one with them adds
+ * the rest, and nothing outside its file changes (law_test_slip_weakening.h is the proof).
  * A fixture of the tests writes CDEM_TEST_LAW instead of CDEM_LAW: it is registered (the
  * kernels, the enum after the users' laws) but no parameter file can name it.
  * The laws live in common/ because both programs read their words (the analysis reads the
