@@ -31,8 +31,10 @@ __attribute__((unused)) static double law_fx_sliding_force(cdem_granular_law law
     const double dx = 1.999, R = 2.0;
     double xs = 1000.0, fx = 0.0, fy = 0.0;
     uint8_t hist = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
+    double slots[16] = {0.0}; /* the law's history slots, a contact that has none yet */
+    assert_true(cl.slot_count <= 16);
     cdem_contact_touching(&cl, CDEM_CLASS_ELEMENT, dx * dx, dx, 0.0, R, 0.0, 0.0, 0.01, &xs, &hist,
-                          &fx, &fy);
+                          slots, &fx, &fy);
     return fy;
 }
 

@@ -56,7 +56,8 @@ static void test_contact_normal_repulsion(void **st) {
     double xs = 0.0, fx = 0, fy = 0;
     uint8_t h = 0;
     /* j to the right of i, overlapping by delta: i is pushed to -x with Kn delta */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - delta, 0.0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - delta, 0.0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_float_equal(fx, -KN * delta, 1e-6 * KN * delta);
     assert_float_equal(fy, 0.0, 1e-9);
     assert_true(h & CDEM_PAIR_TOUCH);
@@ -64,12 +65,13 @@ static void test_contact_normal_repulsion(void **st) {
     const double c = cos(0.3), s = sin(0.3);
     h = 0;
     cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, (R - delta) * c, (R - delta) * s, R, 0, 0, 0.1, &xs,
-                      &h, &fx, &fy);
+                      &h, NULL, &fx, &fy);
     assert_float_equal(fx, -KN * delta * c, 1e-6 * KN * delta);
     assert_float_equal(fy, -KN * delta * s, 1e-6 * KN * delta);
     /* separated: no force, no history */
     xs = 3.0;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 0.1, 0.0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 0.1, 0.0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_true(fx == 0.0 && fy == 0.0 && xs == 0.0 && h == 0);
 }
 
@@ -81,35 +83,40 @@ static void test_contact_bond_attraction_breaking(void **st) {
     uint8_t h = CDEM_PAIR_BONDED;
     /* stretched by half the breaking distance: attraction Kn (r - R) toward j (+x) */
     double stretch = 0.5 * r0 * R;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_float_equal(fx, KN * stretch, 1e-6 * KN * stretch);
     assert_true(h & CDEM_PAIR_BONDED);
     /* just below the threshold: still intact */
     stretch = 0.999 * r0 * R;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_true(h & CDEM_PAIR_BONDED);
     assert_float_equal(fx, KN * stretch, 1e-6 * KN * stretch);
     /* at r - R = r0 R: breaks for good, force zero */
     stretch = r0 * R * 1.0001;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_false(h & CDEM_PAIR_BONDED);
     assert_true(fx == 0.0 && fy == 0.0);
     /* back to a small stretch: no attraction any more */
     stretch = 0.1 * r0 * R;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + stretch, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_true(fx == 0.0 && fy == 0.0);
     /* compression: still repulsive */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx, &fy);
     assert_float_equal(fx, -KN * 2.0, 1e-3);
     /* bonded model has no tangential force */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 100.0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 2.0, 0, R, 0, 100.0, 0.1, &xs, &h, NULL, &fx,
+                      &fy);
     assert_true(fy == 0.0);
     /* wall class uses the wall breaking strain (0.05): a stretch of 0.03 R holds there */
     h = CDEM_PAIR_BONDED;
-    cdem_contact_eval(&law, CDEM_CLASS_WALL, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_WALL, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx, &fy);
     assert_true(h & CDEM_PAIR_BONDED);
     h = CDEM_PAIR_BONDED;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * 1.03, 0, R, 0, 0, 0.1, &xs, &h, NULL, &fx, &fy);
     assert_false(h & CDEM_PAIR_BONDED);
 }
 
@@ -120,7 +127,7 @@ static void drive(const cdem_contact_law *law, int cls, double R, double delta, 
     const double dt = 0.01;
     for (int k = 0; k < nsteps; k++) {
         double fx, fy;
-        cdem_contact_eval(law, cls, R - delta, 0.0, R, 0.0, dxs / dt, dt, xs, h, &fx, &fy);
+        cdem_contact_eval(law, cls, R - delta, 0.0, R, 0.0, dxs / dt, dt, xs, h, NULL, &fx, &fy);
         out[k] = fy;
     }
 }
@@ -164,7 +171,7 @@ static void test_contact_cohesion_lost_at_separation(void **st) {
     assert_true(h & CDEM_PAIR_COHESIVE);
     /* separation deletes the history and cohesion */
     double fx, fy;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, NULL, &fx, &fy);
     assert_true(h == 0 && xs == 0.0 && fx == 0.0 && fy == 0.0);
     /* a new contact is not cohesive: limit mu Fn */
     drive(&law, CDEM_CLASS_ELEMENT, R, delta, 0.01, 200, &xs, &h, f);
@@ -200,7 +207,7 @@ static void test_contact_normal_cohesion_limit_first_slip(void **st) {
     assert_true(h & CDEM_PAIR_COHESIVE);
     /* ... and loses its cohesion when the pair separates: a new contact holds mu Fn */
     double fx, fy;
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, NULL, &fx, &fy);
     assert_true(h == 0 && xs == 0.0 && fx == 0.0 && fy == 0.0);
     drive(&law, CDEM_CLASS_ELEMENT, R, delta, dxs, 200, &xs, &h, f);
     assert_float_equal(f[199], mu * fn, 1e-9 * fn);
@@ -282,7 +289,7 @@ static void test_contact_phases_settling_friction_and_formed_contacts(void **st)
     assert_float_equal(f[0], 0.25 * fn, 1e-9 * fn);
     /* separated, then touching again: a formed contact, cohesive */
     double fx, fy;
-    cdem_contact_eval(&now, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&now, CDEM_CLASS_ELEMENT, R + 1.0, 0, R, 0, 0, 0.01, &xs, &h, NULL, &fx, &fy);
     assert_int_equal(h, 0);
     drive(&now, CDEM_CLASS_ELEMENT, R, delta, 0.0, 1, &xs, &h, f);
     assert_true(h & CDEM_PAIR_COHESIVE);
@@ -318,15 +325,16 @@ static void test_contact_initial_contacts(void **st) {
     double xs = 0.0, fx, fy;
     uint8_t h = CDEM_PAIR_INITIAL;
     /* an exact tangency up to round-off: no force, the mark kept */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * (1.0 + 1e-12), 0, R, 0, 0, 0.01, &xs, &h, &fx,
-                      &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R * (1.0 + 1e-12), 0, R, 0, 0, 0.01, &xs, &h, NULL,
+                      &fx, &fy);
     assert_int_equal(h, CDEM_PAIR_INITIAL);
     assert_true(fx == 0.0 && fy == 0.0);
     /* touching: the mark rides along with the touch flag */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 0.5, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R - 0.5, 0, R, 0, 0, 0.01, &xs, &h, NULL, &fx, &fy);
     assert_int_equal(h, CDEM_PAIR_INITIAL | CDEM_PAIR_TOUCH);
     /* separated (1 mm beyond the tangency): the mark is gone for good */
-    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1e-3, 0, R, 0, 0, 0.01, &xs, &h, &fx, &fy);
+    cdem_contact_eval(&law, CDEM_CLASS_ELEMENT, R + 1e-3, 0, R, 0, 0, 0.01, &xs, &h, NULL, &fx,
+                      &fy);
     assert_int_equal(h, 0);
     assert_int_equal(cdem_contact_separated(CDEM_PAIR_INITIAL | CDEM_PAIR_COHESIVE, R * R, R),
                      CDEM_PAIR_INITIAL);

@@ -57,7 +57,7 @@ static double shear_limit(const cdem_contact_law *law, int cls) {
     const double R = 200.0, delta = 1.0;
     double xs = 0.0, fx = 0.0, fy = 0.0;
     uint8_t h = CDEM_PAIR_TOUCH | CDEM_PAIR_COHESIVE;
-    cdem_contact_eval(law, cls, R - delta, 0.0, R, 0.0, 100.0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(law, cls, R - delta, 0.0, R, 0.0, 100.0, 0.1, &xs, &h, NULL, &fx, &fy);
     assert_float_equal(fx, -KN * delta, 1e-6 * KN);
     return fabs(fy);
 }
@@ -67,7 +67,7 @@ static int bond_holds(const cdem_contact_law *law, int cls, double gap) {
     const double R = 200.0;
     double xs = 0.0, fx = 0.0, fy = 0.0;
     uint8_t h = CDEM_PAIR_BONDED;
-    cdem_contact_eval(law, cls, R + gap, 0.0, R, 0.0, 0.0, 0.1, &xs, &h, &fx, &fy);
+    cdem_contact_eval(law, cls, R + gap, 0.0, R, 0.0, 0.0, 0.1, &xs, &h, NULL, &fx, &fy);
     if (h & CDEM_PAIR_BONDED) /* intact: tension Kn gap pulls i towards j (+x) */
         assert_float_equal(fx, KN * gap, 1e-6 * KN * gap);
     return (h & CDEM_PAIR_BONDED) != 0;

@@ -1,5 +1,6 @@
 /* Tests of solver/neighbour: the cell/Verlet pair list equals a brute-force search, the
- * rebuild criterion, and contact histories surviving re-sorting and element removal. */
+ * rebuild criterion, and contact histories (with a law's history slots) surviving
+ * re-sorting, element removal, threaded builds and checkpoints. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -9,6 +10,7 @@
 
 #include "contact.h"
 #include "neighbour.h"
+#include "snapshot.h"
 
 #include <math.h>
 #include <omp.h>
@@ -203,6 +205,103 @@ static void test_neighbour_history_survives_resort_and_removal(void **st) {
     cdem_state_free(&s);
 }
 
+/* Slot k of the pair with key `key`, as the test writes it. */
+static double slot_tag(uint64_t key, int k) {
+    return tag(key) * (double)(k + 2);
+}
+
+/* 1 when every pair of nb (state s) that carries a history has its slots tagged, and every
+ * other pair has them at 0 (a new pair's). */
+static int slots_follow_ids(const cdem_neighbour *nb, const cdem_state *s) {
+    const int m = nb->slot_count;
+    for (size_t p = 0; p < nb->np; p++) {
+        const uint64_t key = cdem_pair_key(s->id[nb->pi[p]], s->id[nb->pj[p]]);
+        for (int k = 0; k < m; k++) {
+            const double want = nb->hist[p] ? slot_tag(key, k) : 0.0;
+            if (nb->slots[p * (size_t)m + (size_t)k] != want)
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* A law's history slots (two a pair here) travel with their pairs as xs does: through a
+ * forced re-sort, element removal and a threaded build, and through a checkpoint; a pair
+ * without a history (no flags: not a contact) does not keep them. A list restored for another
+ * slot count is refused, naming it; the count is fixed before the first build; a list
+ * without slots stores none. */
+static void test_neighbour_slots_carried_and_stored(void **st) {
+    (void)st;
+    cdem_state s;
+    make_cloud(&s, 600, 3000.0, 9);
+    cdem_neighbour nb;
+    cdem_error err;
+    assert_int_equal(cdem_neighbour_init(&nb, 12.5, 1.0, 1000, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_set_slots(&nb, 2, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, -1, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_set_slots(&nb, 1, &err), CDEM_ERR_INVALID);
+    assert_true(nb.np > 100);
+    for (size_t p = 0; p < nb.np; p++) {
+        const uint64_t key = cdem_pair_key(s.id[nb.pi[p]], s.id[nb.pj[p]]);
+        assert_true(nb.slots[2 * p] == 0.0 && nb.slots[2 * p + 1] == 0.0); /* new pairs */
+        nb.hist[p] = (uint8_t)(key % 3 == 0 ? 0 : CDEM_PAIR_TOUCH);
+        for (int k = 0; k < 2; k++)
+            nb.slots[2 * p + (size_t)k] = slot_tag(key, k); /* also where hist is 0 */
+    }
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 1, &err), CDEM_OK); /* re-sort */
+    assert_true(slots_follow_ids(&nb, &s));
+    unsigned char *keep = malloc(s.n);
+    for (size_t i = 0; i < s.n; i++)
+        keep[i] = (unsigned char)(s.id[i] % 7 != 0);
+    assert_int_equal(cdem_neighbour_build(&nb, &s, keep, 0, &err), CDEM_OK); /* removal */
+    free(keep);
+    assert_true(slots_follow_ids(&nb, &s));
+    nb.par_min = 0;
+    omp_set_num_threads(2);
+    assert_int_equal(cdem_neighbour_build(&nb, &s, NULL, 1, &err), CDEM_OK); /* threaded */
+    omp_set_num_threads(1);
+    assert_true(slots_follow_ids(&nb, &s));
+    /* a checkpoint and its restore: the same slots, pair for pair */
+    cdem_snapshot *snap = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_snapshot_put(&nb, snap, &err), CDEM_OK);
+    cdem_neighbour back;
+    assert_int_equal(cdem_neighbour_init(&back, 12.5, 1.0, 1000, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_set_slots(&back, 2, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_snapshot_get(&back, snap, &s, &err), CDEM_OK);
+    assert_int_equal(back.np, nb.np);
+    assert_memory_equal(back.slots, nb.slots, 2 * nb.np * sizeof *nb.slots);
+    cdem_neighbour_free(&back);
+    /* another law's count is refused, naming it */
+    for (int other = 0; other <= 3; other += 3) {
+        assert_int_equal(cdem_neighbour_init(&back, 12.5, 1.0, 1000, &err), CDEM_OK);
+        assert_int_equal(cdem_neighbour_set_slots(&back, other, &err), CDEM_OK);
+        assert_int_equal(cdem_neighbour_snapshot_get(&back, snap, &s, &err), CDEM_ERR_CONFLICT);
+        assert_non_null(strstr(err.msg, "nb.slot_count = 2"));
+        cdem_neighbour_free(&back);
+    }
+    /* a list without slots stores none, and a restore with slots refuses it */
+    cdem_neighbour plain;
+    cdem_snapshot *snap0 = NULL;
+    assert_int_equal(cdem_snapshot_alloc(&snap0, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_init(&plain, 12.5, 1.0, 1000, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_build(&plain, &s, NULL, -1, &err), CDEM_OK);
+    assert_null(plain.slots);
+    assert_int_equal(cdem_neighbour_snapshot_put(&plain, snap0, &err), CDEM_OK);
+    assert_null(cdem_snapshot_get(snap0, "nb.slots"));
+    assert_null(cdem_snapshot_get(snap0, "nb.slot_count"));
+    assert_int_equal(cdem_neighbour_init(&back, 12.5, 1.0, 1000, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_set_slots(&back, 2, &err), CDEM_OK);
+    assert_int_equal(cdem_neighbour_snapshot_get(&back, snap0, &s, &err), CDEM_ERR_CONFLICT);
+    assert_non_null(strstr(err.msg, "nb.slot_count = 0"));
+    cdem_neighbour_free(&back);
+    cdem_neighbour_free(&plain);
+    cdem_snapshot_free(snap0);
+    cdem_snapshot_free(snap);
+    cdem_neighbour_free(&nb);
+    cdem_state_free(&s);
+}
+
 /* The re-sort orders the elements by cell along the grid's short side first (neighbour.c),
  * so that the threads' chunks, index ranges, are cut across it: in a wide cloud the first
  * half of the indices lies left of the second (up to one cell), in a high one below it, and
@@ -393,6 +492,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_neighbour_matches_brute_force),
         cmocka_unit_test(test_neighbour_history_survives_resort_and_removal),
+        cmocka_unit_test(test_neighbour_slots_carried_and_stored),
         cmocka_unit_test(test_neighbour_order_along_short_side),
         cmocka_unit_test(test_neighbour_rejects_bad_input),
         cmocka_unit_test(test_neighbour_threaded_build_same_list),

@@ -5,7 +5,9 @@
  *     required hooks are there, what it excludes are parameters; every registered mode, the
  *     tests' fixtures too); the law is accepted by the contact kernel
  *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact
- *     (every registered law: also the tests' fixtures, which no parameter file names);
+ *     (every registered law: also the tests' fixtures, which no parameter file names); a law
+ *     with coefficients or history slots of its own has no vector kernel (common/laws/law.h:
+ *     the vector paths pass neither, so they evaluate it by its scalar kernel);
  *   - documented: docs/solver.md names it as `NAME` and docs/parameters.md lists it;
  *   - tested: a test source under tests/ (other than this file) names its enum constant
  *     (CDEM_MODE_<NAME> / CDEM_LAW_<NAME>, '-' as '_').
@@ -21,6 +23,7 @@
 
 #include "bc.h"
 #include "contact.h"
+#include "force.h"
 #include "params.h"
 
 #include <ctype.h>
@@ -184,6 +187,16 @@ static void test_registry_contact_laws(void **state) {
             if (force[j] == force[i])
                 fail_msg("laws %s and %s give the same sliding force %g", cdem_law_name(j),
                          cdem_law_name(law), force[i]);
+        cdem_params pl;
+        cdem_params_defaults(&pl);
+        pl.granular_law = law;
+        cdem_contact_law cl;
+        cdem_error err;
+        assert_int_equal(cdem_contact_law_init(&cl, &pl, 1e9, 1e9, &err), CDEM_OK);
+        if ((cl.coefficient_count > 0 || cl.slot_count > 0) && cdem_force_law_vectorised(law))
+            fail_msg("law %s has %d coefficients and %d history slots of its own and an AVX2 "
+                     "kernel, which would get neither (law.h)",
+                     cdem_law_name(law), cl.coefficient_count, cl.slot_count);
     }
     /* a value that is no law is refused, naming the laws */
     cdem_params p;

@@ -3,7 +3,7 @@
  * The cohesion adds to the strength, not to the spring force: an unloaded cohesive contact
  * carries no shear force, and at Fn = 0 it still resists C0 of shear, so with the paper's C0
  * cliffs many elements high stand (docs/solver.md, "Which law", has the numbers and the
- * law's history). Kept for users who want a Mohr-Coulomb contact. The file's three parts:
+ * law's history). Kept for users who want a Mohr-Coulomb contact. The file's parts:
  * law.h. */
 #if defined(CDEM_LAW_SCALAR) && !defined(CDEM_LAW_COULOMB_SCALAR)
 #define CDEM_LAW_COULOMB_SCALAR
@@ -33,4 +33,8 @@ CDEM_LANES cdem_shear4 cdem_law_coulomb_lanes(__m256d spring, __m256d fn, __m256
 
 #ifdef CDEM_LAW
 CDEM_LAW(COULOMB, "coulomb", "shear strength mu Fn + C0", cdem_law_coulomb, cdem_law_coulomb_lanes)
+#endif
+
+#ifdef CDEM_LAW_STATE
+CDEM_LAW_STATE(COULOMB, 0, 0, NULL) /* no coefficients, no history slots */
 #endif

@@ -7,7 +7,7 @@
  * the two elements together, so it raises the Coulomb threshold by mu C0. A frictionless
  * class (mu = 0: flexural slip, a frictionless weak interval, a smooth base) has no shear
  * strength at all, whatever its C0. Why this law is the default: docs/solver.md, "Which
- * law". The file's three parts: law.h. */
+ * law". The file's parts: law.h. */
 #if defined(CDEM_LAW_SCALAR) && !defined(CDEM_LAW_NORMAL_COHESION_SCALAR)
 #define CDEM_LAW_NORMAL_COHESION_SCALAR
 
@@ -33,4 +33,8 @@ CDEM_LANES cdem_shear4 cdem_law_normal_cohesion_lanes(__m256d spring, __m256d fn
 #ifdef CDEM_LAW
 CDEM_LAW(NORMAL_COHESION, "normal-cohesion", "shear strength mu (Fn + C0)",
          cdem_law_normal_cohesion, cdem_law_normal_cohesion_lanes)
+#endif
+
+#ifdef CDEM_LAW_STATE
+CDEM_LAW_STATE(NORMAL_COHESION, 0, 0, NULL) /* no coefficients, no history slots */
 #endif

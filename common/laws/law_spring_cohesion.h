@@ -6,7 +6,7 @@
  * whenever C0 > mu Fn. With the paper's values the whole assembly flows (docs/solver.md,
  * "Which law"); kept so that the printed equation can be run and compared. At the limit the
  * spring is set so that Ks Xs alone equals the limit force (the spring stores the force,
- * cohesion excluded). The file's three parts: law.h. */
+ * cohesion excluded). The file's parts: law.h. */
 #if defined(CDEM_LAW_SCALAR) && !defined(CDEM_LAW_SPRING_COHESION_SCALAR)
 #define CDEM_LAW_SPRING_COHESION_SCALAR
 
@@ -41,4 +41,8 @@ CDEM_LANES cdem_shear4 cdem_law_spring_cohesion_lanes(__m256d spring, __m256d fn
 #ifdef CDEM_LAW
 CDEM_LAW(SPRING_COHESION, "spring-cohesion", "Fs = Ks Xs + C0, shear strength mu Fn",
          cdem_law_spring_cohesion, cdem_law_spring_cohesion_lanes)
+#endif
+
+#ifdef CDEM_LAW_STATE
+CDEM_LAW_STATE(SPRING_COHESION, 0, 0, NULL) /* no coefficients, no history slots */
 #endif

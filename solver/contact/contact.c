@@ -8,6 +8,32 @@
 
 #include <string.h>
 
+/* the laws' setup functions (common/laws/law.h) */
+#define CDEM_LAW_SETUP
+#include "laws/laws.def"
+#undef CDEM_LAW_SETUP
+
+/* What a law has of its own (its CDEM_LAW_STATE row; a law without one: nothing). */
+typedef struct {
+    int coefficients, slots;
+    cdem_status (*setup)(const cdem_params *p, double *coef, cdem_error *err);
+} law_state;
+
+#define CDEM_LAW_STATE(ID, coefficients, slots, setup)                                             \
+    _Static_assert((coefficients) >= 0 && (coefficients) <= CDEM_LAW_MAX_COEFFICIENTS &&           \
+                       (slots) >= 0 && ((coefficients) == 0) == ((setup) == NULL),                 \
+                   "law " #ID ": 0..CDEM_LAW_MAX_COEFFICIENTS coefficients, slots >= 0, and a "    \
+                   "setup exactly when it has coefficients");
+#include "laws/laws.def"
+#undef CDEM_LAW_STATE
+
+static const law_state law_states[CDEM_LAW_COUNT] = {
+#define CDEM_LAW_STATE(ID, coefficients, slots, setup)                                             \
+    [CDEM_LAW_##ID] = {coefficients, slots, setup},
+#include "laws/laws.def"
+#undef CDEM_LAW_STATE
+};
+
 static const char *const class_names[CDEM_CLASS_TOTAL] = {"element",
                                                           "wall",
                                                           "fault",
@@ -87,6 +113,17 @@ cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, d
                          : p->flexural_slip_style == CDEM_FLEX_WEAK_LAYERS ? 2
                                                                            : 1;
     law->layered_friction = p->layered_friction ? 1 : 0;
+    /* the granular law's own coefficients and history slots (none for the bonded model) */
+    const law_state *own = &law_states[p->granular_law];
+    memset(law->coef, 0, sizeof law->coef);
+    law->coefficient_count = 0;
+    law->slot_count = 0;
+    if (p->material == CDEM_MATERIAL_GRANULAR) {
+        law->coefficient_count = own->coefficients;
+        law->slot_count = own->slots;
+        if (own->setup)
+            CDEM_TRY(own->setup(p, law->coef, err));
+    }
     if (p->material != CDEM_MATERIAL_GRANULAR && p->material != CDEM_MATERIAL_BONDED)
         return CDEM_FAIL(err, CDEM_ERR_RANGE,
                          "contact law: material.model = %d: must be granular or bonded",
@@ -217,10 +254,14 @@ static size_t law_values(const cdem_contact_law *law, double *v) {
     v[k++] = (double)law->granular;
     v[k++] = (double)law->cohesive_rule;
     v[k++] = law->settling_friction;
+    /* the law's coefficients, only when it has some (a checkpoint of a law without stays as
+     * it was) */
+    for (int c = 0; c < law->coefficient_count; c++)
+        v[k++] = law->coef[c];
     return k;
 }
 
-#define LAW_VALUES (4 + 3 * CDEM_CLASS_TOTAL + 6)
+#define LAW_VALUES (4 + 3 * CDEM_CLASS_TOTAL + 6 + CDEM_LAW_MAX_COEFFICIENTS)
 
 cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot *snap,
                                       cdem_error *err) {
@@ -234,13 +275,19 @@ cdem_status cdem_contact_snapshot_check(const cdem_contact_law *law, const cdem_
     double v[LAW_VALUES];
     const size_t n = law_values(law, v);
     const cdem_snapshot_array *a = NULL;
-    CDEM_TRY(cdem_ckpt_get_array(snap, "contact", "law", CDEM_SNAP_F64, n, &a, err));
+    CDEM_TRY(cdem_ckpt_get_array(snap, "contact", "law", CDEM_SNAP_F64, SIZE_MAX, &a, err));
     const double *stored = a->data;
-    for (size_t k = 0; k < n; k++)
+    for (size_t k = 0; k < n && k < a->count; k++)
         if (memcmp(&stored[k], &v[k], sizeof v[k]) != 0)
             return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
                              "checkpoint contact.law value %zu = %.17g but this run's contact law "
                              "has %.17g: the checkpoint belongs to another material",
                              k, stored[k], v[k]);
+    if (a->count != n) /* the same values, but for the law's coefficients */
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint contact.law has %zu values but this run's contact law has "
+                         "%zu (%d coefficients of its own): the checkpoint belongs to another "
+                         "material",
+                         a->count, n, law->coefficient_count);
     return CDEM_OK;
 }

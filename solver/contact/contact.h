@@ -13,10 +13,13 @@
  *   - lost: at the first slip (first_slip on) or when the pair separates;
  *   - the packing phase: while equilibrating, friction x settling_friction
  *     (cdem_contact_law_phase; the run loop says which phase a step is in).
- * The law is a plain value (cdem_contact_law) built once from params + model; the pair
- * history is owned by the pair list (neighbour.h), keyed by the element ids, so it survives
- * list rebuilds, re-sorting and element removal. Evaluation is inline and pure, thread-safe
- * for distinct pairs (one writer per pair slot).
+ * The law is a plain value (cdem_contact_law) built once from params + model, with the
+ * granular law's own coefficients (coef, filled by the law's setup from its CDEM_LAW_STATE
+ * row, law.h); the pair history (flags, Xs and the law's history slots, law->slot_count
+ * doubles per pair) is owned by the pair list (neighbour.h), keyed by the element ids, so it
+ * survives list rebuilds, re-sorting and element removal. Separation ends a contact: its Xs
+ * and its slots go back to 0 (cdem_contact_forget_slots). Evaluation is inline and pure,
+ * thread-safe for distinct pairs (one writer per pair slot).
  * Sign convention: n = (xj - xi)/r, t = (-ny, nx); the returned force acts on i (j gets
  * minus it). Normal force on i = Kn (r - R) n (negative along n = repulsion when r < R).
  * Tangential: Xs += ((vj - vi) . t) dt; force on i = +Fs t, Fs from the law (the spring
@@ -84,10 +87,16 @@ typedef struct {
                                    CDEM_CLASS_SLIP; 2: pairs with an element of a weak layer
                                    (cdem_contact_weak_layer) do */
     int layered_friction;       /* 0/1: layers 5-8, 13-16, 21-24 use CDEM_CLASS_LAYERED */
+    /* the granular law's own (its CDEM_LAW_STATE row, law.h; 0 and 0 when it has none, and
+       for the bonded model) */
+    int coefficient_count;                  /* coef[0..coefficient_count-1] are its */
+    int slot_count;                         /* history slots per pair (the pair list's) */
+    double coef[CDEM_LAW_MAX_COEFFICIENTS]; /* filled once by the law's setup */
 } cdem_contact_law;
 
-/* Fills the law from the material parameters and the model constants kn, ks. Fails with
- * CDEM_ERR_RANGE naming the field when a value is negative/non-finite or kn <= 0. */
+/* Fills the law from the material parameters and the model constants kn, ks, and the
+ * granular law's coefficients by its setup (law.h). Fails with CDEM_ERR_RANGE naming the field
+ * when a value is negative/non-finite or kn <= 0, or as the law's setup fails. */
 cdem_status cdem_contact_law_init(cdem_contact_law *law, const cdem_params *p, double kn, double ks,
                                   cdem_error *err);
 
@@ -127,10 +136,12 @@ cdem_status cdem_contact_assign_weak(const cdem_params *p, cdem_state *s, long *
                                      cdem_error *err);
 
 /* Checkpoints (checkpoint.h): the law's values under "contact." (model, first_slip, kn, ks,
- * per-class friction, cohesion, breaking strain, heterogeneity switches). The contact
- * histories themselves (flags, tangential displacement) belong to the pair list and are
- * stored with it (cdem_neighbour_snapshot_put). _check fails with CDEM_ERR_CONFLICT naming
- * the value when the law of the run being resumed differs from the stored one. */
+ * per-class friction, cohesion, breaking strain, heterogeneity switches, and after them the
+ * granular law's coefficients when it has any: a law without is stored as it always was).
+ * The contact histories themselves (flags, tangential displacement, the law's slots) belong
+ * to the pair list and are stored with it (cdem_neighbour_snapshot_put). _check fails with
+ * CDEM_ERR_CONFLICT naming the value when the law of the run being resumed differs from the
+ * stored one. */
 cdem_status cdem_contact_snapshot_put(const cdem_contact_law *law, cdem_snapshot *snap,
                                       cdem_error *err);
 cdem_status cdem_contact_snapshot_check(const cdem_contact_law *law, const cdem_snapshot *snap,
@@ -164,14 +175,20 @@ static CDEM_INLINE uint8_t cdem_contact_separated(uint8_t h, double r2, double R
                          : 0);
 }
 
-/* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
- * for the granular material, the tangential spring limited by the pair's law. The one
- * kernel of the granular laws: the integrator, the tests and everything else call it (or
- * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
-static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2,
-                                              double dx, double dy, double R, double dvx,
-                                              double dvy, double dt, double *xs, uint8_t *hist,
-                                              double *fx, double *fy) {
+/* A separated pair's history slots (law->slot_count at slots) go back to 0, with its Xs: the
+ * next contact of the pair is a new one (law.h). */
+static CDEM_INLINE void cdem_contact_forget_slots(const cdem_contact_law *law, double *slots) {
+    for (int k = 0; k < law->slot_count; k++)
+        slots[k] = 0.0;
+}
+
+/* cdem_contact_touching; stateful: a constant, 0 only in the force pass's loops of the laws
+ * without state (law.h, CDEM_LAW_CALL: the laws with state are not compiled into them). */
+static CDEM_INLINE void cdem_contact_touching_of(const cdem_contact_law *law, int cls, double r2,
+                                                 double dx, double dy, double R, double dvx,
+                                                 double dvy, double dt, double *xs, uint8_t *hist,
+                                                 double *slots, double *fx, double *fy,
+                                                 int stateful) {
     uint8_t h = *hist;
     const double r = sqrt(r2);
     const double inv = 1.0 / r;
@@ -191,7 +208,7 @@ static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int c
         switch (law->granular) { /* one case per row of laws.def */
 #define CDEM_LAW(ID, word, description, scalar, lanes)                                             \
     case CDEM_LAW_##ID:                                                                            \
-        sh = scalar(spring, fn, mu, c0);                                                           \
+        sh = CDEM_LAW_CALL(scalar, spring, fn, mu, c0, law->coef, slots, stateful);                \
         break;
 #define CDEM_TEST_LAW CDEM_LAW
 #include "laws/laws.def"
@@ -214,12 +231,24 @@ static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int c
     *hist = h;
 }
 
+/* A touching pair (0 < r2 < R^2) that is not an intact bond: repulsive normal force and,
+ * for the granular material, the tangential spring limited by the pair's law. The one
+ * kernel of the granular laws: the integrator, the tests and everything else call it (or
+ * cdem_contact_eval, which ends here). Arguments as cdem_contact_eval's; r2 = dx^2 + dy^2. */
+static CDEM_INLINE void cdem_contact_touching(const cdem_contact_law *law, int cls, double r2,
+                                              double dx, double dy, double R, double dvx,
+                                              double dvy, double dt, double *xs, uint8_t *hist,
+                                              double *slots, double *fx, double *fy) {
+    cdem_contact_touching_of(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, slots, fx, fy, 1);
+}
+
 /* Evaluates one pair. dx, dy = xj - xi; R = ri + rj; dvx, dvy = vj - vi (mid-step velocities,
- * so dv * dt is the relative displacement of the step). Updates *xs and *hist; writes the
- * force on i. Cost: no sqrt unless the pair is within reach (touching or a bond). */
+ * so dv * dt is the relative displacement of the step). Updates *xs, *hist and the pair's
+ * history slots (law->slot_count of them at slots; may be NULL when the law has none); writes
+ * the force on i. Cost: no sqrt unless the pair is within reach (touching or a bond). */
 static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, double dx, double dy,
                                      double R, double dvx, double dvy, double dt, double *xs,
-                                     uint8_t *hist, double *fx, double *fy) {
+                                     uint8_t *hist, double *slots, double *fx, double *fy) {
     const double r2 = dx * dx + dy * dy;
     uint8_t h = *hist;
     if (h & CDEM_PAIR_BONDED) {
@@ -244,10 +273,11 @@ static inline void cdem_contact_eval(const cdem_contact_law *law, int cls, doubl
         *fx = 0.0;
         *fy = 0.0;
         *xs = 0.0;
+        cdem_contact_forget_slots(law, slots);
         *hist = cdem_contact_separated(h, r2, R); /* a broken bond never comes back */
         return;
     }
-    cdem_contact_touching(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, fx, fy);
+    cdem_contact_touching(law, cls, r2, dx, dy, R, dvx, dvy, dt, xs, hist, slots, fx, fy);
 }
 
 #endif

@@ -99,7 +99,9 @@ typedef struct {
     const uint8_t *cls;
     uint8_t *hist;
     double *xs, *pfx, *pfy, *fx, *fy, *vx, *vy;
-    int nchunk;                                      /* chunks of this pass */
+    double *slots; /* the law's history slots (law->slot_count a pair), or NULL */
+    int stateful;  /* 1: the law has state (coefficients or slots): its own loop (chunk_pass) */
+    int nchunk;    /* chunks of this pass */
     const int32_t *chunk_elem, *cross_start, *cross; /* the decomposition (force.h) */
     cdem_force *f;                                   /* cross_done progress slots */
     const cdem_force_kernels *vec;   /* the vector path's kernels (force.h, "Paths"), or NULL */
@@ -148,8 +150,9 @@ static void publish_cross(const force_pass *fp, int c, int32_t slot) {
 }
 
 /* Evaluates the cross pairs into chunk c (their slots only; no sums), in ascending slot
- * order, publishing the progress every CROSS_PUBLISH_EVERY pairs. */
-static void cross_eval(const force_pass *fp, int c) {
+ * order, publishing the progress every CROSS_PUBLISH_EVERY pairs; stateful: cdem_force_pair
+ * (a constant). */
+static CDEM_INLINE void cross_eval_of(const force_pass *fp, int c, int stateful) {
     const double *restrict x = fp->x, *restrict y = fp->y;
     const double *restrict vx = fp->vx, *restrict vy = fp->vy;
     const int32_t *restrict list = fp->cross;
@@ -158,16 +161,28 @@ static void cross_eval(const force_pass *fp, int c) {
         const long p = list[k];
         const int32_t i = fp->pi[p], j = fp->pj[p];
         cdem_force_pair(fp->law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                        fp->cls, fp->hist, fp->xs, fp->pfx, fp->pfy, fp->dt);
+                        fp->cls, fp->hist, fp->xs, fp->slots, fp->pfx, fp->pfy, fp->dt, stateful);
         if ((k - a) % CROSS_PUBLISH_EVERY == CROSS_PUBLISH_EVERY - 1 && k + 1 < b)
             publish_cross(fp, c, list[k + 1]);
     }
     publish_cross(fp, c, INT32_MAX);
 }
 
+/* cross_eval_of for a law with state (a function of its own: chunk_pass says why). */
+static __attribute__((noinline)) void cross_eval_stateful(const force_pass *fp, int c) {
+    cross_eval_of(fp, c, 1);
+}
+
+static void cross_eval(const force_pass *fp, int c) {
+    if (fp->stateful)
+        cross_eval_stateful(fp, c);
+    else
+        cross_eval_of(fp, c, 0);
+}
+
 /* The run loop's guard (integrate.h) over the chunk's elements, while the velocities are in
  * cache: the lowest index whose element moves more than its radius in a step, or -1. */
-static long unstable_in(const force_pass *fp, long lo, long hi) {
+static CDEM_INLINE long unstable_in(const force_pass *fp, long lo, long hi) {
     if (!fp->fin.radius)
         return -1;
     for (long i = lo; i < hi; i++)
@@ -184,7 +199,7 @@ static long unstable_in(const force_pass *fp, long lo, long hi) {
  * chunk was evaluated by that chunk's thread and only adds to its pi here). Then the chunk's
  * elements are finished (docs/performance.md, "Choices in the force pass", says why not per
  * element). */
-static void chunk_pass_scalar(force_pass *fp, int chunk) {
+static CDEM_INLINE void chunk_pass_scalar_of(force_pass *fp, int chunk, int stateful) {
     const long lo = fp->chunk_elem[chunk], hi = fp->chunk_elem[chunk + 1];
     const int32_t *restrict list = fp->cross;
     const int32_t ca = fp->cross_start[chunk], cb = fp->cross_start[chunk + 1];
@@ -210,7 +225,7 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
         const int32_t i = pi[p], j = pj[p];
         if (j < hi) {
             cdem_force_pair(law, p, x[j] - x[i], y[j] - y[i], vx[j] - vx[i], vy[j] - vy[i], fp->Rp,
-                            fp->cls, fp->hist, fp->xs, pfx, pfy, dt);
+                            fp->cls, fp->hist, fp->xs, fp->slots, pfx, pfy, dt, stateful);
             fx[j] -= pfx[p];
             fy[j] -= pfy[p];
             fx[i] += pfx[p];
@@ -229,6 +244,18 @@ static void chunk_pass_scalar(force_pass *fp, int chunk) {
     for (long i = lo; i < hi; i++)
         cdem_force_finish_one(&fp->fin, i, fx[i], fy[i], vx, vy, fx, fy);
     fp->unstable[chunk] = unstable_in(fp, lo, hi);
+}
+
+/* The scalar path's pass of a law without state. */
+static void chunk_pass_scalar(force_pass *fp, int chunk) {
+    chunk_pass_scalar_of(fp, chunk, 0);
+}
+
+/* The pass of a law with state (coefficients or history slots), on every path: the scalar
+ * loop with the laws with state (such a law has no vector kernel, law.h), in a function of
+ * its own, so that the loops of all the other laws have none of their code. */
+static __attribute__((noinline)) void chunk_pass_stateful(force_pass *fp, int chunk) {
+    chunk_pass_scalar_of(fp, chunk, 1);
 }
 
 /* The scatter of the evaluated pairs b..be-1 into the interleaved sums, in slot order, as
@@ -286,7 +313,9 @@ static void chunk_pass_vec(force_pass *fp, int chunk) {
 }
 
 static void chunk_pass(force_pass *fp, int chunk) {
-    if (fp->vec)
+    if (fp->stateful)
+        chunk_pass_stateful(fp, chunk);
+    else if (fp->vec)
         chunk_pass_vec(fp, chunk);
     else
         chunk_pass_scalar(fp, chunk);
@@ -538,6 +567,7 @@ static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cde
     cdem_contact_law_phase(in->law, in->equilibrating, &lawc);
     const int kick = in->kick, check_moved = in->check_moved;
     const long n = (long)s->n;
+    double *slots = nb->slot_count > 0 ? nb->slots : NULL; /* the law's history slots */
     force_pass fp = {
         .law = &lawc,
         .dt = in->dt,
@@ -564,6 +594,8 @@ static int pass_with(cdem_force *f, cdem_neighbour *nb, cdem_state *s, const cde
         .cls = nb->cls,
         .hist = nb->hist,
         .xs = nb->xs,
+        .slots = slots,
+        .stateful = lawc.coefficient_count > 0 || lawc.slot_count > 0,
         .pfx = nb->pfx,
         .pfy = nb->pfy,
         .fx = s->fx,

@@ -134,38 +134,51 @@ static CDEM_INLINE int cdem_force_drift_one(const cdem_force_drift_args *d, long
 /* Force of pair p on its pi into the slot pfx[p], pfy[p] (zero when it does not touch):
  * the common case of a list pair that does not touch is settled here, everything else by
  * the one contact kernel (contact.h); a branch-free evaluation of every list pair is slower
- * (docs/performance.md, "Choices in the force pass"). */
+ * (docs/performance.md, "Choices in the force pass"). stateful: a constant, 1 in the loop of
+ * the laws with state (coefficients or history slots; slots: the list's, law->slot_count a
+ * pair, or NULL), 0 in the loops of all the others, which then have no code of the laws with
+ * state (CDEM_LAW_CALL) and are the instructions they were before laws had state: with it
+ * (a slot pointer computed and kept in every loop, the laws with state in the kernel's
+ * switch) the scalar path ran 0.5-1 % more instructions. */
 static CDEM_INLINE void cdem_force_pair(const cdem_contact_law *restrict law, long p, double dx,
                                         double dy, double dvx, double dvy,
                                         const double *restrict Rp, const uint8_t *restrict cls,
                                         uint8_t *restrict hist, double *restrict xs,
-                                        double *restrict pfx, double *restrict pfy, double dt) {
+                                        double *restrict slots, double *restrict pfx,
+                                        double *restrict pfy, double dt, int stateful) {
     const double R = Rp[p];
     const uint8_t h = hist[p];
     const double r2 = dx * dx + dy * dy;
+    /* the pair's history slots (only a kernel with slots reads them) */
+    double *const own = stateful && slots ? slots + p * law->slot_count : NULL;
     if (!(h & CDEM_PAIR_BONDED)) {
         if (r2 >= R * R || r2 <= 0.0) {
-            /* separated: xs != 0 only with h != 0 */
+            /* separated: xs and the slots != 0 only with h != 0 */
             pfx[p] = 0.0;
             pfy[p] = 0.0;
             if (h) {
                 hist[p] = cdem_contact_separated(h, r2, R);
                 xs[p] = 0.0;
+                if (own)
+                    cdem_contact_forget_slots(law, own);
             }
             return;
         }
-        cdem_contact_touching(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p],
-                              &pfy[p]);
+        cdem_contact_touching_of(law, cls[p], r2, dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], own,
+                                 &pfx[p], &pfy[p], stateful);
         return;
     }
-    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], &pfx[p], &pfy[p]);
+    cdem_contact_eval(law, cls[p], dx, dy, R, dvx, dvy, dt, &xs[p], &hist[p], own, &pfx[p],
+                      &pfy[p]);
 }
 
-/* cdem_force_pair for pair p of the arrays a. */
+/* cdem_force_pair for pair p of the arrays a, for a law without state (the vector paths':
+ * a law with state is evaluated by the scalar loop of its own, force.c). */
 static CDEM_INLINE void cdem_force_pair_at(const cdem_force_pairs *a, long p) {
     const int32_t i = a->pi[p], j = a->pj[p];
     cdem_force_pair(a->law, p, a->x[j] - a->x[i], a->y[j] - a->y[i], a->vx[j] - a->vx[i],
-                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, a->pfx, a->pfy, a->dt);
+                    a->vy[j] - a->vy[i], a->R, a->cls, a->hist, a->xs, NULL, a->pfx, a->pfy, a->dt,
+                    0);
 }
 
 /* The kernels of a vector path (force.h, "Paths"). Each gives the bits of the scalar code

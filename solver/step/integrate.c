@@ -51,6 +51,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     it->force.law_scalar_only = !cdem_force_law_vectorised(it->law.granular);
     CDEM_TRY(cdem_neighbour_init(&it->nb, 0.25 * m->radius[0], 1.0 + it->law.max_breaking_strain,
                                  RESORT_EVERY, err));
+    CDEM_TRY(cdem_neighbour_set_slots(&it->nb, it->law.slot_count, err)); /* the law's history */
     cdem_viscous_init(&it->viscous, m);
     return CDEM_OK;
 }

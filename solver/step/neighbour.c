@@ -51,6 +51,18 @@ cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_fa
     return CDEM_OK;
 }
 
+cdem_status cdem_neighbour_set_slots(cdem_neighbour *nb, int count, cdem_error *err) {
+    if (count < 0 || nb->n_builds != 0 || nb->np != 0)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID,
+                         "neighbour list: %d history slots a pair: must be >= 0 and set before "
+                         "the first build",
+                         count);
+    nb->slot_count = count;
+    if (count > 0 && nb->pcap > 0)
+        CDEM_TRY(grow((void **)&nb->slots, sizeof(double) * (size_t)count, nb->pcap, err));
+    return CDEM_OK;
+}
+
 void cdem_neighbour_free(cdem_neighbour *nb) {
     if (!nb)
         return;
@@ -60,6 +72,7 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->cls);
     free(nb->hist);
     free(nb->xs);
+    free(nb->slots);
     free(nb->pfx);
     free(nb->pfy);
     free(nb->istart);
@@ -76,6 +89,7 @@ void cdem_neighbour_free(cdem_neighbour *nb) {
     free(nb->cell_y);
     free(nb->cell_r);
     free(nb->carry);
+    free(nb->carry_slots);
     free(nb->oldmap);
     for (int t = 0; t < CDEM_NB_MAX_THREADS; t++) {
         free(nb->tbuf[t].pi);
@@ -140,6 +154,8 @@ static cdem_status reserve_pairs(cdem_neighbour *nb, size_t np, cdem_error *err)
     CDEM_TRY(grow((void **)&nb->pfx, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->pfy, sizeof(double), c, err));
     CDEM_TRY(grow((void **)&nb->jslot, sizeof(int32_t), c, err));
+    if (nb->slot_count > 0)
+        CDEM_TRY(grow((void **)&nb->slots, sizeof(double) * (size_t)nb->slot_count, c, err));
     nb->pcap = c;
     return CDEM_OK;
 }
@@ -153,9 +169,33 @@ static int build_threads(const cdem_neighbour *nb, size_t items) {
     return nthr > CDEM_NB_MAX_THREADS ? CDEM_NB_MAX_THREADS : nthr < 1 ? 1 : nthr;
 }
 
-/* Whether pair p has a history to carry. */
+/* Whether pair p has a history to carry (a pair without flags does not touch: its slots, if
+ * the law has any, are not a contact's, law.h). */
 static int has_history(const cdem_neighbour *nb, size_t p) {
     return nb->hist[p] != 0 || nb->xs[p] != 0.0;
+}
+
+/* Pair `from`'s history slots in src to pair `to`'s in dst (m a pair). */
+static CDEM_INLINE void copy_slots(size_t m, double *dst, size_t to, const double *src,
+                                   size_t from) {
+    for (size_t k = 0; k < m; k++)
+        dst[to * m + k] = src[from * m + k];
+}
+
+/* The histories of the pairs a..b-1 into the carry from entry k on, with their m history
+ * slots each. Called with the constant 0 for a law without slots, so that its loop is the
+ * one without them. */
+static CDEM_INLINE void carry_range(cdem_neighbour *nb, size_t a, size_t b, size_t k, size_t m) {
+    for (size_t p = a; p < b; p++) {
+        if (!has_history(nb, p))
+            continue;
+        nb->carry[k].i = nb->pi[p];
+        nb->carry[k].j = nb->pj[p];
+        nb->carry[k].xs = nb->xs[p];
+        nb->carry[k].hist = nb->hist[p];
+        copy_slots(m, nb->carry_slots, k, nb->slots, p);
+        k++;
+    }
 }
 
 /* The histories to carry, in slot order: counted and copied by each thread over its own
@@ -165,7 +205,7 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
     nb->ncarry = 0;
     if (nb->n_builds == 0 || nb->n > s->n)
         return CDEM_OK; /* no list yet (or the state was replaced): nothing valid to carry */
-    const size_t np = nb->np;
+    const size_t np = nb->np, m = (size_t)nb->slot_count;
     const int nthr = build_threads(nb, np);
     size_t count[CDEM_NB_MAX_THREADS + 1] = {0}, total = 0;
     int failed = 0;
@@ -186,25 +226,22 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
             if (total > nb->carrycap) {
                 const size_t c = next_cap(nb->carrycap, total);
                 void *q = realloc(nb->carry, c * sizeof(cdem_pair_carry));
-                if (q) {
+                if (q)
                     nb->carry = q;
+                void *qs = q && m > 0 ? realloc(nb->carry_slots, c * m * sizeof(double)) : NULL;
+                if (qs)
+                    nb->carry_slots = qs;
+                if (q && (m == 0 || qs))
                     nb->carrycap = c;
-                } else {
+                else
                     failed = 1;
-                }
             }
         }
         if (!failed) {
-            k = count[t];
-            for (size_t p = a; p < b; p++) {
-                if (!has_history(nb, p))
-                    continue;
-                nb->carry[k].i = nb->pi[p];
-                nb->carry[k].j = nb->pj[p];
-                nb->carry[k].xs = nb->xs[p];
-                nb->carry[k].hist = nb->hist[p];
-                k++;
-            }
+            if (m == 0)
+                carry_range(nb, a, b, count[t], 0);
+            else
+                carry_range(nb, a, b, count[t], m);
         }
     }
     if (failed)
@@ -214,25 +251,39 @@ static cdem_status save_carry(cdem_neighbour *nb, const cdem_state *s, cdem_erro
     return CDEM_OK;
 }
 
+/* Restores carried history k (with its m history slots) into its pair's slot, if the pair is
+ * still in the list. */
+static CDEM_INLINE void restore_one(cdem_neighbour *nb, long k, size_t m) {
+    const cdem_pair_carry *c = &nb->carry[k];
+    const size_t a = nb->oldmap[c->i], b = nb->oldmap[c->j];
+    if (a == SIZE_MAX || b == SIZE_MAX)
+        return; /* an element of the pair was removed */
+    const int32_t lo = (int32_t)(a < b ? a : b), hi = (int32_t)(a < b ? b : a);
+    for (int32_t p = nb->istart[lo]; p < nb->istart[lo + 1]; p++) {
+        if (nb->pj[p] == hi) {
+            nb->hist[p] = c->hist;
+            nb->xs[p] = c->xs;
+            copy_slots(m, nb->slots, (size_t)p, nb->carry_slots, (size_t)k);
+            return;
+        }
+    }
+}
+
 /* Restores the saved histories: old indices -> new through oldmap, then the slot of
- * (lo, hi) is found in lo's contiguous pi range. O(pairs). */
+ * (lo, hi) is found in lo's contiguous pi range. O(pairs). Every carried pair has its own
+ * slot: the iterations write disjoint slots. A law without history slots has a loop of its
+ * own (restore_one with the constant 0). */
 static void restore_carry(cdem_neighbour *nb) {
     const long ncarry = (long)nb->ncarry;
-    /* every carried pair has its own slot: the iterations write disjoint slots */
+    const size_t m = (size_t)nb->slot_count;
+    if (m == 0) {
 #pragma omp parallel for schedule(static) if (ncarry > nb->par_min)
-    for (long k = 0; k < ncarry; k++) {
-        const cdem_pair_carry *c = &nb->carry[k];
-        const size_t a = nb->oldmap[c->i], b = nb->oldmap[c->j];
-        if (a == SIZE_MAX || b == SIZE_MAX)
-            continue; /* an element of the pair was removed */
-        const int32_t lo = (int32_t)(a < b ? a : b), hi = (int32_t)(a < b ? b : a);
-        for (int32_t p = nb->istart[lo]; p < nb->istart[lo + 1]; p++) {
-            if (nb->pj[p] == hi) {
-                nb->hist[p] = c->hist;
-                nb->xs[p] = c->xs;
-                break;
-            }
-        }
+        for (long k = 0; k < ncarry; k++)
+            restore_one(nb, k, 0);
+    } else {
+#pragma omp parallel for schedule(static) if (ncarry > nb->par_min)
+        for (long k = 0; k < ncarry; k++)
+            restore_one(nb, k, m);
     }
 }
 
@@ -665,6 +716,8 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
     else
         CDEM_TRY(enumerate_threaded(nb, s, &g, nthr, err));
     CDEM_TRY(build_csr(nb, n, err));
+    if (nb->slot_count > 0) /* every pair's slots start at 0; the carried ones are restored */
+        memset(nb->slots, 0, nb->np * (size_t)nb->slot_count * sizeof *nb->slots);
     restore_carry(nb);
     memcpy(nb->x0, s->x, n * sizeof(double));
     memcpy(nb->y0, s->y, n * sizeof(double));
@@ -691,6 +744,11 @@ cdem_status cdem_neighbour_snapshot_put(const cdem_neighbour *nb, cdem_snapshot 
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "cls", CDEM_SNAP_U8, nb->np, nb->cls, err));
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "hist", CDEM_SNAP_U8, nb->np, nb->hist, err));
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "xs", CDEM_SNAP_F64, nb->np, nb->xs, err));
+    if (nb->slot_count > 0) { /* only then: a list without slots is stored as it always was */
+        CDEM_TRY(cdem_ckpt_put_i64(snap, P, "slot_count", nb->slot_count, err));
+        CDEM_TRY(cdem_ckpt_put_array(snap, P, "slots", CDEM_SNAP_F64,
+                                     nb->np * (size_t)nb->slot_count, nb->slots, err));
+    }
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "pfx", CDEM_SNAP_F64, nb->np, nb->pfx, err));
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "pfy", CDEM_SNAP_F64, nb->np, nb->pfy, err));
     CDEM_TRY(cdem_ckpt_put_array(snap, P, "x0", CDEM_SNAP_F64, nb->n, nb->x0, err));
@@ -715,6 +773,19 @@ cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot 
                          "checkpoint)",
                          (long long)n, s->n);
     const size_t P_ = (size_t)np, N_ = (size_t)n;
+    /* the law's history slots: stored only by a list that has them */
+    int64_t slot_count = 0;
+    if (cdem_snapshot_get(snap, "nb.slot_count"))
+        CDEM_TRY(cdem_ckpt_get_range(snap, P, "slot_count", 1, INT32_MAX, &slot_count, err));
+    if (slot_count != nb->slot_count)
+        return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
+                         "checkpoint nb.slot_count = %lld history slots a contact but this run's "
+                         "contact law has %d: the checkpoint belongs to another law",
+                         (long long)slot_count, nb->slot_count);
+    const cdem_snapshot_array *slots = NULL;
+    const size_t S_ = P_ * (size_t)slot_count;
+    if (slot_count > 0)
+        CDEM_TRY(cdem_ckpt_get_array(snap, P, "slots", CDEM_SNAP_F64, S_, &slots, err));
     const cdem_snapshot_array *pi, *pj, *R, *cls, *hist, *xs, *pfx, *pfy, *x0, *y0;
     CDEM_TRY(cdem_ckpt_get_array(snap, P, "pi", CDEM_SNAP_I32, P_, &pi, err));
     CDEM_TRY(cdem_ckpt_get_array(snap, P, "pj", CDEM_SNAP_I32, P_, &pj, err));
@@ -743,6 +814,8 @@ cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot 
         memcpy(nb->cls, cls->data, P_ * sizeof *nb->cls);
         memcpy(nb->hist, hist->data, P_ * sizeof *nb->hist);
         memcpy(nb->xs, xs->data, P_ * sizeof *nb->xs);
+        if (slots)
+            memcpy(nb->slots, slots->data, S_ * sizeof *nb->slots);
         memcpy(nb->pfx, pfx->data, P_ * sizeof *nb->pfx);
         memcpy(nb->pfy, pfy->data, P_ * sizeof *nb->pfy);
     }

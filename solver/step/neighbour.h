@@ -2,11 +2,12 @@
  * reach + skin) finds the candidate pairs at each rebuild; the Verlet list keeps every pair
  * whose gap is below the skin, and stays valid until some element has moved more than half
  * the skin since the build (then cdem_neighbour_needs_rebuild says so). Never all-pairs.
- * Each pair carries its contact history (contact.h) and a force slot (one writer per slot);
- * fixed per-element slot lists (CSR) make the per-element force sums
- * independent of the thread count. At a rebuild the histories are carried over by element
- * id pair, so they survive re-sorting and element removal; every `resort_every` builds the
- * state arrays are permuted into cell order (memory locality).
+ * Each pair carries its contact history (contact.h: the flags, Xs, and the granular law's
+ * history slots, slot_count doubles a pair, none and nothing allocated for a law without)
+ * and a force slot (one writer per slot); fixed per-element slot lists (CSR) make the
+ * per-element force sums independent of the thread count. At a rebuild the histories are
+ * carried over by element id pair, so they survive re-sorting and element removal; every
+ * `resort_every` builds the state arrays are permuted into cell order (memory locality).
  * Between builds the caller may only append elements to the state (removal goes through
  * the keep argument of the build). Ownership: cdem_neighbour owns its buffers (grown geometrically,
  * only at build time); it never owns the state. Thread safety: one build at a time (it
@@ -23,7 +24,8 @@
 #include <stdint.h>
 
 /* Carried contact history of one pair across a build, by the pair's element indices before
- * the build (mapped through removal and re-sorting; ids never change meaning). */
+ * the build (mapped through removal and re-sorting; ids never change meaning). Its law's
+ * history slots travel beside it (cdem_neighbour carry_slots, the same index). */
 typedef struct {
     int32_t i, j; /* element indices before the build, i < j */
     double xs;    /* tangential displacement, m */
@@ -60,6 +62,9 @@ typedef struct {
     uint8_t *hist;     /* CDEM_PAIR_* history flags */
     double *xs;        /* m, accumulated tangential displacement (contact frame) */
     double *pfx, *pfy; /* N, contact force on pi of the last evaluation (pj gets minus) */
+    int slot_count;    /* the law's history slots per pair (cdem_neighbour_set_slots), >= 0 */
+    double *slots;     /* pair p's at slots[p * slot_count ..] (pcap * slot_count; NULL when
+                          slot_count is 0) */
 
     /* per-element pair slots, in a fixed order: the slots where e is pi are the range
      * istart[e]..istart[e+1]-1 (pairs are enumerated by ascending pi); the slots where e is
@@ -89,6 +94,7 @@ typedef struct {
     /* carried histories */
     size_t ncarry, carrycap;
     cdem_pair_carry *carry;
+    double *carry_slots; /* carry[k]'s slots at carry_slots[k * slot_count ..] (NULL when none) */
 
     /* per-thread pair buffers of a threaded build (thread t enumerates the t-th contiguous
      * element range; the buffers are concatenated in thread order) */
@@ -115,9 +121,16 @@ int cdem_neighbour_avx2_usable(void);
 size_t cdem_neighbour_near_avx2(const cdem_neighbour_cells *c, int32_t i, double xi, double yi,
                                 double ri, int32_t k0, int32_t k1, int32_t *out_k, double *out_R);
 
-/* Sets up an empty list. skin > 0 (m); reach_factor >= 1. */
+/* Sets up an empty list. skin > 0 (m); reach_factor >= 1. The pairs have no history slots
+ * until cdem_neighbour_set_slots. */
 cdem_status cdem_neighbour_init(cdem_neighbour *nb, double skin, double reach_factor,
                                 int resort_every, cdem_error *err);
+
+/* Gives every pair `count` history slots (the granular law's, cdem_contact_law slot_count),
+ * zero until the law writes them; before the first build or restore only (else
+ * CDEM_ERR_INVALID). They are carried as Xs is (rebuilds, removal, re-sorting), set back to 0
+ * with it when the pair separates (the force pass, contact.h) and stored in checkpoints. */
+cdem_status cdem_neighbour_set_slots(cdem_neighbour *nb, int count, cdem_error *err);
 void cdem_neighbour_free(cdem_neighbour *nb);
 
 /* 1 when the list must be rebuilt: the element count changed, or some element moved more
@@ -149,14 +162,17 @@ cdem_status cdem_neighbour_build(cdem_neighbour *nb, cdem_state *s, const unsign
                                  int resort, cdem_error *err);
 
 /* Checkpoints (checkpoint.h): the whole list under "nb." — pairs in their order (pi, pj, R,
- * cls), the contact histories (hist, xs), the last pair forces (pfx, pfy), the reference
- * positions of the last build (x0, y0), n, n_builds, n_sorts — so a resumed run rebuilds at
- * the same steps, re-sorts at the same builds and sums forces in the same pair order. The
- * CSR (istart, jstart, jslot) is derived from pi, pj exactly as a build derives it. */
+ * cls), the contact histories (hist, xs; with history slots also slot_count and slots, in
+ * pair order: a list without slots is stored as it always was), the last pair forces (pfx,
+ * pfy), the reference positions of the last build (x0, y0), n, n_builds, n_sorts — so a
+ * resumed run rebuilds at the same steps, re-sorts at the same builds and sums forces in the
+ * same pair order. The CSR (istart, jstart, jslot) is derived from pi, pj exactly as a build
+ * derives it. */
 cdem_status cdem_neighbour_snapshot_put(const cdem_neighbour *nb, cdem_snapshot *snap,
                                         cdem_error *err);
-/* Restores into nb (initialised with the same skin and reach factor, else CDEM_ERR_CONFLICT)
- * for the state s already restored (s->n must equal the stored n). */
+/* Restores into nb (initialised with the same skin, reach factor and slot count, else
+ * CDEM_ERR_CONFLICT naming the value) for the state s already restored (s->n must equal the
+ * stored n). */
 cdem_status cdem_neighbour_snapshot_get(cdem_neighbour *nb, const cdem_snapshot *snap,
                                         const cdem_state *s, cdem_error *err);
 
