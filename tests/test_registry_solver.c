@@ -176,10 +176,8 @@ static void test_registry_contact_laws(void **state) {
             assert_string_equal(cdem_law_name(law), laws[i]);
         assert_true(strcmp(cdem_law_description(law), "?") != 0);
         force[i] = law_fx_sliding_force(law);
-        /* a force of the law's sign; the salt law (CDEM_LAW_SALT, the pair law of salt
-         * elements) has no shear strength and transmits none */
-        assert_true(isfinite(force[i]) &&
-                    (law == CDEM_LAW_SALT ? force[i] == 0.0 : force[i] > 0.0));
+        /* a force of the law's sign: every law has a shear strength */
+        assert_true(isfinite(force[i]) && force[i] > 0.0);
         for (int j = 0; j < i; j++)
             if (force[j] == force[i])
                 fail_msg("laws %s and %s give the same sliding force %g", cdem_law_name(j),
@@ -192,7 +190,7 @@ static void test_registry_contact_laws(void **state) {
     cdem_contact_law cl;
     cdem_error err;
     assert_int_equal(cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err), CDEM_ERR_RANGE);
-    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb, spring-cohesion or salt"));
+    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb or spring-cohesion"));
     assert_documented_and_tested("material.granular_law", laws, n, "CDEM_LAW_");
 }
 

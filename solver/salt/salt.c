@@ -5,10 +5,7 @@
 #include "salt.h"
 
 #include "grid.h"
-
-#define CDEM_LAW_SCALAR
-#include "laws/law.h"
-#include "laws/laws.def"
+#include "salt_law.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -134,7 +131,7 @@ cdem_status cdem_salt_measure(const cdem_state *s, double region_area, double re
                         continue;
                     const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
                     const double r = sqrt(dx * dx + dy * dy), R = s->radius[i] + s->radius[j];
-                    const double w = cdem_law_salt_weight(r, R, reach);
+                    const double w = cdem_salt_law_weight(r, R, reach);
                     if (!(w > 0.0) || r <= 0.0)
                         continue;
                     sum += w * r * r / 8.0;
@@ -578,7 +575,7 @@ void cdem_salt_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *
         const int both = (s->flags[i] & s->flags[j] & CDEM_FLAG_SALT) != 0;
         const double cc = zeta > 0.0 && !both && r2 < R * R ? zeta * critical(salt, s, i, j) : 0.0;
         double fx, fy;
-        cdem_law_salt_pair(dx, dy, r2, R, s->vx[j] - s->vx[i], s->vy[j] - s->vy[i], both, salt->kn,
+        cdem_salt_law_pair(dx, dy, r2, R, s->vx[j] - s->vx[i], s->vy[j] - s->vy[i], both, salt->kn,
                            c, cc, salt->reach, &fx, &fy);
         ex[i] += fx;
         ey[i] += fy;

@@ -6,7 +6,7 @@
  * its area ratio J (p = K (1/J - 1), no tension); a force evaluation does P2G (the salt, then
  * the non-salt elements that share its nodes: the no-slip contacts), the gradient and
  * sigma = -p I + 2 eta D', the node forces and G2P, and the salt's pairs with the law of
- * common/laws/law_salt.h; after a step the salt is projected back onto a grid of its own
+ * salt_law.h; after a step the salt is projected back onto a grid of its own
  * (cdem_salt_project), which moves it and whose divergence J follows. The formulas and
  * measurements: docs/solver.md, section 9.
  * Determinism: serial sums in element or pair order, the same bits for any thread count.

@@ -92,10 +92,6 @@ static void time_scale_rule(const cdem_params *p, const cdem_model *m, cdem_rule
 }
 
 void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
-    if (p->granular_law == CDEM_LAW_SALT)
-        cdem_rule_add(log, "material.granular_law = salt: the salt law is the pair law of salt "
-                           "elements (salt.layer), not a material; a cover needs a shear "
-                           "strength: use normal-cohesion, coulomb or spring-cohesion");
     if (p->salt_layer == CDEM_SALT_OFF)
         return;
     const char *lw = layer_word(p->salt_layer);
