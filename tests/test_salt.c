@@ -84,7 +84,7 @@ static void test_salt_viscous_kernel_simple_shear(void **state) {
     assert_int_equal(cdem_integrator_prime(&c.it, &c.s, &err), CDEM_OK);
     const cdem_salt *salt = &c.salt;
     const double eta = salt->viscosity;
-    const double p_expect = c.m.salt.bulk_modulus * (1.0 / j0 - 1.0);
+    const double p_expect = c.sm.bulk_modulus * (1.0 / j0 - 1.0);
     double sum_sxy = 0.0, sum_p = 0.0, worst = 0.0;
     long n = 0;
     for (size_t i = 0; i < c.s.n; i++) {
@@ -211,10 +211,12 @@ static void test_salt_projection_moves_with_j(void **state) {
 /* salt-4: the placement of salt.layer in a built assembly. */
 static void place(cdem_params *p, cdem_state *s, cdem_model *m, cdem_salt_layer *layer,
                   cdem_status expect, cdem_error *err) {
+    cdem_salt_model sm;
     assert_int_equal(cdem_model_derive(p, NULL, m, err), CDEM_OK);
+    assert_int_equal(cdem_salt_model_derive(p, m, &sm, err), CDEM_OK);
     assert_int_equal(cdem_state_init(s, 1024, 0, err), CDEM_OK);
     assert_int_equal(cdem_assembly_build(p, m, s, NULL, err), CDEM_OK);
-    assert_int_equal(cdem_salt_place(p, m, s, layer, err), expect);
+    assert_int_equal(cdem_salt_place(p, m, &sm, s, layer, err), expect);
 }
 
 static void test_salt_placement(void **state) {
@@ -287,7 +289,8 @@ static void test_salt_placement(void **state) {
 }
 
 /* salt-6: bad input names the key, the value and what is allowed: a negative viscosity, a
- * salt layer as thick as the assembly, the salt as a cover's law (the rules between keys are test_params.c's). */
+ * salt layer as thick as the assembly, the salt as a cover's law (the rules between keys are
+ * test_params.c's). */
 static void test_salt_bad_input(void **state) {
     (void)state;
     static const struct {
