@@ -15,6 +15,7 @@
 
 #include "bc.h"
 #include "run.h"
+#include "run_fixtures.h"
 #include "snapshot.h"
 #include "state.h"
 #include "summary.h"
@@ -66,27 +67,6 @@ static void test_bc_still_is_a_users_mode_on_the_clock_of_time(void **state) {
     free(text);
 }
 
-/* In memory (no file), no log: a run keeps a pointer to its options, so they outlive it. */
-static const cdem_run_options quiet_run = {.quiet = 1};
-
-static cdem_snapshot *capture(const cdem_run_ctx *r) {
-    cdem_snapshot *snap = NULL;
-    cdem_error err;
-    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
-    if (cdem_run_capture(r, snap, &err) != CDEM_OK)
-        fail_msg("cdem_run_capture: %s", err.msg);
-    return snap;
-}
-
-static const void *array_of(const cdem_snapshot *s, const char *name, size_t *count) {
-    const cdem_snapshot_array *a = cdem_snapshot_get(s, name);
-    if (!a)
-        fail_msg("the checkpoint has no %s", name);
-    if (count)
-        *count = a->count;
-    return a->data;
-}
-
 /* still-2 */
 static void test_bc_still_walls_stay_while_the_tilt_moves_the_pile(void **state) {
     (void)state;
@@ -99,11 +79,10 @@ static void test_bc_still_walls_stay_while_the_tilt_moves_the_pile(void **state)
     assert_int_equal(cdem_run_advance(r, cdem_run_total_steps(r), &err), CDEM_OK);
     cdem_snapshot *after = capture(r);
     size_t n0 = 0, n1 = 0;
-    const uint32_t *flags = array_of(before, "state.flags", &n0);
-    const int32_t *id0 = array_of(before, "state.id", NULL),
-                  *id1 = array_of(after, "state.id", &n1);
-    const double *x0 = array_of(before, "state.x", NULL), *y0 = array_of(before, "state.y", NULL);
-    const double *x1 = array_of(after, "state.x", NULL), *y1 = array_of(after, "state.y", NULL);
+    const uint32_t *flags = array_n(before, "state.flags", &n0);
+    const int32_t *id0 = array_n(before, "state.id", NULL), *id1 = array_n(after, "state.id", &n1);
+    const double *x0 = array_n(before, "state.x", NULL), *y0 = array_n(before, "state.y", NULL);
+    const double *x1 = array_n(after, "state.x", NULL), *y1 = array_n(after, "state.y", NULL);
     size_t walls = 0, free_moved = 0;
     for (size_t i = 0; i < n0; i++) {
         size_t j = 0; /* the same element after */
