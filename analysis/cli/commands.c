@@ -21,6 +21,7 @@
     X(calibrate)                                                                                   \
     X(voids)                                                                                       \
     X(faults)                                                                                      \
+    X(fault_seal)                                                                                  \
     X(wedge)                                                                                       \
     X(plot_csv)                                                                                    \
     X(export_sspx)                                                                                 \
