@@ -22,7 +22,7 @@ complete -o filenames -F _cdem_run cdem-run
 _cdem_strain() {
     local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"
     if [ "$COMP_CWORD" -eq 1 ]; then
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults fault-seal wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help -V --version -h --help" -- "$cur"))
         [ ${#COMPREPLY[@]} -eq 0 ] && COMPREPLY=($(compgen -f -- "$cur"))
         return
     fi
@@ -143,6 +143,18 @@ _cdem_strain() {
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
         esac
         opts="--increment --quantity --threshold --bin --min-rows --include-salt -o --output -h --help" ;;
+    fault-seal)
+        case "$prev" in
+            --increment) COMPREPLY=($(compgen -W "last equil first" -- "$cur")); return ;;
+            --fault-x) return ;;
+            --half-width) return ;;
+            --band) return ;;
+            --step) return ;;
+            --seal-layers) return ;;
+            --table) COMPREPLY=($(compgen -W "juxtaposition throw seals" -- "$cur")); return ;;
+            -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+        esac
+        opts="--increment --fault-x --half-width --band --step --seal-layers --table -o --output -h --help" ;;
     wedge)
         case "$prev" in
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
@@ -186,7 +198,7 @@ _cdem_strain() {
     quantities)
         opts="-h --help" ;;
     help)
-        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
+        COMPREPLY=($(compgen -W "info compute element limits render series plot-series mohr repose calibrate voids faults fault-seal wedge plot-csv export-sspx export-biaxial import-cdem2d xdmf quantities help" -- "$cur"))
         return ;;
     esac
     if [[ "$cur" == -* ]]; then
