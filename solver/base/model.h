@@ -101,9 +101,6 @@ typedef struct {
     double displacement_per_step;  /* m, boundary_speed * dt */
     double gravity;                /* m/s^2, the magnitude actually applied (0 when the mode
                                       turns it off); its direction: mode.gravity_tilt */
-    double gravity_x, gravity_y;   /* m/s^2, gravity's vector at the start: gravity turned by
-                                      mode.gravity_tilt (cdem_model_gravity_vector), derived
-                                      once for the loads and the summary */
     long elements_estimated;       /* free elements the assembly will hold, about
                                       (cdem_model_estimate_elements): the memory the run needs
                                       is checked from it before anything is built */
