@@ -23,6 +23,7 @@
 #include "snapshot.h"
 #include "state.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -56,7 +57,11 @@ typedef struct {
     int32_t has_stress;         /* 1 when sxx, syy, sxy are stored (filled by the reader) */
 } cdem_increment_info;
 
-/* One time-series sample. Columns with no meaning for the mode are 0. */
+/* One time-series sample. Columns with no meaning for the mode are 0. A process adds its
+ * own columns in its file common/processes/<id>.h (CDEM_PROCESS_SERIES(name, unit, lo, hi,
+ * label): a float64 member here, a column of /series after the others, its bounds lo..hi
+ * checked by the reader and the writer, NaN allowed: its process was off; the analysis's
+ * label), without a line here or in common/h5/. */
 typedef struct {
     int64_t step;               /* time step */
     double time;                /* s */
@@ -76,15 +81,32 @@ typedef struct {
     double left_wall_force_y;   /* N */
     double right_wall_force_x;  /* N, the same for the right lateral wall */
     double right_wall_force_y;  /* N */
-    double salt_area;           /* m^2, the salt's material area (sum of J pi r^2 / phi over
-                                   the salt elements, solver/step/salt.h): conserved to within
-                                   its elastic compression; NaN without salt */
-    double salt_top;            /* m, the highest salt element's top (a diapir's crest);
-                                   NaN without salt */
     double axial_strain;        /* biaxial */
     double differential_stress; /* biaxial, N/m */
     double sea_level;           /* m, NaN when none */
+    /* the processes' own columns (common/processes/<id>.h, CDEM_PROCESS_SERIES), in registry
+     * order; NaN while their process is off (cdem_series_processes_absent) */
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label) double name;
+#include "processes.def"
+#undef CDEM_PROCESS_SERIES
 } cdem_series_sample;
+
+/* The number of the processes' own series columns. */
+enum {
+    CDEM_PROCESS_SERIES_COUNT = 0
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label) +1
+#include "processes.def"
+#undef CDEM_PROCESS_SERIES
+};
+
+/* Sets every process's columns of q to NaN (not measured: the process is off); a process
+ * that runs fills its own (solver/process/process.h, its sample hook). */
+static inline void cdem_series_processes_absent(cdem_series_sample *q) {
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label) q->name = NAN;
+#include "processes.def"
+#undef CDEM_PROCESS_SERIES
+    (void)q;
+}
 
 /* What the writer may do with a file already at the output path.
  * Whatever the policy, the old file stays untouched until the new one is complete enough to

@@ -141,7 +141,7 @@ static const cdem_param_def param_table[] = {
     {"physics", "calculate_stress", CDEM_PTYPE_BOOL, P_OFF(calculate_stress), 0, "", "off", 0, 1, 0, 0, NULL,
      "store per-element stress in every increment", 0, 0},
     {"physics", "damping_mode", CDEM_PTYPE_ENUM, P_OFF(damping_mode), 0, "", "absolute", 0, 0, 0, 0, damping_words,
-     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required with salt)", 0, 0},
+     "absolute: the paper's drag on each free element's velocity (the calibration of Figs. 4-6); contact: a normal dashpot on each contact instead, which damps relative motion only (required by a viscous substrate process)", 0, 0},
     {"physics", "contact_damping", CDEM_PTYPE_DOUBLE, P_OFF(contact_damping), 0, "", "0.2", 0, 1, 0, 0, NULL,
      "damping_mode = contact: each contact's dashpot as a fraction of its critical damping 2 sqrt(Kn m_i m_j / (m_i + m_j))", 0, 0},
 

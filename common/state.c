@@ -122,7 +122,7 @@ cdem_status cdem_state_append(cdem_state *s, int32_t id, double x, double y, dou
     s->layer[i] = layer;
     s->flags[i] = flags;
     s->born[i] = born;
-    s->area_ratio[i] = 1.0; /* a disc keeps its area; only salt elements change it */
+    s->area_ratio[i] = 1.0; /* a disc keeps its area; only a viscous process changes it */
     if (index)
         *index = i;
     return CDEM_OK;

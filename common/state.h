@@ -28,7 +28,7 @@ enum {
     CDEM_FLAG_MYLAR = 1u << 7,        /* CD "mylar sheet" element dragging the hanging wall */
     CDEM_FLAG_SURFACE = 1u << 8,      /* top-surface element (overburden acts on it) */
     CDEM_FLAG_BASE = 1u << 9,         /* wall element of the base row (material.base_*) */
-    CDEM_FLAG_SALT = 1u << 10,        /* a viscous salt element (salt.layer; solver/step/salt.h) */
+    CDEM_FLAG_SALT = 1u << 10,        /* a viscous salt element (salt.layer; solver/salt/) */
     /* bits 16..22: the element moves with boundary actor 2..8 ([boundary.N]; the first actor's
      * elements carry CDEM_FLAG_MOVING), as CDEM_FLAG_ACTOR_MOVING(N) */
     CDEM_FLAG_ACTORS_MOVING = 0x7Fu << 16,
@@ -36,6 +36,10 @@ enum {
 
 /* The flag of the elements boundary actor n (2..8) moves. */
 #define CDEM_FLAG_ACTOR_MOVING(n) (1u << (14 + (n)))
+
+/* The elements of a process (solver/process/process.h, its flag): the process evaluates their
+ * pairs, never the pair list (cdem_contact_class); the analysis colours and filters by them. */
+#define CDEM_FLAGS_PROCESS (CDEM_FLAG_SALT)
 
 /* Elements that are integrated by Newton's law: neither wall, fault nor footwall display. */
 #define CDEM_FLAGS_BOUNDARY                                                                        \
@@ -57,10 +61,11 @@ typedef enum {
  *   X(name, C type, file type, in_increments, stress)
  *   in_increments  1: a dataset /increments/<name> of the run file; 0: checkpoints only
  *   stress         1: allocated only when has_stress (the three stress components)
- * area_ratio (J) is 1 for every element but salt, whose material area J pi r^2 / phi it
- * scales (solver/step/salt.h). It is in checkpoints, not in increments: J stays within 1 % of
- * 1 (the salt's bulk modulus), the salt's pressure K (1/J - 1) is in the stress datasets and
- * its area in the series (salt_area), and every file of a run without salt stays as it was. */
+ * area_ratio (J) is 1 for every element but a viscous process's elements, whose material area
+ * J pi r^2 / phi it scales (solver/process/process.h). It is in checkpoints, not in
+ * increments: J stays within 1 % of 1 (the process's bulk modulus), its pressure K (1/J - 1)
+ * is in the stress datasets and its area in the process's series columns, and every file of a
+ * run without such a process stays as it was. */
 #define CDEM_STATE_FIELDS(X)                                                                       \
     X(id, int32_t, CDEM_FIELD_I32, 1, 0)     /* stable element id, unique within a run */          \
     X(x, double, CDEM_FIELD_F64, 1, 0)       /* centre position, m */                              \
@@ -77,7 +82,8 @@ typedef enum {
     X(sxx, double, CDEM_FIELD_F64, 1, 1)     /* stress, N/m, compression positive */               \
     X(syy, double, CDEM_FIELD_F64, 1, 1)     /* NULL unless has_stress */                          \
     X(sxy, double, CDEM_FIELD_F64, 1, 1)                                                           \
-    X(area_ratio, double, CDEM_FIELD_F64, 0, 0) /* salt: material area / area at placement (J) */
+    X(area_ratio, double, CDEM_FIELD_F64, 0, 0) /* a viscous process's elements: material          \
+                                                   area / area at placement (J) */
 
 typedef struct {
     size_t n;        /* number of elements in use */
@@ -118,7 +124,7 @@ void cdem_state_free(cdem_state *s);
 
 /* The lowest and highest centre heights of the free elements (neither wall, fault, footwall
  * display nor mylar: CDEM_FLAGS_BOUNDARY); lo = +inf and hi = -inf when there are none. The
- * layers, the weak interval, the erosion level and the salt layer are measured on it. */
+ * layers, the weak interval, the erosion level and a process's band are measured on it. */
 void cdem_state_free_y_range(const cdem_state *s, double *lo, double *hi);
 
 /* Grows every array to hold at least capacity elements (geometric growth). */

@@ -55,6 +55,7 @@ __attribute__((unused)) static cdem_params salt_cell_params(double width_km, dou
 typedef struct {
     cdem_params p;
     cdem_model m;
+    cdem_salt_model sm; /* the salt's constants (cdem_salt_model_derive) */
     cdem_state s;
     cdem_integrator it;
     cdem_salt_layer layer;
@@ -70,7 +71,8 @@ __attribute__((unused)) static int salt_cell_open(salt_cell *c, const cdem_param
                                                   cdem_error *err) {
     memset(c, 0, sizeof *c);
     c->p = *p;
-    if (cdem_model_derive(&c->p, NULL, &c->m, err) != CDEM_OK)
+    if (cdem_model_derive(&c->p, NULL, &c->m, err) != CDEM_OK ||
+        cdem_salt_model_derive(&c->p, &c->m, &c->sm, err) != CDEM_OK)
         return 0;
     if (cdem_state_init(&c->s, 1024, 1, err) != CDEM_OK)
         return 0;
@@ -90,7 +92,7 @@ __attribute__((unused)) static int salt_cell_open(salt_cell *c, const cdem_param
         while (cls + 1 < CDEM_NUM_RADII && c->s.radius[i] > c->m.radius[cls])
             cls++;
         c->s.flags[i] |= CDEM_FLAG_SALT;
-        c->s.mass[i] = c->m.salt.mass[cls];
+        c->s.mass[i] = c->sm.mass[cls];
         c->s.area_ratio[i] = j0;
         top = fmax(top, c->s.y[i] + c->s.radius[i]);
         right = fmax(right, c->s.x[i] + c->s.radius[i]);
@@ -101,12 +103,13 @@ __attribute__((unused)) static int salt_cell_open(salt_cell *c, const cdem_param
     c->gap = top - c->y_base;
     c->layer.band_lo = c->y_base;
     c->layer.band_hi = top;
-    if (cdem_salt_measure(&c->s, region_area > 0.0 ? region_area : right * c->gap, c->m.salt.reach,
+    if (cdem_salt_measure(&c->s, region_area > 0.0 ? region_area : right * c->gap, c->sm.reach,
                           &c->layer, err) != CDEM_OK)
         return 0;
     if (cdem_integrator_init(&c->it, &c->p, &c->m, err) != CDEM_OK)
         return 0;
-    if (cdem_salt_configure(&c->salt, &c->m, &c->p, &c->layer, c->it.nb.skin, err) != CDEM_OK ||
+    if (cdem_salt_configure(&c->salt, &c->m, &c->sm, &c->p, &c->layer, c->it.nb.skin, err) !=
+            CDEM_OK ||
         cdem_salt_join(&c->salt, &c->it.viscous, err) != CDEM_OK)
         return 0;
     c->it.damping_factor = 0.0; /* the deformation steps of damping_mode = contact */
@@ -159,10 +162,7 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
      * would own a slanted band of nodes that the shear sweeps across (docs/solver.md 9.5) */
     p.salt_wall_contact = CDEM_SALT_FREE_SLIP;
     salt_cell c;
-    cdem_model m0;
-    if (cdem_model_derive(&p, NULL, &m0, err) != CDEM_OK)
-        return 0;
-    const double j0 = 1.0 / (1.0 + confining / m0.salt.bulk_modulus);
+    const double j0 = 1.0 / (1.0 + confining / p.salt_bulk_modulus);
     if (!salt_cell_open(&c, &p, j0, INFINITY, INFINITY, 0.0, err))
         return 0;
     c.m.gravity = 0.0;
@@ -205,8 +205,8 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
     cdem_state_compact(&c.s, keep, NULL);
     free(keep);
     /* the salt measured again in the box it now fills, and the module set up with it */
-    if (cdem_salt_measure(&c.s, W * H, c.m.salt.reach, &c.layer, err) != CDEM_OK ||
-        cdem_salt_configure(&c.salt, &c.m, &c.p, &c.layer, c.it.nb.skin, err) != CDEM_OK) {
+    if (cdem_salt_measure(&c.s, W * H, c.sm.reach, &c.layer, err) != CDEM_OK ||
+        cdem_salt_configure(&c.salt, &c.m, &c.sm, &c.p, &c.layer, c.it.nb.skin, err) != CDEM_OK) {
         salt_cell_close(&c);
         return 0;
     }
@@ -294,7 +294,7 @@ __attribute__((unused)) static int couette_run(double U, double strain, double c
         sxy += yb * vb;
         nn += 1.0;
     }
-    out->eta_set = c.m.salt.viscosity;
+    out->eta_set = c.sm.viscosity;
     out->rate_nominal = U / H;
     out->rate_bulk = (nn * sxy - sx * sy) / (nn * sxx - sx * sx);
     out->tau_plate = tau_plate / (double)n_avg;
@@ -386,7 +386,7 @@ __attribute__((unused)) static int huppert_run(double box_km, double l0, double 
     cdem_salt_measures(&c.s, phi, &area0, &top, &n_salt);
     out->area0 = area0;
     out->elements = n_salt;
-    const double rho = c.m.salt.density, g = c.m.gravity, eta = c.m.salt.viscosity;
+    const double rho = c.sm.density, g = c.m.gravity, eta = c.sm.viscosity;
     out->theory_k = 1.4112 * pow(rho * g * area0 * area0 * area0 / (3.0 * eta), 0.2);
     const long steps = (long)ceil(runtime / dt), sample = (long)fmax(1.0, round(every / dt));
     for (long step = 1; step <= steps; step++) {

@@ -2,7 +2,8 @@
  * granular contact law that the parameter table offers (the words of boundary.mode and
  * material.granular_law, common/params.c) is
  *   - implemented: the mode's row of common/modes.def has its ops (cdem_bc_find succeeds, the
- *     required hooks are there, what it excludes are parameters; every registered mode, the
+ *     required hooks are there, what it excludes are parameters (or the processes); every
+ *     registered mode, the
  *     tests' fixtures too); the law is accepted by the contact kernel
  *     (cdem_contact_law_init) and gives a tangential force of its own in a sliding contact
  *     (every registered law: also the tests' fixtures, which no parameter file names); a law
@@ -24,7 +25,9 @@
 #include "bc.h"
 #include "contact.h"
 #include "force.h"
+#include "h5format.h"
 #include "params.h"
+#include "process.h"
 
 #include <ctype.h>
 #include <glob.h>
@@ -134,6 +137,8 @@ static void test_registry_boundary_modes(void **state) {
             !(ops->apply || (ops->step_begin && ops->step_move)))
             fail_msg("boundary.mode = %s: a required hook of cdem_bc_ops is missing (bc.h)", word);
         for (size_t k = 0; ops->excludes && ops->excludes[k]; k++) {
+            if (strcmp(ops->excludes[k], CDEM_EXCLUDES_PROCESSES) == 0)
+                continue; /* the processes: their own rules refuse them */
             char section[32];
             const char *dot = strchr(ops->excludes[k], '.');
             assert_non_null(dot);
@@ -179,10 +184,8 @@ static void test_registry_contact_laws(void **state) {
             assert_string_equal(cdem_law_name(law), laws[i]);
         assert_true(strcmp(cdem_law_description(law), "?") != 0);
         force[i] = law_fx_sliding_force(law);
-        /* a force of the law's sign; the salt law (CDEM_LAW_SALT, the pair law of salt
-         * elements) has no shear strength and transmits none */
-        assert_true(isfinite(force[i]) &&
-                    (law == CDEM_LAW_SALT ? force[i] == 0.0 : force[i] > 0.0));
+        /* a force of the law's sign: every law has a shear strength */
+        assert_true(isfinite(force[i]) && force[i] > 0.0);
         for (int j = 0; j < i; j++)
             if (force[j] == force[i])
                 fail_msg("laws %s and %s give the same sliding force %g", cdem_law_name(j),
@@ -205,8 +208,48 @@ static void test_registry_contact_laws(void **state) {
     cdem_contact_law cl;
     cdem_error err;
     assert_int_equal(cdem_contact_law_init(&cl, &p, 1e9, 1e9, &err), CDEM_ERR_RANGE);
-    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb, spring-cohesion or salt"));
+    assert_non_null(strstr(err.msg, "must be normal-cohesion, coulomb or spring-cohesion"));
     assert_documented_and_tested("material.granular_law", laws, n, "CDEM_LAW_");
+}
+
+/* Every registered process (common/processes.def) has its required hook and a context; the
+ * flag its elements carry is one of CDEM_FLAGS_PROCESS (state.h), so that the pair list
+ * leaves their pairs to it; each of the processes' series columns (CDEM_PROCESS_SERIES) is a
+ * member of the sample the writer takes, with bounds, and docs/format.md quotes it. */
+static void test_registry_processes(void **state) {
+    (void)state;
+    const cdem_process_ops *const all[] = {
+#define CDEM_PROCESS(ID, id, word) cdem_process_##id,
+#define CDEM_TEST_PROCESS          CDEM_PROCESS
+#include "processes.def"
+#undef CDEM_PROCESS
+#undef CDEM_TEST_PROCESS
+    };
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; k++) {
+        assert_non_null(all[k]->word);
+        if (!all[k]->active || all[k]->state_size == 0)
+            fail_msg("process %s: active and state_size are required (process.h)", all[k]->word);
+        if (all[k]->flag & ~(uint32_t)CDEM_FLAGS_PROCESS)
+            fail_msg("process %s: its flag 0x%x is not in CDEM_FLAGS_PROCESS (state.h)",
+                     all[k]->word, (unsigned)all[k]->flag);
+    }
+    char *format = scratch_read_file("docs/format.md");
+    assert_non_null(format);
+    cdem_series_sample q;
+    memset(&q, 0, sizeof q);
+    cdem_series_processes_absent(&q);
+    size_t n = 0;
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label)                                             \
+    do {                                                                                           \
+        n++;                                                                                       \
+        assert_true(isnan(q.name) && (double)(lo) < (double)(hi) && *(unit) && *(label));          \
+        if (!strstr(format, "| `" #name "` | float64 |"))                                          \
+            fail_msg("series column %s: not in docs/format.md's table", #name);                    \
+    } while (0);
+#include "processes.def"
+#undef CDEM_PROCESS_SERIES
+    assert_int_equal(n, CDEM_PROCESS_SERIES_COUNT);
+    free(format);
 }
 
 /* The checker finds a word left out of the docs, of the parameter page or of the tests. */
@@ -228,6 +271,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_registry_boundary_modes),
         cmocka_unit_test(test_registry_contact_laws),
+        cmocka_unit_test(test_registry_processes),
         cmocka_unit_test(test_registry_checker_finds_omissions),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,6 +1,6 @@
-/* test_salt: the viscous salt (solver/salt/salt.h, its pair law common/laws/law_salt.h, its
+/* test_salt: the viscous salt (solver/salt/salt.h, its pair law solver/salt/salt_law.h, its
  * rules solver/salt/salt_rules.c). Fast checks of make test:
- *   salt-1 the pair law's kernels: no shear strength, the repulsion only against a non-salt
+ *   salt-1 the pair law (not a granular law): the repulsion only against a non-salt
  *          element, the central dashpot and its weight, no force for a rigid rotation;
  *   salt-2 the viscous kernel: the grid's stress of an affine simple shear is eta x rate and
  *          the pressure is K (1/J - 1), on a real assembly; it is the salt's stress of an
@@ -12,7 +12,8 @@
  *          shear rate within 20 % of the set viscosity, the plate's force within 20 % of
  *          eta U / H (a plate of wall elements, and one of cover elements), no slip at the
  *          plates (bulk rate within 10 % of U / H) and the area within 1 %;
- *   salt-6 bad input: a negative viscosity or density, a layer as thick as the assembly;
+ *   salt-6 bad input: a negative viscosity or density, a layer as thick as the assembly,
+ *          the salt as a cover's law (no granular law: an unknown word);
  *   salt-7 the projection: a salt moving as one body moves as one, its J unchanged, whatever
  *          velocity gradient the forces' grid saw.
  * The long checks (three rates over two decades, the gravity current) run under
@@ -26,39 +27,33 @@
 
 #include "salt_cells.h"
 
-#define CDEM_LAW_SCALAR
-#include "laws/law.h"
-#include "laws/laws.def"
+#include "salt_law.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* salt-1: the law's scalar kernel and its pair force. */
+/* salt-1: the pair law's force. */
 static void test_salt_law_kernel(void **state) {
     (void)state;
-    /* the registry's entry: no shear strength whatever the normal force and cohesion */
-    assert_string_equal(cdem_law_name(CDEM_LAW_SALT), "salt");
-    const cdem_shear sh = cdem_law_salt(3e5, 1e6, 0.6, 5e8);
-    assert_true(sh.force == 0.0 && sh.spring == 0.0 && sh.slid == 1);
     /* the dashpot's weight: 1 up to R, linear to 0 at reach x R */
-    assert_true(cdem_law_salt_weight(1.0, 2.0, 1.5) == 1.0);
-    assert_true(fabs(cdem_law_salt_weight(2.5, 2.0, 1.5) - 0.5) < 1e-15);
-    assert_true(cdem_law_salt_weight(3.0, 2.0, 1.5) == 0.0);
+    assert_true(cdem_salt_law_weight(1.0, 2.0, 1.5) == 1.0);
+    assert_true(fabs(cdem_salt_law_weight(2.5, 2.0, 1.5) - 0.5) < 1e-15);
+    assert_true(cdem_salt_law_weight(3.0, 2.0, 1.5) == 0.0);
     /* i at the origin, j at (1.9, 0), R = 2: overlap 0.1, approaching at 1 m/s */
     const double kn = 1e9, c = 1e6, dx = 1.9;
     double fx, fy;
-    cdem_law_salt_pair(dx, 0.0, dx * dx, 2.0, -1.0, 0.0, 1, kn, c, 0.0, 1.5, &fx, &fy);
+    cdem_salt_law_pair(dx, 0.0, dx * dx, 2.0, -1.0, 0.0, 1, kn, c, 0.0, 1.5, &fx, &fy);
     assert_true(fabs(fx - (-c)) < 1e-9 * c && fy == 0.0); /* salt-salt: the dashpot alone */
-    cdem_law_salt_pair(dx, 0.0, dx * dx, 2.0, -1.0, 0.0, 0, kn, c, 0.0, 1.5, &fx, &fy);
+    cdem_salt_law_pair(dx, 0.0, dx * dx, 2.0, -1.0, 0.0, 0, kn, c, 0.0, 1.5, &fx, &fy);
     const double rep = kn * (2.0 - 1.9);
     assert_true(fabs(fx - (-c - rep)) < 1e-9 * rep); /* salt-cover: repulsion too */
     /* apart (r > R) within reach: no repulsion, the weighted dashpot */
-    cdem_law_salt_pair(2.5, 0.0, 6.25, 2.0, 1.0, 0.0, 0, kn, c, 0.0, 1.5, &fx, &fy);
+    cdem_salt_law_pair(2.5, 0.0, 6.25, 2.0, 1.0, 0.0, 0, kn, c, 0.0, 1.5, &fx, &fy);
     assert_true(fabs(fx - 0.5 * c) < 1e-9 * c);
     /* a rigid rotation (dv perpendicular to d) is not resisted */
-    cdem_law_salt_pair(1.2, 1.6, 4.0, 2.0, -1.6, 1.2, 1, kn, c, 0.0, 1.5, &fx, &fy);
+    cdem_salt_law_pair(1.2, 1.6, 4.0, 2.0, -1.6, 1.2, 1, kn, c, 0.0, 1.5, &fx, &fy);
     assert_true(fabs(fx) < 1e-9 * c && fabs(fy) < 1e-9 * c);
 }
 
@@ -89,7 +84,7 @@ static void test_salt_viscous_kernel_simple_shear(void **state) {
     assert_int_equal(cdem_integrator_prime(&c.it, &c.s, &err), CDEM_OK);
     const cdem_salt *salt = &c.salt;
     const double eta = salt->viscosity;
-    const double p_expect = c.m.salt.bulk_modulus * (1.0 / j0 - 1.0);
+    const double p_expect = c.sm.bulk_modulus * (1.0 / j0 - 1.0);
     double sum_sxy = 0.0, sum_p = 0.0, worst = 0.0;
     long n = 0;
     for (size_t i = 0; i < c.s.n; i++) {
@@ -216,10 +211,12 @@ static void test_salt_projection_moves_with_j(void **state) {
 /* salt-4: the placement of salt.layer in a built assembly. */
 static void place(cdem_params *p, cdem_state *s, cdem_model *m, cdem_salt_layer *layer,
                   cdem_status expect, cdem_error *err) {
+    cdem_salt_model sm;
     assert_int_equal(cdem_model_derive(p, NULL, m, err), CDEM_OK);
+    assert_int_equal(cdem_salt_model_derive(p, m, &sm, err), CDEM_OK);
     assert_int_equal(cdem_state_init(s, 1024, 0, err), CDEM_OK);
     assert_int_equal(cdem_assembly_build(p, m, s, NULL, err), CDEM_OK);
-    assert_int_equal(cdem_salt_place(p, m, s, layer, err), expect);
+    assert_int_equal(cdem_salt_place(p, m, &sm, s, layer, err), expect);
 }
 
 static void test_salt_placement(void **state) {
@@ -292,7 +289,8 @@ static void test_salt_placement(void **state) {
 }
 
 /* salt-6: bad input names the key, the value and what is allowed: a negative viscosity, a
- * salt layer as thick as the assembly (the rules between keys are test_params.c's). */
+ * salt layer as thick as the assembly, the salt as a cover's law (the rules between keys are
+ * test_params.c's). */
 static void test_salt_bad_input(void **state) {
     (void)state;
     static const struct {
@@ -304,6 +302,9 @@ static void test_salt_bad_input(void **state) {
         {"salt.thickness_percent=120", "thickness_percent = 120: must be > 0 and < 100 %"},
         {"salt.thickness_percent=100", "thickness_percent = 100: must be > 0 and < 100 %"},
         {"salt.layer=dome", "layer = dome: must be one of off, basal, interval"},
+        /* the salt's pair law is no granular law: a cover cannot take it */
+        {"material.granular_law=salt",
+         "granular_law = salt: must be one of normal-cohesion, coulomb, spring-cohesion"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cdem_params p;

@@ -43,8 +43,10 @@ static const column_def columns[] = {
     COL(left_wall_force_y, "Left wall force y (N)"),
     COL(right_wall_force_x, "Right wall force x (N)"),
     COL(right_wall_force_y, "Right wall force y (N)"),
-    COL(salt_area, "Salt area (m^2)"),
-    COL(salt_top, "Salt top (m)"),
+/* the processes' own columns, labelled by their rows (common/processes/<id>.h) */
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label) COL(name, label),
+#include "processes.def"
+#undef CDEM_PROCESS_SERIES
 };
 #undef COL
 #undef ICOL

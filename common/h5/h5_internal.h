@@ -126,9 +126,15 @@ typedef struct {
     size_t offset;    /* offsetof(cdem_series_sample, field) */
     int optional;     /* 1: added after format version 2 first shipped; a file without it
                          reads as NaN (its writer did not measure it) */
+    /* a process's column (common/processes/<id>.h, CDEM_PROCESS_SERIES): NaN (its process is
+     * off) or within lo..hi (range: the bounds as declared, for messages), in unit */
+    int process;
+    double lo, hi;
+    const char *range, *unit;
 } series_column;
 
-#define N_SERIES 20
+/* the columns of every run, the lateral walls' four, then the processes' */
+#define N_SERIES (18 + CDEM_PROCESS_SERIES_COUNT)
 extern const series_column h5i_series_columns[N_SERIES];
 
 /* Per-element datasets of an increment: the rows of CDEM_STATE_FIELDS (state.h) marked

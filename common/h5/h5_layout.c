@@ -2,10 +2,11 @@
  * /series columns, the per-element datasets of an increment (driven by CDEM_STATE_FIELDS,
  * state.h), the members of /increments/index and /checkpoint/index, and the checks every
  * index row must pass. Writer, reader and resume all walk these tables, so a new column or
- * index member is one row here (and its docs). The physical bounds of the values (an index
- * row, an element, a series sample; CDEM_FILE_MAX_*, h5format.h) are checked here too, by the
- * reader on every value it reads and by the writer on every value it writes, so that what
- * one writes the other reads. The table lengths are fixed in h5_internal.h
+ * index member is one row here (and its docs); a process's own columns are its rows
+ * CDEM_PROCESS_SERIES (common/processes/<id>.h, h5format.h), read from processes.def. The physical
+ * bounds of the values (an index row, an element, a series sample; CDEM_FILE_MAX_*, h5format.h) are
+ * checked here too, by the reader on every value it reads and by the writer on every value it
+ * writes, so that what one writes the other reads. The table lengths are fixed in h5_internal.h
  * (they size arrays of handles); the static_asserts below keep them honest.
  * Each increment starts at a chunk boundary (h5i_chunk_end), so compressed chunks are
  * written once. */
@@ -19,9 +20,13 @@
 #include <string.h>
 
 #define SCOL(field, type)                                                                          \
-    { #field, type, offsetof(cdem_series_sample, field), 0 }
+    { #field, type, offsetof(cdem_series_sample, field), 0, 0, 0.0, 0.0, NULL, NULL }
 #define SCOL_OPTIONAL(field, type)                                                                 \
-    { #field, type, offsetof(cdem_series_sample, field), 1 }
+    { #field, type, offsetof(cdem_series_sample, field), 1, 0, 0.0, 0.0, NULL, NULL }
+/* a process's column: optional (a file written before it, or by a run without the process's
+ * code, lacks it) */
+#define CDEM_PROCESS_SERIES(name, unit, lo, hi, label)                                             \
+    {#name, COL_F64, offsetof(cdem_series_sample, name), 1, 1, lo, hi, #lo ".." #hi, unit},
 const series_column h5i_series_columns[] = {
     SCOL(step, COL_I64),
     SCOL(time, COL_F64),
@@ -41,13 +46,14 @@ const series_column h5i_series_columns[] = {
     SCOL_OPTIONAL(left_wall_force_y, COL_F64),
     SCOL_OPTIONAL(right_wall_force_x, COL_F64),
     SCOL_OPTIONAL(right_wall_force_y, COL_F64),
-    SCOL_OPTIONAL(salt_area, COL_F64),
-    SCOL_OPTIONAL(salt_top, COL_F64),
+#include "processes.def"
 };
 #undef SCOL
 #undef SCOL_OPTIONAL
+#undef CDEM_PROCESS_SERIES
 static_assert(sizeof h5i_series_columns / sizeof h5i_series_columns[0] == N_SERIES,
               "N_SERIES (h5_internal.h) is the length of the table");
+static_assert(N_SERIES <= 32, "h5i_bad_sample's mask of absent columns has 32 bits");
 
 /* The rows of CDEM_STATE_FIELDS marked in_increments, in table order (h5_internal.h). The
  * list is built by the preprocessor so that its length is a compile-time constant. */
@@ -294,21 +300,20 @@ const char *h5i_bad_sample(const cdem_series_sample *q, int blown_up, unsigned a
         memcpy(&v, (const char *)q + sc->offset, sizeof v);
         *column = sc->name;
         const int sea = !strcmp(sc->name, "sea_level");
-        const int salt = !strncmp(sc->name, "salt_", 5);
-        if (isnan(v) && (sea || salt || (absent >> c & 1u)))
-            continue; /* no sedimentation, no salt; a column the file does not have */
+        if (isnan(v) && (sea || sc->process || (absent >> c & 1u)))
+            continue; /* no sedimentation, a process that is off; a column the file lacks */
         if (!isfinite(v)) {
             if (blown_up)
                 continue; /* a run that blew up: its last samples may hold Inf or NaN */
             return say_why(buf, cap, "%s = %.15g must be a finite number", sc->name, v);
         }
-        if ((sea || !strcmp(sc->name, "net_displacement") || !strcmp(sc->name, "salt_top")) &&
-            !within(v, CDEM_FILE_MAX_LENGTH))
+        if ((sea || !strcmp(sc->name, "net_displacement")) && !within(v, CDEM_FILE_MAX_LENGTH))
             return say_why(buf, cap, "%s = %.15g m must be within -1e7..1e7 m", sc->name, v);
         if (!strcmp(sc->name, "kinetic_energy") && v < 0.0)
             return say_why(buf, cap, "kinetic_energy = %.15g J/m must be >= 0", v);
-        if (!strcmp(sc->name, "salt_area") && !(v >= 0.0 && v <= 1e14))
-            return say_why(buf, cap, "salt_area = %.15g m^2 must be within 0..1e14 m^2", v);
+        if (sc->process && !(v >= sc->lo && v <= sc->hi))
+            return say_why(buf, cap, "%s = %.15g %s must be within %s %s", sc->name, v, sc->unit,
+                           sc->range, sc->unit);
         if (!strcmp(sc->name, "axial_strain") && !within(v, CDEM_FILE_MAX_STRAIN))
             return say_why(buf, cap, "axial_strain = %.15g must be within -1e6..1e6", v);
         if (!strcmp(sc->name, "differential_stress") && !within(v, CDEM_FILE_MAX_STRESS))

@@ -1,6 +1,8 @@
 /* salt: the parameters of the viscous salt process ([salt]; solver/salt/, docs/solver.md
  * section 9), read as processes.def says: its section's name, the enums of its keys, its
- * fields of cdem_params, their words and its rows of the parameter table. */
+ * fields of cdem_params, their words and its rows of the parameter table; its own elements
+ * (their density, which the model's time step must know) and its columns of the time
+ * series. */
 /* clang-format off */
 #ifdef CDEM_PARAM_SECTIONS
 "salt",
@@ -74,5 +76,18 @@ static const char *const from_rate_words[] = {"rate", NULL};
      "the same for the base and the fault elements", 0, 0},
     {"salt", "wall_contact", CDEM_PTYPE_ENUM, P_OFF(salt_wall_contact), 0, "", "no-slip", 0, 0, 0, 0, salt_contact_words,
      "the same for the lateral walls", 0, 0},
+#endif
+
+#ifdef CDEM_PROCESS_ELEMENTS
+/* the salt elements: their density, when salt.layer is on */
+CDEM_PROCESS_ELEMENTS("salt", "salt.salt_density", p->salt_layer != CDEM_SALT_OFF, p->salt_density)
+#endif
+
+#ifdef CDEM_PROCESS_SERIES
+/* m^2, the salt's material area (sum of J pi r^2 / phi over the salt elements): conserved to
+ * within its elastic compression */
+CDEM_PROCESS_SERIES(salt_area, "m^2", 0, 1e14, "Salt area (m^2)")
+/* m, the highest salt element's top (a diapir's crest); within the coordinate bound */
+CDEM_PROCESS_SERIES(salt_top, "m", -1e7, 1e7, "Salt top (m)")
 #endif
     /* clang-format on */

@@ -159,7 +159,7 @@ cdem_status cdem_ckpt_state_put(const cdem_state *st, int boundary_forces, cdem_
 
 /* 1 for a field added to the state after checkpoints first shipped, when the checkpoint
  * (written by an older cdem-run) lacks it: the field then takes its value of an element that
- * never changed it (area_ratio: 1, no salt existed then). */
+ * never changed it (area_ratio: 1, no process changed it then). */
 static int added_later_and_absent(const cdem_state_field *f, const cdem_snapshot *s) {
     return strcmp(f->name, "area_ratio") == 0 && !cdem_snapshot_get(s, "state.area_ratio");
 }

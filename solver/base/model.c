@@ -37,6 +37,24 @@ void cdem_model_gravity_vector(double g, double tilt_deg, double *gx, double *gy
     *gy = -(g * cos(t));
 }
 
+/* A process's own elements of the given density (kg/m^3): the mass of their smallest class
+ * lowers the model's smallest mass, and the lightest of the processes' is remembered (the
+ * summary names it). */
+static cdem_status process_elements(cdem_model *m, const char *word, const char *key,
+                                    double density, cdem_error *err) {
+    if (!(density > 0.0) || !isfinite(density))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "cannot derive the model: %s = %g kg/m^3 must be positive", key, density);
+    const double mass = density * M_PI * m->radius[0] * m->radius[0];
+    if (!m->lightest_process || mass < m->lightest_process_mass) {
+        m->lightest_process = word;
+        m->lightest_process_mass = mass;
+    }
+    if (mass < m->min_mass)
+        m->min_mass = mass;
+    return CDEM_OK;
+}
+
 /* Sea-level rise factors, in cdem_sea_level_rise order. */
 static const double sea_factor[] = {0.0, 0.25, 0.5, 0.75, 1.0};
 
@@ -80,21 +98,13 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
         if (light > 0 && light < m->min_mass)
             m->min_mass = light;
     }
-    cdem_salt_model *salt = &m->salt;
-    if (p->salt_layer != CDEM_SALT_OFF) {
-        if (!(p->salt_density > 0.0) || !isfinite(p->salt_density))
-            return CDEM_FAIL(
-                err, CDEM_ERR_RANGE,
-                "cannot derive the model: salt.salt_density = %g kg/m^3 must be positive",
-                p->salt_density);
-        salt->on = 1;
-        salt->density = p->salt_density;
-        for (int i = 0; i < CDEM_NUM_RADII; i++)
-            salt->mass[i] = p->salt_density * M_PI * m->radius[i] * m->radius[i];
-        if (salt->mass[0] < m->min_mass) /* a lighter salt sets the time step, as a light
-                                            interval does */
-            m->min_mass = salt->mass[0];
-    }
+    /* the processes' own elements (common/processes/<id>.h, CDEM_PROCESS_ELEMENTS): a
+     * lighter one sets the time step, as a light interval does */
+#define CDEM_PROCESS_ELEMENTS(word, key, on, density)                                              \
+    if (on)                                                                                        \
+        CDEM_TRY(process_elements(m, word, key, density, err));
+#include "processes.def"
+#undef CDEM_PROCESS_ELEMENTS
 
     if (p->keep_constants || p->unit_scaling >= 1000.0) {
         m->kn = kn_default;
@@ -158,22 +168,6 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
     m->sediment_steps = lround(m->sediment_interval / m->displacement_per_step);
     m->settling_steps = lround(0.2 * p->equilibration / m->dt);
     m->sea_level_factor = sea_factor[p->sea_level_rise];
-    if (salt->on) {
-        salt->viscosity_geological = p->salt_viscosity;
-        salt->rate = p->salt_rate * 1e-3 / CDEM_SECONDS_PER_YEAR;
-        salt->time_scale =
-            isnan(p->salt_time_scale) ? m->boundary_speed / salt->rate : p->salt_time_scale;
-        salt->viscosity = p->salt_viscosity / salt->time_scale;
-        salt->bulk_modulus = p->salt_bulk_modulus;
-        salt->grid_spacing = p->salt_grid_spacing * m->average_radius;
-        salt->reach = p->salt_reach;
-        salt->dashpot_fraction = p->salt_dashpot_fraction;
-        if (!(salt->viscosity > 0.0) || !isfinite(salt->viscosity))
-            return CDEM_FAIL(err, CDEM_ERR_RANGE,
-                             "cannot derive the model: salt.viscosity = %g Pa s over the time "
-                             "scale %g gives a model viscosity of %g Pa s",
-                             p->salt_viscosity, salt->time_scale, salt->viscosity);
-    }
     return CDEM_OK;
 }
 

@@ -31,6 +31,10 @@
     { 4, 3, 2, 1 }
 #define CDEM_RADIUS_SHARES_TOTAL 10
 
+/* Seconds in a (Julian) year: the geological times of the processes that map the run's
+ * clock to them (a viscous substrate's rate in mm per year, a tilt's history in Myr). */
+#define CDEM_SECONDS_PER_YEAR (365.25 * 86400.0)
+
 /* Boundary speed of the original program: v = CDEM_BOUNDARY_ACCEL * dt, in m/s. */
 #define CDEM_BOUNDARY_ACCEL 25.0
 
@@ -75,32 +79,15 @@ static inline cdem_model_mode cdem_model_mode_default(void) {
  * has the bits of gravity as a scalar along -y (force_pairs.h, the finish). */
 void cdem_model_gravity_vector(double g, double tilt_deg, double *gx, double *gy);
 
-/* The salt's constants (salt.*; docs/solver.md, "Salt"), all 0 when salt.layer = off. The
- * model runs at natural lengths, densities and gravity but with time compressed by
- * time_scale S = boundary speed / geological rate; the salt's model viscosity is the
- * geological one / S, which keeps the ratio of viscous to gravitational and frictional
- * stresses (eta V / (rho g h H)) of nature. */
-typedef struct {
-    int on;                      /* 1: salt.layer is basal or interval */
-    double density;              /* kg/m^3 */
-    double mass[CDEM_NUM_RADII]; /* kg per metre, density * pi r^2 of each radius class */
-    double viscosity_geological; /* Pa s, salt.viscosity */
-    double rate;                 /* m/s, salt.rate in SI */
-    double time_scale;           /* S: geological seconds per model second */
-    double viscosity;            /* Pa s, the model's: viscosity_geological / S */
-    double bulk_modulus;         /* Pa */
-    double grid_spacing;         /* m, salt.grid_spacing x the average radius */
-    double reach;                /* the pair dashpots' reach / (r_i + r_j) */
-    double dashpot_fraction;     /* alpha of the pair dashpots */
-} cdem_salt_model;
-
-/* Seconds in a (Julian) year: salt.rate is in mm per year. */
-#define CDEM_SECONDS_PER_YEAR (365.25 * 86400.0)
-
 typedef struct {
     double radius[CDEM_NUM_RADII]; /* m, ascending */
     double mass[CDEM_NUM_RADII];   /* kg per metre of thickness, density * pi r^2 */
-    double min_mass;               /* kg, smallest mass of any element (light interval included) */
+    double min_mass;               /* kg, smallest mass of any element (light interval and
+                                      the processes' own elements included) */
+    const char *lightest_process;  /* the word of the process whose own elements are the
+                                      lightest of the processes' (NULL: no process has
+                                      elements of its own) */
+    double lightest_process_mass;  /* kg, the mass of its smallest element class */
     double average_radius;         /* m, mean of the four radii */
     double max_radius;             /* m */
     double kn, ks;                 /* N/m, normal and shear spring stiffness */
@@ -132,7 +119,6 @@ typedef struct {
     int composed;                  /* 1: the actor is one of several (bc.h, "Boundaries compose":
                                       a composing mode then adds its velocities to the
                                       others'); 0: alone */
-    cdem_salt_model salt;          /* the salt's constants (all 0 without salt) */
 } cdem_model;
 
 /* Computes every derived quantity from the parameters and the mode's part `mode` (its derive

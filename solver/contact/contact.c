@@ -50,8 +50,9 @@ const char *cdem_contact_class_name(int cls) {
 }
 
 int cdem_contact_class(uint32_t flags_i, uint32_t flags_j) {
-    /* a salt pair is the salt module's (solver/step/salt.h), never the pair list's */
-    if ((flags_i | flags_j) & (CDEM_FLAG_FOOTWALL | CDEM_FLAG_SALT))
+    /* a pair with a process's element is the process's (process/process.h), never the pair
+     * list's */
+    if ((flags_i | flags_j) & (CDEM_FLAG_FOOTWALL | CDEM_FLAGS_PROCESS))
         return -1;
     if ((flags_i & CDEM_FLAGS_BOUNDARY) && (flags_j & CDEM_FLAGS_BOUNDARY))
         return -1;

@@ -106,7 +106,7 @@ const char *cdem_contact_class_name(int cls);
 /* Class of a pair from the two elements' flags (CDEM_FLAG_*): fault beats wall (base for a
  * wall flagged CDEM_FLAG_BASE) beats element. Returns -1 when the pair is not one of the pair
  * list's: it never interacts (both boundary elements, or either a display-only footwall
- * element) or it has a salt element (the salt module evaluates it, solver/step/salt.h). */
+ * element) or it has a process's element (CDEM_FLAGS_PROCESS: the process evaluates it). */
 int cdem_contact_class(uint32_t flags_i, uint32_t flags_j);
 
 /* Refines a base class (cdem_contact_class) of a pair from its elements' layers and flags.

@@ -123,7 +123,7 @@ typedef struct {
      * the keys and the fix) */
     void (*validate)(const cdem_params *p, cdem_rule_log *log);
     /* may be NULL: parameters the mode cannot run with, "section.key" (NULL-terminated); each
-     * must be off (a switch or a choice) or 0 (a number) */
+     * must be off (a switch or a choice) or 0 (a number); or CDEM_EXCLUDES_PROCESSES */
     const char *const *excludes;
     /* 1: boundary.inversion reverses the mode's sense; 0: inversion = on is refused */
     int inverts;
@@ -178,6 +178,15 @@ cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *er
 /* The modes' parameter rules (a cdem_params_rules of cdem_params_validate): p's mode's
  * validate, its excludes, and inversion = on with a mode that does not invert. */
 void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log);
+
+/* An entry of a mode's excludes: no physical process (solver/process/) may run with the mode
+ * (a test of the cover's material); a process's own rules ask cdem_bc_excludes and refuse
+ * it, naming their keys (this layer knows no process). */
+#define CDEM_EXCLUDES_PROCESSES "processes"
+
+/* 1 when the mode's excludes list entry (a "section.key" or CDEM_EXCLUDES_PROCESSES); 0 for
+ * a value that is no mode. */
+int cdem_bc_excludes(cdem_mode mode, const char *entry);
 
 /* The model of p (cdem_model_derive) with its mode's part (the mode's derive hook). */
 cdem_status cdem_bc_derive_model(const cdem_params *p, cdem_model *m, cdem_error *err);

@@ -348,13 +348,14 @@ static cdem_status biaxial_restore(void *vctx, const cdem_snapshot *snap, cdem_e
 }
 
 /* What the test cannot run with: a load on its top, and everything that makes the sample
- * other than one uniform material (heterogeneity, erosion, deposits). */
+ * other than one uniform material (heterogeneity, erosion, deposits, a physical process). */
 static const char *const biaxial_excludes[] = {"surface.overburden_pressure",
                                                "heterogeneity.flexural_slip",
                                                "heterogeneity.weak_interval",
                                                "heterogeneity.layered_friction",
                                                "surface.erosion",
                                                "surface.sedimentation",
+                                               CDEM_EXCLUDES_PROCESSES,
                                                NULL};
 
 /* The test is defined on a 10 x 5 unit sample. */
@@ -404,7 +405,8 @@ static const cdem_bc_ops biaxial_ops = {
     .save = biaxial_save,               /* checkpoint: platens, window, reference */
     .restore = biaxial_restore,         /* resume */
     .validate = biaxial_validate,       /* the 10 x 5 sample */
-    .excludes = biaxial_excludes,       /* overburden, heterogeneity, erosion, deposits */
+    .excludes = biaxial_excludes,       /* overburden, heterogeneity, erosion, deposits,
+                                           processes */
     .inverts = 0,                       /* the platens only close */
     .derive = biaxial_derive,           /* no gravity, smooth bottom platen */
     .describe = biaxial_describe,       /* pressure, strain, gravity */

@@ -6,8 +6,8 @@
  * detachment_sense = shortening (the original's mode): the walls move inward, the right one
  * left (-x); = extension (beyond the original): outward, the right one right (+x): the
  * thin-skinned extension of a cover spreading over its detachment toward the retreating
- * wall (over salt, the set-up of Vendeville and Jackson's 1992 analogue models; issue 37,
- * docs/solver.md section 4). With extension the base runs on past each moving wall by one
+ * wall (over a viscous substrate, the set-up of Vendeville and Jackson's 1992 analogue models;
+ * issue 37, docs/solver.md section 4). With extension the base runs on past each moving wall by one
  * assembly width (derive: base_beyond_*), so the spreading material stays on it; a wall
  * that moves farther than that leaves the base's end, where the escape rule removes what
  * falls off (docs/solver.md).

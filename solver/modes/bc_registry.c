@@ -31,6 +31,16 @@ cdem_status cdem_bc_find(cdem_mode mode, const cdem_bc_ops **ops, cdem_error *er
     return CDEM_OK;
 }
 
+int cdem_bc_excludes(cdem_mode mode, const char *entry) {
+    const cdem_bc_ops *ops = NULL;
+    if (!entry || cdem_bc_find(mode, &ops, NULL) != CDEM_OK)
+        return 0;
+    for (size_t k = 0; ops->excludes && ops->excludes[k]; k++)
+        if (strcmp(ops->excludes[k], entry) == 0)
+            return 1;
+    return 0;
+}
+
 /* The rules of one actor's mode (p: the actor's parameters). */
 static void mode_rules(const cdem_params *p, cdem_rule_log *log) {
     const cdem_bc_ops *ops = NULL;
@@ -45,7 +55,7 @@ static void mode_rules(const cdem_params *p, cdem_rule_log *log) {
         const char *key = strchr(ops->excludes[k], '.');
         const size_t n = key ? (size_t)(key - ops->excludes[k]) : 0;
         if (!key || n >= sizeof section)
-            continue;
+            continue; /* CDEM_EXCLUDES_PROCESSES: the processes' own rules */
         memcpy(section, ops->excludes[k], n);
         section[n] = '\0';
         const cdem_param_def *d = cdem_params_find(section, key + 1);

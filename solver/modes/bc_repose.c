@@ -105,9 +105,11 @@ static cdem_status repose_restore(void *vctx, const cdem_snapshot *snap, cdem_er
     return CDEM_OK;
 }
 
-/* What a collapse cannot run with: a load on its free surface, erosion, deposits. */
+/* What a collapse cannot run with: a load on its free surface, erosion, deposits, a physical
+ * process (a test of the cover's material). */
 static const char *const repose_excludes[] = {"surface.overburden_pressure", "surface.erosion",
-                                              "surface.sedimentation", NULL};
+                                              "surface.sedimentation", CDEM_EXCLUDES_PROCESSES,
+                                              NULL};
 
 /* No boundary moves: the walls go and the assembly collapses, so the display interval is in
  * seconds (cdem_model_mode). */
@@ -141,7 +143,7 @@ static const cdem_bc_ops repose_ops = {
     .save = repose_save,               /* checkpoint: n_removed */
     .restore = repose_restore,         /* resume */
     .validate = NULL,                  /* its rules are its excludes */
-    .excludes = repose_excludes,       /* overburden, erosion, sedimentation */
+    .excludes = repose_excludes,       /* overburden, erosion, sedimentation, processes */
     .inverts = 0,                      /* nothing to invert */
     .derive = repose_derive,           /* no moving boundary, interval in s */
     .describe = repose_describe,       /* which walls go */

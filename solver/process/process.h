@@ -1,5 +1,5 @@
-/* process: the physical processes of a run beside the contacts and the boundaries (a viscous
- * substrate such as the salt; docs/solver.md, "Processes"). A process is one folder
+/* process: the physical processes of a run beside the contacts and the boundaries (e.g. a
+ * viscous substrate; docs/solver.md, "Processes"). A process is one folder
  * solver/<id>/ defining one static const cdem_process_ops and its pointer cdem_process_<id>,
  * and one row of common/processes.def; the registry (process_registry.c) is made from the
  * rows, and the run loop (run/run.c), the output (run/run_output.c), the summary
@@ -8,7 +8,8 @@
  * unless said):
  *   before the run, from the parameters alone: active (required: whether these parameters
  *   turn it on), rules (its parameter rules, one cdem_rule_add each), describe (its section
- *   of the summary);
+ *   of the summary), time_scale (the clock's map to geological time, if it has one: the
+ *   others' summaries quote their times in it);
  *   set-up, in this order: place (after the assembly is built and the weak interval flagged:
  *   the elements it takes; its log line), configure (after the stepper is set up: its forces
  *   join the step through cdem_viscous_add, integrate.h / viscous.h);
@@ -16,9 +17,19 @@
  *   output: increment (before an increment is written: its elements' stress when the run
  *   stores stress; its own measures), sample (a time-series sample: its columns);
  *   the end: finish (its last log line), free.
+ * What the common layer must know of a process is declared in its file
+ * common/processes/<id>.h (processes.def says how), where both programs and the layers below
+ * this one read it: its parameters; CDEM_PROCESS_ELEMENTS, the density of elements of its own,
+ * whose smallest mass the model's time step must know before any process exists
+ * (base/model.c, which names the lightest in the summary); CDEM_PROCESS_SERIES, its columns of
+ * the time series (h5format.h: the writer, the reader and the analysis take them from there;
+ * its sample hook fills them, NaN while it is off). Its elements' flag (flag, below) is also
+ * in state.h's CDEM_FLAGS_PROCESS, so that the pair list leaves their pairs to it.
+ * A process derives its own constants from the parameters and the model (e.g. in place, the
+ * first hook with a context; describe and rules derive them again).
  * A process's state is its context (state_size bytes, calloc'd): a resumed run sets the same
  * process up again on the same assembly, so what it places and measures is the same; what
- * evolves lives in the element state (the salt's area ratio J) or the stepper (gravity's
+ * evolves lives in the element state (e.g. the area ratio J) or the stepper (gravity's
  * direction) and is checkpointed with it.
  * Ownership: cdem_processes owns the contexts. Thread safety: one per run. Units: SI. */
 #ifndef CDEM_PROCESS_H
@@ -41,6 +52,10 @@ typedef struct {
     int (*active)(const cdem_params *p);
     void (*rules)(const cdem_params *p, cdem_rule_log *log);
     void (*describe)(const cdem_params *p, const cdem_model *m, FILE *out);
+    /* geological seconds per model second when the process maps the run's clock to geological
+     * time (a viscous substrate of a geological viscosity does), else 0: what the other
+     * processes' summaries quote their times in (cdem_processes_time_scale) */
+    double (*time_scale)(const cdem_params *p, const cdem_model *m);
     /* log: the run's log, or NULL (quiet) */
     cdem_status (*place)(void *ctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          FILE *log, cdem_error *err);
@@ -66,10 +81,13 @@ typedef struct {
 } cdem_processes;
 
 /* Every registered process's parameter rules (a process that is off checks its own keys'
- * consistency too, as the salt's rules always did). */
+ * consistency too). */
 void cdem_processes_rules(const cdem_params *p, cdem_rule_log *log);
 /* The summary's sections of the processes p turns on. */
 void cdem_processes_describe(const cdem_params *p, const cdem_model *m, FILE *out);
+/* The geological seconds per model second of the first process p turns on that maps the
+ * clock (its time_scale hook), with its word in *word; 0 (and *word NULL) when none does. */
+double cdem_processes_time_scale(const cdem_params *p, const cdem_model *m, const char **word);
 /* The processes p turns on, their contexts allocated (nothing placed yet). */
 cdem_status cdem_processes_init(cdem_processes *ps, const cdem_params *p, cdem_error *err);
 /* Adds a process whatever the parameters say, its context allocated (the tests' fixtures,

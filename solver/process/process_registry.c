@@ -30,6 +30,19 @@ void cdem_processes_describe(const cdem_params *p, const cdem_model *m, FILE *ou
     }
 }
 
+double cdem_processes_time_scale(const cdem_params *p, const cdem_model *m, const char **word) {
+    *word = NULL;
+    for (size_t k = 0; k < N_PROCESSES; k++) {
+        const cdem_process_ops *o = *registry[k];
+        const double s = o->active(p) && o->time_scale ? o->time_scale(p, m) : 0.0;
+        if (s > 0.0) {
+            *word = o->word;
+            return s;
+        }
+    }
+    return 0.0;
+}
+
 cdem_status cdem_processes_add(cdem_processes *ps, const cdem_process_ops *ops, cdem_error *err) {
     if (ps->n == (int)(sizeof ps->ops / sizeof ps->ops[0]))
         return CDEM_FAIL(err, CDEM_ERR_RANGE, "too many processes at once (%d)", ps->n);

@@ -1,8 +1,9 @@
 /* run_output: what a run writes into its file besides checkpoints (run_ctx.h): the
- * increments (after the erosion due before them, with the stress when asked: the salt's
- * elements their continuum stress; the salt's area change tracked for the final log), the
- * time-series samples (kinetic energy, contacts, bonds, boundary and base forces, the mode's
- * measures) and the summary text. */
+ * increments (after the erosion due before them, with the stress when asked; before each,
+ * the processes' increment hooks: a viscous process's elements get their continuum stress,
+ * and its measures are tracked for its last log line), the time-series samples (kinetic
+ * energy, contacts, bonds, boundary and base forces, the mode's measures, the processes'
+ * columns) and the summary text. */
 #include "run_ctx.h"
 
 #include "stress.h"
@@ -100,7 +101,7 @@ cdem_status run_write_sample(run_ctx *r, cdem_error *err) {
     q.right_wall_force_x = wall[1][0];
     q.right_wall_force_y = wall[1][1];
     q.sea_level = cdem_sediment_sea_level(&r->sed, r->step);
-    q.salt_area = q.salt_top = NAN; /* the columns of a process that is off */
+    cdem_series_processes_absent(&q); /* the columns of a process that is off */
     cdem_processes_sample(&r->procs, s, &q);
     cdem_bc_measure(&r->bc, s, r->step, 1, &q.axial_strain, &q.differential_stress);
     return r->w ? cdem_h5_writer_append_series(r->w, &q, err) : CDEM_OK;

@@ -165,10 +165,12 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, label, "%.6g m, mass %.6g kg/m", m->radius[i], m->mass[i]);
     }
     line(f, "average radius", "%.6g m", m->average_radius);
-    line(f, "smallest mass", "%.6g kg/m%s", m->min_mass,
-         m->salt.on && m->min_mass == m->salt.mass[0] ? " (salt)"
-         : m->min_mass < m->mass[0]                   ? " (light interval)"
-                                                      : "");
+    char lightest[64] = ""; /* whose elements set the smallest mass, when not the cover's */
+    if (m->lightest_process && m->min_mass == m->lightest_process_mass)
+        snprintf(lightest, sizeof lightest, " (%s)", m->lightest_process);
+    else if (m->min_mass < m->mass[0])
+        snprintf(lightest, sizeof lightest, " (light interval)");
+    line(f, "smallest mass", "%.6g kg/m%s", m->min_mass, lightest);
 
     heading(f, "Constants");
     const char *kn_origin = p->unit_scaling >= 1000.0 ? "default constant"

@@ -1,18 +1,42 @@
-/* salt: see salt.h. The placement and the salt's constants (cdem_salt_place, _measure,
- * _configure), what is sized at list builds (the grid, the scratch, the salt's pairs), the
- * force evaluation (P2G, velocity gradient and stress, G2P, the pair law) and the area
- * update. The parameter rules are in salt_rules.c. */
+/* salt: see salt.h. The salt's constants (cdem_salt_model_derive), the placement and what
+ * it measures (cdem_salt_place, _measure, _configure), what is sized at list builds (the
+ * grid, the scratch, the salt's pairs), the force evaluation (P2G, velocity gradient and stress,
+ * G2P, the pair law) and the area update. The parameter rules are in salt_rules.c. */
 #include "salt.h"
 
 #include "grid.h"
-
-#define CDEM_LAW_SCALAR
-#include "laws/law.h"
-#include "laws/laws.def"
+#include "salt_law.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* ---------------------------------------------------------------- constants */
+
+cdem_status cdem_salt_model_derive(const cdem_params *p, const cdem_model *m, cdem_salt_model *sm,
+                                   cdem_error *err) {
+    memset(sm, 0, sizeof *sm);
+    if (p->salt_layer == CDEM_SALT_OFF)
+        return CDEM_OK;
+    sm->on = 1;
+    sm->density = p->salt_density;
+    for (int i = 0; i < CDEM_NUM_RADII; i++)
+        sm->mass[i] = p->salt_density * M_PI * m->radius[i] * m->radius[i];
+    sm->viscosity_geological = p->salt_viscosity;
+    sm->rate = p->salt_rate * 1e-3 / CDEM_SECONDS_PER_YEAR;
+    sm->time_scale = isnan(p->salt_time_scale) ? m->boundary_speed / sm->rate : p->salt_time_scale;
+    sm->viscosity = p->salt_viscosity / sm->time_scale;
+    sm->bulk_modulus = p->salt_bulk_modulus;
+    sm->grid_spacing = p->salt_grid_spacing * m->average_radius;
+    sm->reach = p->salt_reach;
+    sm->dashpot_fraction = p->salt_dashpot_fraction;
+    if (!(sm->viscosity > 0.0) || !isfinite(sm->viscosity))
+        return CDEM_FAIL(err, CDEM_ERR_RANGE,
+                         "cannot derive the model: salt.viscosity = %g Pa s over the time "
+                         "scale %g gives a model viscosity of %g Pa s",
+                         p->salt_viscosity, sm->time_scale, sm->viscosity);
+    return CDEM_OK;
+}
 
 /* ---------------------------------------------------------------- placement */
 
@@ -28,10 +52,10 @@ static void band_fractions(const cdem_params *p, double *a, double *b) {
     }
 }
 
-cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, cdem_state *s,
-                            cdem_salt_layer *layer, cdem_error *err) {
+cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, const cdem_salt_model *sm,
+                            cdem_state *s, cdem_salt_layer *layer, cdem_error *err) {
     memset(layer, 0, sizeof *layer);
-    if (!p || !m || !s)
+    if (!p || !m || !sm || !s)
         return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_salt_place: NULL argument");
     if (p->salt_layer == CDEM_SALT_OFF)
         return CDEM_OK;
@@ -57,7 +81,7 @@ cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, cdem_stat
         while (cls + 1 < CDEM_NUM_RADII && s->radius[i] > m->radius[cls])
             cls++;
         s->flags[i] |= CDEM_FLAG_SALT;
-        s->mass[i] = m->salt.mass[cls];
+        s->mass[i] = sm->mass[cls];
         s->area_ratio[i] = 1.0;
         xmin = fmin(xmin, s->x[i] - s->radius[i]);
         xmax = fmax(xmax, s->x[i] + s->radius[i]);
@@ -74,7 +98,7 @@ cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, cdem_stat
     /* the region the salt fills: from the base's surface (basal) or the band's foot up to the
      * cut between the salt's centres and the cover's, across the salt's width */
     const double foot = p->salt_layer == CDEM_SALT_BASAL ? bottom : y_lo;
-    CDEM_TRY(cdem_salt_measure(s, (xmax - xmin) * (y_hi - foot), m->salt.reach, layer, err));
+    CDEM_TRY(cdem_salt_measure(s, (xmax - xmin) * (y_hi - foot), sm->reach, layer, err));
     layer->band_lo = foot;
     layer->band_hi = y_hi;
     return CDEM_OK;
@@ -134,7 +158,7 @@ cdem_status cdem_salt_measure(const cdem_state *s, double region_area, double re
                         continue;
                     const double dx = s->x[j] - s->x[i], dy = s->y[j] - s->y[i];
                     const double r = sqrt(dx * dx + dy * dy), R = s->radius[i] + s->radius[j];
-                    const double w = cdem_law_salt_weight(r, R, reach);
+                    const double w = cdem_salt_law_weight(r, R, reach);
                     if (!(w > 0.0) || r <= 0.0)
                         continue;
                     sum += w * r * r / 8.0;
@@ -161,23 +185,24 @@ double cdem_salt_dashpot(const cdem_salt_model *sm, const cdem_salt_layer *layer
     return c < cap ? c : cap;
 }
 
-cdem_status cdem_salt_configure(cdem_salt *salt, const cdem_model *m, const cdem_params *p,
-                                const cdem_salt_layer *layer, double skin, cdem_error *err) {
+cdem_status cdem_salt_configure(cdem_salt *salt, const cdem_model *m, const cdem_salt_model *sm,
+                                const cdem_params *p, const cdem_salt_layer *layer, double skin,
+                                cdem_error *err) {
     cdem_salt_free(salt);
-    if (!m->salt.on)
+    if (!sm->on)
         return CDEM_OK;
     if (!layer || !(layer->phi > 0.0) || layer->elements <= 0)
         return CDEM_FAIL(err, CDEM_ERR_INVALID,
                          "salt: the module needs the placed salt's packing fraction");
     salt->on = 1;
-    salt->viscosity = m->salt.viscosity;
-    salt->bulk_modulus = m->salt.bulk_modulus;
-    salt->h = m->salt.grid_spacing;
-    salt->reach = m->salt.reach;
+    salt->viscosity = sm->viscosity;
+    salt->bulk_modulus = sm->bulk_modulus;
+    salt->h = sm->grid_spacing;
+    salt->reach = sm->reach;
     salt->phi = layer->phi;
     salt->kn = m->kn;
     salt->contact_damping = m->contact_damping;
-    salt->dashpot = cdem_salt_dashpot(&m->salt, layer, m->min_mass, m->dt);
+    salt->dashpot = cdem_salt_dashpot(sm, layer, m->min_mass, m->dt);
     salt->skin = skin;
     salt->join = (p->salt_cover_contact == CDEM_SALT_NO_SLIP ? CDEM_SALT_JOIN_COVER : 0u) |
                  (p->salt_base_contact == CDEM_SALT_NO_SLIP ? CDEM_SALT_JOIN_BASE : 0u) |
@@ -578,7 +603,7 @@ void cdem_salt_forces(cdem_salt *salt, const cdem_state *s, double *ex, double *
         const int both = (s->flags[i] & s->flags[j] & CDEM_FLAG_SALT) != 0;
         const double cc = zeta > 0.0 && !both && r2 < R * R ? zeta * critical(salt, s, i, j) : 0.0;
         double fx, fy;
-        cdem_law_salt_pair(dx, dy, r2, R, s->vx[j] - s->vx[i], s->vy[j] - s->vy[i], both, salt->kn,
+        cdem_salt_law_pair(dx, dy, r2, R, s->vx[j] - s->vx[i], s->vy[j] - s->vy[i], both, salt->kn,
                            c, cc, salt->reach, &fx, &fy);
         ex[i] += fx;
         ey[i] += fy;

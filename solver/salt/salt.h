@@ -6,7 +6,7 @@
  * its area ratio J (p = K (1/J - 1), no tension); a force evaluation does P2G (the salt, then
  * the non-salt elements that share its nodes: the no-slip contacts), the gradient and
  * sigma = -p I + 2 eta D', the node forces and G2P, and the salt's pairs with the law of
- * common/laws/law_salt.h; after a step the salt is projected back onto a grid of its own
+ * salt_law.h; after a step the salt is projected back onto a grid of its own
  * (cdem_salt_project), which moves it and whose divergence J follows. The formulas and
  * measurements: docs/solver.md, section 9.
  * Determinism: serial sums in element or pair order, the same bits for any thread count.
@@ -25,6 +25,35 @@
 
 #include <stddef.h>
 #include <stdint.h>
+
+/* salt.rate is in mm per year (CDEM_SECONDS_PER_YEAR, model.h). */
+
+/* The salt's constants (salt.*; docs/solver.md, "Salt"), all 0 when salt.layer = off. The
+ * model runs at natural lengths, densities and gravity but with time compressed by
+ * time_scale S = boundary speed / geological rate; the salt's model viscosity is the
+ * geological one / S, which keeps the ratio of viscous to gravitational and frictional
+ * stresses (eta V / (rho g h H)) of nature. The salt elements' density is also declared to
+ * the model (common/processes/salt.h, CDEM_PROCESS_ELEMENTS), whose smallest mass, and so
+ * whose time step, a lighter salt sets. */
+typedef struct {
+    int on;                      /* 1: salt.layer is basal or interval */
+    double density;              /* kg/m^3 */
+    double mass[CDEM_NUM_RADII]; /* kg per metre, density * pi r^2 of each radius class */
+    double viscosity_geological; /* Pa s, salt.viscosity */
+    double rate;                 /* m/s, salt.rate in SI */
+    double time_scale;           /* S: geological seconds per model second */
+    double viscosity;            /* Pa s, the model's: viscosity_geological / S */
+    double bulk_modulus;         /* Pa */
+    double grid_spacing;         /* m, salt.grid_spacing x the average radius */
+    double reach;                /* the pair dashpots' reach / (r_i + r_j) */
+    double dashpot_fraction;     /* alpha of the pair dashpots */
+} cdem_salt_model;
+
+/* The salt's constants of p on the model m (cdem_model_derive's, whose boundary speed gives
+ * the time scale): *sm all 0 when salt.layer is off; CDEM_ERR_RANGE for a model viscosity
+ * that is not positive and finite. */
+cdem_status cdem_salt_model_derive(const cdem_params *p, const cdem_model *m, cdem_salt_model *sm,
+                                   cdem_error *err);
 
 /* What the placement measured (cdem_salt_place, cdem_salt_measure): the constants of the
  * salt's discretisation. A resumed run places the salt of the same assembly again and gets
@@ -111,8 +140,9 @@ typedef struct {
 /* The packing fraction the checks and the summary assume for the salt. */
 #define CDEM_SALT_RULES_PHI 0.75
 
-/* Fills *t (all 0 when salt.layer is off). */
-void cdem_salt_time_map(const cdem_params *p, const cdem_model *m, cdem_salt_time *t);
+/* Fills *t (all 0 when salt.layer is off), sm: cdem_salt_model_derive's. */
+void cdem_salt_time_map(const cdem_params *p, const cdem_model *m, const cdem_salt_model *sm,
+                        cdem_salt_time *t);
 
 /* The salt's parameter rules (cdem-run's validation): bonded cover, weak interval and modes
  * that exclude it, the interval's order, absolute damping, the time-step limits. */
@@ -120,21 +150,22 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log);
 
 /* Places the salt of salt.layer in the built assembly (before equilibration, like the weak
  * interval): the free elements whose centre lies in the band get CDEM_FLAG_SALT, the salt's
- * mass and J = 1; *layer receives what cdem_salt_measure measures. Does nothing when
+ * mass (sm) and J = 1; *layer receives what cdem_salt_measure measures. Does nothing when
  * salt.layer is off (layer zeroed). */
-cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, cdem_state *s,
-                            cdem_salt_layer *layer, cdem_error *err);
+cdem_status cdem_salt_place(const cdem_params *p, const cdem_model *m, const cdem_salt_model *sm,
+                            cdem_state *s, cdem_salt_layer *layer, cdem_error *err);
 
 /* Measures the salt elements of s, which fill a region of area region_area (m^2): their disc
  * area, packing fraction, beta (with the pair dashpots' reach) and the most pairs of one. */
 cdem_status cdem_salt_measure(const cdem_state *s, double region_area, double reach,
                               cdem_salt_layer *layer, cdem_error *err);
 
-/* Sets the module up from the model's salt constants and the placement (m->salt.on = 0:
- * off). kn: the repulsion; dt: the time step (caps the pair dashpots so that they never set
- * it); contact_damping: as physics (0 with absolute damping); skin: the pair list's. */
-cdem_status cdem_salt_configure(cdem_salt *salt, const cdem_model *m, const cdem_params *p,
-                                const cdem_salt_layer *layer, double skin, cdem_error *err);
+/* Sets the module up from the salt's constants sm and the placement (sm->on = 0: off), with
+ * the model's repulsion kn, its time step dt (caps the pair dashpots so that they never set
+ * it), its contact damping (0 with absolute damping); skin: the pair list's. */
+cdem_status cdem_salt_configure(cdem_salt *salt, const cdem_model *m, const cdem_salt_model *sm,
+                                const cdem_params *p, const cdem_salt_layer *layer, double skin,
+                                cdem_error *err);
 
 /* The configured module's forces join the step of the viscous module v (viscous.h): its grid
  * and pairs after each list build, its forces each step, its area update after each step.

@@ -17,6 +17,7 @@
 #define line cdem_summary_line
 
 typedef struct {
+    cdem_salt_model model; /* its constants (cdem_salt_model_derive, at placement) */
     cdem_salt_layer layer; /* what the placement measured */
     cdem_salt salt;        /* the module: its grid, pairs and constants (salt.h) */
     double area_change;    /* largest |salt area / its area at placement - 1| over the
@@ -30,9 +31,13 @@ static int salt_active(const cdem_params *p) {
 /* The salt's section (docs/solver.md, section 9): where it is, its material and how the
  * model's clock maps onto geological time, with the ratio that mapping keeps. */
 static void salt_describe(const cdem_params *p, const cdem_model *m, FILE *f) {
-    const cdem_salt_model *sm = &m->salt;
+    cdem_salt_model salt_model;
+    cdem_error err;
+    if (cdem_salt_model_derive(p, m, &salt_model, &err) != CDEM_OK)
+        return; /* the parameter check refuses it first */
+    const cdem_salt_model *sm = &salt_model;
     cdem_salt_time t;
-    cdem_salt_time_map(p, m, &t);
+    cdem_salt_time_map(p, m, sm, &t);
     fprintf(f, "\nSalt\n");
     if (p->salt_layer == CDEM_SALT_BASAL)
         line(f, "layer",
@@ -81,7 +86,8 @@ static void salt_describe(const cdem_params *p, const cdem_model *m, FILE *f) {
 static cdem_status salt_place(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
                               FILE *log, cdem_error *err) {
     salt_ctx *c = vctx;
-    CDEM_TRY(cdem_salt_place(p, m, s, &c->layer, err));
+    CDEM_TRY(cdem_salt_model_derive(p, m, &c->model, err));
+    CDEM_TRY(cdem_salt_place(p, m, &c->model, s, &c->layer, err));
     if (log && c->layer.elements > 0)
         fprintf(log,
                 "cdem-run: salt: %ld elements between y = %.6g and %.6g m, packing fraction %.4f, "
@@ -113,7 +119,7 @@ cdem_status cdem_salt_join(cdem_salt *salt, cdem_viscous *v, cdem_error *err) {
 static cdem_status salt_configure(void *vctx, const cdem_params *p, const cdem_model *m,
                                   cdem_integrator *it, cdem_error *err) {
     salt_ctx *c = vctx;
-    CDEM_TRY(cdem_salt_configure(&c->salt, m, p, &c->layer, it->nb.skin, err));
+    CDEM_TRY(cdem_salt_configure(&c->salt, m, &c->model, p, &c->layer, it->nb.skin, err));
     return cdem_salt_join(&c->salt, &it->viscous, err);
 }
 
@@ -152,6 +158,14 @@ static void salt_free(void *vctx) {
     cdem_salt_free(&((salt_ctx *)vctx)->salt);
 }
 
+/* The clock's map to geological time (salt.rate or salt.time_scale), 0 when it cannot be
+ * derived (the rules say why). */
+static double salt_time_scale(const cdem_params *p, const cdem_model *m) {
+    cdem_salt_model sm;
+    cdem_error err;
+    return cdem_salt_model_derive(p, m, &sm, &err) == CDEM_OK ? sm.time_scale : 0.0;
+}
+
 static const cdem_process_ops salt_ops = {
     .word = "salt",
     .state_size = sizeof(salt_ctx),
@@ -159,6 +173,7 @@ static const cdem_process_ops salt_ops = {
     .active = salt_active,
     .rules = cdem_salt_rules,
     .describe = salt_describe,
+    .time_scale = salt_time_scale,
     .place = salt_place,
     .configure = salt_configure,
     .increment = salt_increment,

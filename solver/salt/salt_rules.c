@@ -33,11 +33,11 @@ static void salt_band(const cdem_params *p, double *a, double *b) {
     }
 }
 
-void cdem_salt_time_map(const cdem_params *p, const cdem_model *m, cdem_salt_time *t) {
+void cdem_salt_time_map(const cdem_params *p, const cdem_model *m, const cdem_salt_model *sm,
+                        cdem_salt_time *t) {
     memset(t, 0, sizeof *t);
-    if (p->salt_layer == CDEM_SALT_OFF || !m->salt.on)
+    if (p->salt_layer == CDEM_SALT_OFF || !sm->on)
         return;
-    const cdem_salt_model *sm = &m->salt;
     double a, b;
     salt_band(p, &a, &b);
     t->salt_thickness = (b - a) * m->height_m;
@@ -92,10 +92,6 @@ static void time_scale_rule(const cdem_params *p, const cdem_model *m, cdem_rule
 }
 
 void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
-    if (p->granular_law == CDEM_LAW_SALT)
-        cdem_rule_add(log, "material.granular_law = salt: the salt law is the pair law of salt "
-                           "elements (salt.layer), not a material; a cover needs a shear "
-                           "strength: use normal-cohesion, coulomb or spring-cohesion");
     if (p->salt_layer == CDEM_SALT_OFF)
         return;
     const char *lw = layer_word(p->salt_layer);
@@ -106,7 +102,7 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
                       "cover over salt is not calibrated): set material.material = granular or "
                       "salt.layer = off",
                       lw);
-    if (p->mode == CDEM_MODE_BIAXIAL || p->mode == CDEM_MODE_REPOSE)
+    if (cdem_bc_excludes(p->mode, CDEM_EXCLUDES_PROCESSES))
         cdem_rule_add(log,
                       "salt.layer = %s: not supported with boundary.mode = %s (a test of the "
                       "cover's material): set salt.layer = off",
@@ -146,15 +142,17 @@ void cdem_salt_rules(const cdem_params *p, cdem_rule_log *log) {
                           p->weak_interval == CDEM_WEAK_LOWER ? "the lower part" : "the top");
     }
     cdem_model m;
+    cdem_salt_model salt_model;
     cdem_error err;
-    if (cdem_bc_derive_model(p, &m, &err) != CDEM_OK)
+    if (cdem_bc_derive_model(p, &m, &err) != CDEM_OK ||
+        cdem_salt_model_derive(p, &m, &salt_model, &err) != CDEM_OK)
         return; /* the table's rules or the mode's say what is wrong */
-    const cdem_salt_model *sm = &m.salt;
+    const cdem_salt_model *sm = &salt_model;
     const int own_scale = !isnan(p->salt_time_scale);
     if (own_scale && m.mode.moving_boundaries > 0)
         time_scale_rule(p, &m, log);
     cdem_salt_time t;
-    cdem_salt_time_map(p, &m, &t);
+    cdem_salt_time_map(p, &m, sm, &t);
     if (p->damping_mode == CDEM_DAMPING_ABSOLUTE) {
         const double D = t.damping_number;
         if (!(D < 0.1))

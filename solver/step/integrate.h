@@ -17,8 +17,8 @@
  * allocates in a step except at list rebuilds (geometric growth). Heterogeneity: after each
  * list rebuild the element-element pair classes are refined from layers and flags
  * (cdem_contact_refine). Determinism: bit-identical for any thread count (force.h).
- * With contact damping or salt (viscous.h) a step drifts first, brings the list up to date,
- * adds their forces around the force pass (step_with_viscous in integrate.c).
+ * With contact damping or a viscous process (viscous.h) a step drifts first, brings the list
+ * up to date, adds their forces around the force pass (step_with_viscous in integrate.c).
  * Thread safety: one integrator per run. Units: SI (m, s, kg per metre, N). */
 #ifndef CDEM_INTEGRATE_H
 #define CDEM_INTEGRATE_H
@@ -77,7 +77,8 @@ typedef struct {
     cdem_loads loads;       /* gravity, overburden, confinement (loads.h) */
     cdem_removal removal;   /* escapes, erosion, the mode's removals and their record
                                (removal.h) */
-    cdem_viscous viscous;   /* contact damping and salt (viscous.h; off: nothing changes) */
+    cdem_viscous viscous;   /* contact damping and the processes' forces (viscous.h; off:
+                               nothing changes) */
     /* may be NULL (gravity as the mode sets it): on every deformation step k >= 1, after the
      * mode's gravity hook, turns gravity (*gx, *gy: the mode's, else the model's direction) in
      * the model's frame and returns 1, or returns 0 to leave it; the run sets it to its

@@ -1,6 +1,6 @@
 /* tilt: see tilt.h. The process (solver/process/process.h): active when tilt.angle is not 0;
  * its rules; its summary section (the tilt's history, in model time, in boundary displacement
- * when a boundary moves and in geological time when the salt maps the clock); configure (its
+ * when a boundary moves and in geological time when a process maps the clock); configure (its
  * schedule on the run's model); and its gravity hook, which turns the mode's gravity by the
  * angle of the step. */
 #include "bc.h"
@@ -118,10 +118,12 @@ static void tilt_describe(const cdem_params *p, const cdem_model *m, FILE *f) {
     if (v > 0.0)
         line(f, "in boundary displacement", "tilting from %.6g m to %.6g m (of %.6g m)", v * t0,
              v * t1, v * run);
-    if (m->salt.on && m->salt.time_scale > 0.0) {
-        const double myr = m->salt.time_scale / CDEM_SECONDS_PER_YEAR / 1e6;
-        line(f, "in geological time", "%.4g Myr of tilting: %.4g degrees/Myr (salt time scale)",
-             (t1 - t0) * myr, fabs(t.angle) / ((t1 - t0) * myr));
+    const char *by = NULL;
+    const double scale = cdem_processes_time_scale(p, m, &by);
+    if (scale > 0.0) {
+        const double myr = scale / CDEM_SECONDS_PER_YEAR / 1e6;
+        line(f, "in geological time", "%.4g Myr of tilting: %.4g degrees/Myr (%s time scale)",
+             (t1 - t0) * myr, fabs(t.angle) / ((t1 - t0) * myr), by);
     }
     double gx, gy;
     cdem_model_gravity_vector(m->gravity, m->mode.gravity_tilt + t.angle, &gx, &gy);
