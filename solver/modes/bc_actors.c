@@ -225,8 +225,9 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
     return CDEM_OK;
 }
 
-/* The per-element moves of several actors (cdem_bc_step_move_of): each active actor's over
- * the range, in order (no element moves with two: check_shared). */
+/* The per-element moves of several actors (cdem_bc_step_move_of): the active actors'
+ * velocities zeroed, then each active actor's moves over the range, in order (an element on
+ * two active blocks takes both, velocities added). */
 static void actors_step_move(const void *vbc, cdem_state *s, long lo, long hi) {
     const cdem_bc *bc = vbc;
     const long k = bc->k_now;
