@@ -32,6 +32,10 @@ MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 1)
 endif
 
 BUILD   ?= build
+# An absolute BUILD inside the tree (the tests pass $CDEM_BUILD to make install) is the same
+# folder as the relative one: one spelling, so that the dependency files (.d) name the
+# targets as every other make of the tree does and a changed header rebuilds what includes it.
+override BUILD := $(patsubst $(CURDIR)/%,%,$(BUILD))
 CC      ?= gcc
 PKGS    := hdf5 gsl cairo zlib
 OPT     ?= -O2

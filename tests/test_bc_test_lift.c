@@ -17,6 +17,7 @@
 
 #include "bc.h"
 #include "run.h"
+#include "run_fixtures.h"
 #include "snapshot.h"
 #include "state.h"
 
@@ -101,27 +102,6 @@ static void test_bc_test_lift_key_listed_nowhere(void **state) {
     free(record);
 }
 
-/* In memory (no file), no log: a run keeps a pointer to its options, so they outlive it. */
-static const cdem_run_options quiet_run = {.quiet = 1};
-
-static cdem_snapshot *capture(const cdem_run_ctx *r) {
-    cdem_snapshot *snap = NULL;
-    cdem_error err;
-    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
-    if (cdem_run_capture(r, snap, &err) != CDEM_OK)
-        fail_msg("cdem_run_capture: %s", err.msg);
-    return snap;
-}
-
-static const void *array_of(const cdem_snapshot *s, const char *name, size_t *count) {
-    const cdem_snapshot_array *a = cdem_snapshot_get(s, name);
-    if (!a)
-        fail_msg("the checkpoint has no %s", name);
-    if (count)
-        *count = a->count;
-    return a->data;
-}
-
 /* lift-3 */
 static void test_bc_test_lift_base_rises_by_its_ratio(void **state) {
     (void)state;
@@ -138,12 +118,11 @@ static void test_bc_test_lift_base_rises_by_its_ratio(void **state) {
     assert_int_equal(cdem_run_advance(r, cdem_run_total_steps(r), &err), CDEM_OK);
     cdem_snapshot *after = capture(r);
     size_t n = 0, n2 = 0;
-    const uint32_t *flags = array_of(before, "state.flags", &n);
-    const int32_t *id0 = array_of(before, "state.id", NULL),
-                  *id1 = array_of(after, "state.id", &n2);
-    const double *x0 = array_of(before, "state.x", NULL), *y0 = array_of(before, "state.y", NULL);
-    const double *x1 = array_of(after, "state.x", NULL), *y1 = array_of(after, "state.y", NULL);
-    const double *net = array_of(after, "bc.net", NULL);
+    const uint32_t *flags = array_n(before, "state.flags", &n);
+    const int32_t *id0 = array_n(before, "state.id", NULL), *id1 = array_n(after, "state.id", &n2);
+    const double *x0 = array_n(before, "state.x", NULL), *y0 = array_n(before, "state.y", NULL);
+    const double *x1 = array_n(after, "state.x", NULL), *y1 = array_n(after, "state.y", NULL);
+    const double *net = array_n(after, "bc.net", NULL);
     assert_true(net[0] > 1.0); /* the run moved its boundary */
     const double rise = 2.0 * net[0];
     size_t base = 0, walls = 0;

@@ -19,6 +19,7 @@
 
 #include "bc.h"
 #include "run.h"
+#include "run_fixtures.h"
 #include "snapshot.h"
 #include "state.h"
 #include "summary.h"
@@ -37,33 +38,6 @@ static cdem_params tilt_params(void) {
     p.runtime = 300;
     p.checkpoint_interval = 0;
     return p;
-}
-
-/* In memory (no file), no log: a run keeps a pointer to its options, so they outlive it. */
-static const cdem_run_options quiet_run = {.quiet = 1};
-
-static cdem_run_ctx *open_run(const cdem_params *p, const cdem_snapshot *resume) {
-    cdem_run_ctx *r = NULL;
-    cdem_error err;
-    if (cdem_run_open(p, &quiet_run, resume, &r, &err) != CDEM_OK)
-        fail_msg("cdem_run_open: %s", err.msg);
-    return r;
-}
-
-static cdem_snapshot *capture(const cdem_run_ctx *r) {
-    cdem_snapshot *snap = NULL;
-    cdem_error err;
-    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
-    if (cdem_run_capture(r, snap, &err) != CDEM_OK)
-        fail_msg("cdem_run_capture: %s", err.msg);
-    return snap;
-}
-
-static const double *array_of(const cdem_snapshot *s, const char *name) {
-    const cdem_snapshot_array *a = cdem_snapshot_get(s, name);
-    if (!a)
-        fail_msg("the checkpoint has no %s", name);
-    return (const double *)a->data;
 }
 
 /* tilt-1 */

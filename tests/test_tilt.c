@@ -27,6 +27,7 @@
 #include "bc.h"
 #include "process.h"
 #include "run.h"
+#include "run_fixtures.h"
 #include "snapshot.h"
 #include "state.h"
 #include "summary.h"
@@ -73,35 +74,11 @@ static double composed_angle(const cdem_params *p, const cdem_model *m, long k) 
     return MODE_TILT_START + MODE_TILT_TURN * turned + cdem_tilt_angle_at(&t, k);
 }
 
-/* In memory (no file), no log: a run keeps a pointer to its options, so they outlive it. */
-static const cdem_run_options quiet_run = {.quiet = 1};
-
-static cdem_run_ctx *open_run(const cdem_params *p, const cdem_snapshot *resume) {
-    cdem_run_ctx *r = NULL;
-    cdem_error err;
-    if (cdem_run_open(p, &quiet_run, resume, &r, &err) != CDEM_OK)
-        fail_msg("cdem_run_open: %s", err.msg);
-    return r;
-}
-
-static cdem_snapshot *capture(const cdem_run_ctx *r) {
-    cdem_snapshot *snap = NULL;
-    cdem_error err;
-    assert_int_equal(cdem_snapshot_alloc(&snap, &err), CDEM_OK);
-    if (cdem_run_capture(r, snap, &err) != CDEM_OK)
-        fail_msg("cdem_run_capture: %s", err.msg);
-    return snap;
-}
-
 static const cdem_snapshot_array *array_named(const cdem_snapshot *s, const char *name) {
     const cdem_snapshot_array *a = cdem_snapshot_get(s, name);
     if (!a)
         fail_msg("the checkpoint has no %s", name);
     return a;
-}
-
-static const double *array_of(const cdem_snapshot *s, const char *name) {
-    return (const double *)array_named(s, name)->data;
 }
 
 /* Degrees gravity points from -y toward +x in a snapshot. */

@@ -101,6 +101,12 @@ typedef struct {
     double displacement_per_step;  /* m, boundary_speed * dt */
     double gravity;                /* m/s^2, the magnitude actually applied (0 when the mode
                                       turns it off); its direction: mode.gravity_tilt */
+    double gravity_x, gravity_y;   /* m/s^2, gravity's vector at the start: gravity turned by
+                                      mode.gravity_tilt (cdem_model_gravity_vector), derived
+                                      once for the loads and the summary */
+    long elements_estimated;       /* free elements the assembly will hold, about
+                                      (cdem_model_estimate_elements): the memory the run needs
+                                      is checked from it before anything is built */
     double width_m, height_m;      /* assembly size in m */
     long equil_steps;              /* time steps of equilibration, round(equilibration / dt) */
     long total_steps;              /* time steps of the whole run, round(runtime / dt) */

@@ -135,7 +135,7 @@ static cdem_status setup(run_ctx *r, cdem_error *err) {
     const cdem_params *p = r->p;
     const cdem_run_options *opt = r->opt;
     CDEM_TRY(cdem_bc_derive_model(p, &r->m, err));
-    CDEM_TRY(cdem_run_check_memory(p, err)); /* before anything of the model's size is built */
+    CDEM_TRY(run_check_model_memory(&r->m, err)); /* before anything of its size is built */
     if (r->opt->dt_factor > 0.0)
         r->m.dt *= r->opt->dt_factor; /* fault injection (tests): a time step too large */
     CDEM_TRY(cdem_sediment_init(&r->sed, p, &r->m, err));

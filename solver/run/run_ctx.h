@@ -120,6 +120,9 @@ void run_count_kinds(const cdem_state *s, long *n_free, long *n_boundary);
 /* The summary text stored in the file (r->summary): the parameters' summary, the mode's view
  * and the solver line. */
 cdem_status run_make_summary(run_ctx *r, cdem_error *err);
+/* cdem_run_check_memory for the derived model (its elements_estimated): the set-up's, which
+ * has derived it already (run_validate.c). */
+cdem_status run_check_model_memory(const cdem_model *m, cdem_error *err);
 
 /* run_progress.c */
 double run_now(void);

@@ -5,6 +5,7 @@
  * rules hooks: process/process.h). And the one limit on the size of a model that is not a rule of
  * its parameters: the memory of the machine it runs on (cdem_run_check_memory). */
 #include "run.h"
+#include "run_ctx.h"
 
 #include "bc.h"
 #include "model.h"
@@ -103,12 +104,8 @@ double cdem_run_memory_estimate(const cdem_params *p) {
     return memory_for(cdem_model_estimate_elements(p));
 }
 
-cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
-    return cdem_run_check_memory_in(p, memory_available(), err);
-}
-
-cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_error *err) {
-    const long n = cdem_model_estimate_elements(p);
+/* The memory check of a model of about n elements against `have` bytes. */
+static cdem_status check_memory_of(long n, double have, cdem_error *err) {
     const double need = memory_for(n);
     /* the memory first (the limit a user meets), then the 32-bit indices */
     if (have <= 0.0 || need <= have) {
@@ -127,4 +124,16 @@ cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_err
                      "available: use larger elements ([assembly] radius_scale), a smaller "
                      "assembly, or a machine with more memory",
                      n, need / 1e9, CDEM_RUN_MEMORY_PER_ELEMENT, have / 1e9);
+}
+
+cdem_status cdem_run_check_memory(const cdem_params *p, cdem_error *err) {
+    return cdem_run_check_memory_in(p, memory_available(), err);
+}
+
+cdem_status cdem_run_check_memory_in(const cdem_params *p, double have, cdem_error *err) {
+    return check_memory_of(cdem_model_estimate_elements(p), have, err);
+}
+
+cdem_status run_check_model_memory(const cdem_model *m, cdem_error *err) {
+    return check_memory_of(m->elements_estimated, memory_available(), err);
 }

@@ -190,8 +190,7 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
              m->damping, p->deformation_damping);
     line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
     if (m->mode.gravity_tilt != 0.0 && m->gravity > 0.0) {
-        double gx, gy;
-        cdem_model_gravity_vector(m->gravity, m->mode.gravity_tilt, &gx, &gy);
+        const double gx = m->gravity_x, gy = m->gravity_y;
         line(f, "gravity", "%g m/s^2, tilted %g degrees from -y toward %s: (%.6g, %.6g) m/s^2",
              m->gravity, fabs(m->mode.gravity_tilt), m->mode.gravity_tilt > 0.0 ? "+x" : "-x", gx,
              gy);
