@@ -119,6 +119,9 @@ typedef struct {
     uint32_t moving_flag;          /* the flag of the elements the boundary actor moves:
                                       CDEM_FLAG_MOVING (the run's model, its first actor), else
                                       CDEM_FLAG_ACTOR_MOVING(N) (bc.h, cdem_bc_moving_flag) */
+    int composed;                  /* 1: the actor is one of several (bc.h, "Boundaries compose":
+                                      a composing mode then adds its velocities to the
+                                      others'); 0: alone */
 } cdem_model;
 
 /* Computes every derived quantity from the parameters and the mode's part `mode` (its derive
