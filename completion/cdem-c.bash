@@ -140,9 +140,11 @@ _cdem_strain() {
             --threshold) return ;;
             --bin) return ;;
             --min-rows) return ;;
+            --band) return ;;
+            --contrast) return ;;
             -o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
         esac
-        opts="--increment --quantity --threshold --bin --min-rows --include-salt -o --output -h --help" ;;
+        opts="--increment --quantity --threshold --bin --min-rows --include-salt --timeline --band --contrast -o --output -h --help" ;;
     fault-seal)
         case "$prev" in
             --increment) COMPREPLY=($(compgen -W "last equil first" -- "$cur")); return ;;

@@ -2,6 +2,7 @@
 #include "cmd_options.h"
 
 #include "analysis.h"
+#include "fault_timeline.h"
 #include "run_file.h"
 
 #include <math.h>
@@ -122,6 +123,50 @@ static void json_number(FILE *f, double v) {
 }
 
 /* info --json: the same facts as the text, for scripts (docs/analysis.md). */
+/* The boundary actors of a run of several or with a window (nothing otherwise: the output of
+ * a run of one actor is as before): mode, where each fault meets the base, its dip, its window
+ * in m of the run's boundary displacement and in increments, its displacement so far. */
+static void print_actors(const cdem_analysis *a) {
+    cdem_timeline_actor t[CDEM_BOUNDARY_ACTORS];
+    const int n = cdem_timeline_actors(cdem_analysis_params(a), t);
+    if (n == 0 || (n == 1 && !(t[0].start > 0.0) && !(t[0].stop > 0.0)))
+        return;
+    const size_t count = cdem_analysis_count(a);
+    const double run = cdem_timeline_run_displacement(a, count - 1);
+    printf("boundary actors: %d (run's boundary displacement so far %.3f m)\n", n, run);
+    printf("%-14s %-16s %10s %7s %-22s %-14s %14s\n", "actor", "mode", "x_base_m", "dip_deg",
+           "window_m", "increments", "displacement_m");
+    for (int j = 0; j < n; j++) {
+        char window[48], incs[32], x[24], dip[16];
+        if (t[j].stop > 0.0)
+            snprintf(window, sizeof window, "%g-%g", t[j].start, t[j].stop);
+        else
+            snprintf(window, sizeof window, "%g-end", t[j].start);
+        /* the increments whose interval the window overlaps (by more than a rounding) */
+        int first = -1, last = -1;
+        double before = 0.0;
+        for (size_t k = 0; k < count; k++) {
+            const double r = cdem_timeline_run_displacement(a, k);
+            const double eps = 0.01 * (r - before);
+            if (r > before && r > t[j].start + eps &&
+                (!(t[j].stop > 0.0) || before < t[j].stop - eps)) {
+                if (first < 0)
+                    first = cdem_analysis_info(a, k)->number;
+                last = cdem_analysis_info(a, k)->number;
+            }
+            before = r;
+        }
+        if (first < 0)
+            snprintf(incs, sizeof incs, "none yet");
+        else
+            snprintf(incs, sizeof incs, "%d-%d", first, last);
+        snprintf(x, sizeof x, t[j].fault ? "%.1f" : "-", t[j].x_base);
+        snprintf(dip, sizeof dip, t[j].fault ? "%g" : "-", t[j].dip_deg);
+        printf("%-14s %-16s %10s %7s %-22s %-14s %14.3f\n", t[j].section, cdem_mode_name(t[j].mode),
+               x, dip, window, incs, cdem_timeline_actor_displacement(&t[j], run));
+    }
+}
+
 static int info_json(const cdem_cmd_options *o) {
     cdem_error err;
     cdem_h5_reader *r = NULL;
@@ -265,6 +310,8 @@ static int cmd_info(const cdem_cmd_options *o) {
                    in->time, phase_name(in->phase), in->net_displacement,
                    (long long)in->n_elements);
     }
+    if (!imported)
+        print_actors(a);
     cdem_analysis_close(a);
     return CDEM_EXIT_OK;
 }
@@ -280,7 +327,10 @@ static const cdem_cli_help help = {
     .forms = info_forms,
     .about = "Prints the run's summary (as cdem-run --summary printed it), its stop reason and "
              "the list of increments with step, time, phase, net displacement and element "
-             "count. Works on a file that is still being written.",
+             "count; for a run of several boundary actors (or one with a window), then each "
+             "actor: its mode, where its fault meets the base, its dip, its window in m of the "
+             "run's boundary displacement and in increments, and its displacement so far. "
+             "Works on a file that is still being written.",
     .options = info_options,
 };
 

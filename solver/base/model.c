@@ -168,7 +168,6 @@ cdem_status cdem_model_derive(const cdem_params *p, const cdem_model_mode *mode,
     m->sediment_steps = lround(m->sediment_interval / m->displacement_per_step);
     m->settling_steps = lround(0.2 * p->equilibration / m->dt);
     m->sea_level_factor = sea_factor[p->sea_level_rise];
-    cdem_model_gravity_vector(m->gravity, m->mode.gravity_tilt, &m->gravity_x, &m->gravity_y);
     m->elements_estimated = cdem_model_estimate_elements(p);
     return CDEM_OK;
 }

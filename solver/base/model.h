@@ -101,9 +101,6 @@ typedef struct {
     double displacement_per_step;  /* m, boundary_speed * dt */
     double gravity;                /* m/s^2, the magnitude actually applied (0 when the mode
                                       turns it off); its direction: mode.gravity_tilt */
-    double gravity_x, gravity_y;   /* m/s^2, gravity's vector at the start: gravity turned by
-                                      mode.gravity_tilt (cdem_model_gravity_vector), derived
-                                      once for the loads and the summary */
     long elements_estimated;       /* free elements the assembly will hold, about
                                       (cdem_model_estimate_elements): the memory the run needs
                                       is checked from it before anything is built */
@@ -122,6 +119,9 @@ typedef struct {
     uint32_t moving_flag;          /* the flag of the elements the boundary actor moves:
                                       CDEM_FLAG_MOVING (the run's model, its first actor), else
                                       CDEM_FLAG_ACTOR_MOVING(N) (bc.h, cdem_bc_moving_flag) */
+    int composed;                  /* 1: the actor is one of several (bc.h, "Boundaries compose":
+                                      a composing mode then adds its velocities to the
+                                      others'); 0: alone */
 } cdem_model;
 
 /* Computes every derived quantity from the parameters and the mode's part `mode` (its derive

@@ -31,14 +31,22 @@
  * ramps are its window's. Each actor's elements carry its own moving flag (the model's
  * moving_flag, cdem_bc_moving_flag), so that actors never take each other's elements; a mode
  * that can be one of several sets `composes` and `adopt` (the other actors' elements that
- * ride on its block). When an actor's window ends its elements stop (their velocity is set to
- * 0). A run of one actor without a window goes through exactly the code paths of a run before
- * actors existed (the refactor guard, scripts/refactor_guard.sh).
+ * ride on its block). Windows may overlap: the actors whose windows hold a step move in turn,
+ * and an element that rides on several active blocks (a block in the hanging wall of two
+ * faults) takes the sum of their moves: the front end zeroes the velocity of every element of
+ * an active actor, and a composing mode, told by its model (m->composed), adds its move's
+ * velocity instead of setting it. When an actor's window ends its elements stop (their
+ * velocity is set to 0). The faults' geometry is checked before the run (their traces, the
+ * `trace` hook): faults that meet the base too close together or whose traces cross inside
+ * the assembly are refused, naming both sections. A run of one actor without a window goes
+ * through exactly the code paths of a run before actors existed (the refactor guard,
+ * scripts/refactor_guard.sh).
  * Ownership: cdem_bc owns its contexts. Thread safety: one cdem_bc per run. Units: m, s. */
 #ifndef CDEM_BC_H
 #define CDEM_BC_H
 
 #include "cdem_error.h"
+#include "fault_file.h"
 #include "model.h"
 #include "params.h"
 #include "snapshot.h"
@@ -97,12 +105,18 @@ typedef struct {
      * the steps that do not call the mode (sediment settling), and checkpoints keep it */
     void (*gravity)(const void *ctx, long k, double g, double *gx, double *gy);
     /* 1: the mode can be one of several boundary actors (it moves only the elements that
-     * carry its model's moving_flag and has an adopt hook); 0: it runs alone */
+     * carry its model's moving_flag, adds its velocities when m->composed, and has an adopt
+     * hook); 0: it runs alone */
     int composes;
     /* may be NULL; a run of several actors, after every actor's init: flags with the mode's
      * moving flag the other actors' boundary elements that ride on its moving block (e.g. a
      * later fault's ramp in a planar fault's hanging wall) */
     void (*adopt)(void *ctx, cdem_state *s);
+    /* may be NULL (not a fault): the fault's trace from the parameters alone, a polyline from
+     * where it meets the base (y = 0) up-dip to the height `height` (m) of the assembly, for
+     * the checks of several faults (cdem_bc_rules: overlap, crossing) and their messages */
+    cdem_status (*trace)(const cdem_params *p, const cdem_model *m, double height,
+                         cdem_fault_polyline *out, cdem_error *err);
     /* Before the run, from the parameters alone (cdem_run_validate, cdem_bc_derive_model, the
      * summary), in this order in the parameter check: */
     /* may be NULL: the mode's own rules, one cdem_rule_add each (the message names the mode,
@@ -142,6 +156,7 @@ typedef struct {
     int n_more;              /* actors after the first */
     cdem_bc_actor *more;     /* owned, n_more of them */
     long k_now;              /* the deformation step being applied (the split moves read it) */
+    uint32_t active_now;     /* the moving flags of the actors active in step k_now */
 } cdem_bc;
 
 /* The flag of the elements the actor whose model is m moves (a model made by hand, without a
@@ -185,9 +200,8 @@ void cdem_bc_describe_fault(const cdem_params *p, const cdem_model *m, FILE *out
 void cdem_bc_describe_inversion(const cdem_params *p, const cdem_model *m, FILE *out);
 
 /* Finds the mode of every actor of p (p->mode, then [boundary.N]'s), allocates their
- * contexts and runs their inits on s in order; with several actors, then their adopt hooks,
- * and refuses (CDEM_ERR_CONFLICT, naming both sections) two actors whose windows overlap and
- * who would move one element both. */
+ * contexts and runs their inits on s in order (each model's `composed` set when there are
+ * several); with several actors, then their adopt hooks. */
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          cdem_error *err);
 /* k >= 1: the mode's apply (deformation step k); k <= 0: an equilibration step, the mode's

@@ -1,16 +1,15 @@
 /* bc_actors: the boundary of a run as a list of boundary actors (bc.h, "Boundaries compose";
  * docs/solver.md, "Boundaries on a timeline"): their set-up (each actor's parameters, model,
- * window and moving flag; the adopt pass; the refusal of two actors that would move one
- * element at once), the front end the stepper and the run call (apply or the split moves of
- * the actors active in a step, the stop of a window that ended, gravity, net displacement,
- * views) and their checkpoints (the first actor under "bc.", actor N under "bcN."). A run of
+ * window and moving flag; the adopt pass), the front end the stepper and the run call (apply or the
+ * split moves of the actors active in a step, the stop of a window that ended, gravity, net
+ * displacement, views; with several actors, the zeroing of the velocities that the active actors
+ * then add up) and their checkpoints (the first actor under "bc.", actor N under "bcN."). A run of
  * one actor without a window takes exactly the paths of before (`single`). The registry of
  * the modes and what the modes share are bc_registry.c. */
 #include "bc.h"
 
 #include "checkpoint.h"
 
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +68,7 @@ static cdem_status init_actor(cdem_bc_actor *a, const cdem_params *p, int j, con
                          "[boundary.%d] mode = %s cannot be one of several boundary actors", j + 1,
                          a->name);
     cdem_bc_actor_model(a->p, j, m, &a->m, &a->k_start, &a->k_stop);
+    a->m.composed = 1;
     a->ctx = calloc(1, a->ops->state_size);
     if (!a->ctx)
         return CDEM_FAIL(err, CDEM_ERR_NOMEM, "out of memory for boundary actor %d (%s)", j + 1,
@@ -98,35 +98,6 @@ static void actor_of(const cdem_bc *bc, int j, const cdem_bc_ops **ops, void **c
     *moving = a->m.moving_flag;
 }
 
-/* Two actors whose windows overlap may not move one element both. */
-static cdem_status check_shared(const cdem_bc *bc, const cdem_state *s, cdem_error *err) {
-    for (int i = 0; i <= bc->n_more; i++)
-        for (int j = i + 1; j <= bc->n_more; j++) {
-            const cdem_bc_ops *o;
-            void *c;
-            long si, ei, sj, ej;
-            uint32_t fi, fj;
-            actor_of(bc, i, &o, &c, &si, &ei, &fi);
-            actor_of(bc, j, &o, &c, &sj, &ej, &fj);
-            const long end_i = ei ? ei : LONG_MAX, end_j = ej ? ej : LONG_MAX;
-            if (!(si < end_j && sj < end_i))
-                continue; /* one after the other */
-            for (size_t e = 0; e < s->n; e++)
-                if ((s->flags[e] & fi) && (s->flags[e] & fj)) {
-                    char a[32], b[32];
-                    snprintf(a, sizeof a, i == 0 ? "[boundary]" : "[boundary.%d]", i + 1);
-                    snprintf(b, sizeof b, "[boundary.%d]", j + 1);
-                    return CDEM_FAIL(err, CDEM_ERR_CONFLICT,
-                                     "boundary actors %s and %s act at the same time and would "
-                                     "both move boundary element id %d (at x = %.6g m, y = %.6g "
-                                     "m): one block cannot move two ways at once; give them "
-                                     "windows one after the other (start, stop)",
-                                     a, b, (int)s->id[e], s->x[e], s->y[e]);
-                }
-        }
-    return CDEM_OK;
-}
-
 cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m, cdem_state *s,
                          cdem_error *err) {
     memset(bc, 0, sizeof *bc);
@@ -140,8 +111,9 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
     bc->name = cdem_mode_name(p->mode);
     bc->lateral_pressure = ops->confined ? p->confining_pressure : 0.0;
     cdem_bc_actor_model(p, 0, m, &bc->m_first, &bc->k_start, &bc->k_stop);
-    cdem_status st = ops->init(bc->ctx, p, &bc->m_first, s, err);
     const int n = cdem_params_actor_count(p);
+    bc->m_first.composed = n > 1;
+    cdem_status st = ops->init(bc->ctx, p, &bc->m_first, s, err);
     if (st == CDEM_OK && n > 1) {
         bc->more = calloc((size_t)(n - 1), sizeof *bc->more);
         if (!bc->more)
@@ -160,8 +132,6 @@ cdem_status cdem_bc_init(cdem_bc *bc, const cdem_params *p, const cdem_model *m,
         for (int j = 0; st == CDEM_OK && j < bc->n_more; j++)
             if (bc->more[j].ops->adopt)
                 bc->more[j].ops->adopt(bc->more[j].ctx, s);
-        if (st == CDEM_OK)
-            st = check_shared(bc, s, err);
     }
     if (st != CDEM_OK) {
         cdem_bc_free(bc);
@@ -192,6 +162,32 @@ static void stop_ended(const cdem_bc *bc, cdem_state *s, long k) {
         }
 }
 
+/* The moving flags of the actors whose window holds deformation step k. */
+static uint32_t active_flags(const cdem_bc *bc, long k) {
+    uint32_t active = 0;
+    for (int j = 0; j <= bc->n_more; j++) {
+        const cdem_bc_ops *o;
+        void *c;
+        long ks, ke;
+        uint32_t f;
+        actor_of(bc, j, &o, &c, &ks, &ke, &f);
+        if (in_window(ks, ke, k))
+            active |= f;
+    }
+    return active;
+}
+
+/* Several actors: the velocity of the elements of the active ones (flags `active`) over lo..hi
+ * is set to 0 before their moves, which add theirs (a block on two active blocks moves by
+ * both). */
+static void zero_active(cdem_state *s, uint32_t active, long lo, long hi) {
+    for (long i = lo; i < hi; i++)
+        if (s->flags[i] & active) {
+            s->vx[i] = 0.0;
+            s->vy[i] = 0.0;
+        }
+}
+
 /* apply of one actor at the run's deformation step k (k <= 0: an equilibration step). */
 static cdem_status apply_one(const cdem_bc_ops *ops, void *ctx, const char *name, cdem_state *s,
                              long k, double du, double dt, cdem_error *err) {
@@ -217,6 +213,8 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
                    : CDEM_OK;
     bc->k_now = k;
     stop_ended(bc, s, k);
+    if (bc->n_more > 0)
+        zero_active(s, active_flags(bc, k), 0, (long)s->n);
     if (in_window(bc->k_start, bc->k_stop, k))
         CDEM_TRY(apply_one(bc->ops, bc->ctx, bc->name, s, k - bc->k_start, du, dt, err));
     for (int j = 0; j < bc->n_more; j++) {
@@ -227,11 +225,14 @@ cdem_status cdem_bc_apply(cdem_bc *bc, cdem_state *s, long k, double du, double 
     return CDEM_OK;
 }
 
-/* The per-element moves of several actors (cdem_bc_step_move_of): each active actor's over
- * the range, in order (no element moves with two: check_shared). */
+/* The per-element moves of several actors (cdem_bc_step_move_of): the active actors'
+ * velocities zeroed, then each active actor's moves over the range, in order (an element on
+ * two active blocks takes both, velocities added). */
 static void actors_step_move(const void *vbc, cdem_state *s, long lo, long hi) {
     const cdem_bc *bc = vbc;
     const long k = bc->k_now;
+    if (bc->n_more > 0)
+        zero_active(s, bc->active_now, lo, hi);
     if (in_window(bc->k_start, bc->k_stop, k))
         bc->ops->step_move(bc->ctx, s, lo, hi);
     for (int j = 0; j < bc->n_more; j++) {
@@ -298,6 +299,7 @@ cdem_status cdem_bc_step_begin(cdem_bc *bc, long k, double du, double dt, cdem_e
     if (k <= 0 || single(bc))
         return bc->ops->step_begin(bc->ctx, k <= 0 ? 0 : k, du, dt, err);
     bc->k_now = k;
+    bc->active_now = active_flags(bc, k);
     if (in_window(bc->k_start, bc->k_stop, k))
         CDEM_TRY(bc->ops->step_begin(bc->ctx, k - bc->k_start, du, dt, err));
     for (int j = 0; j < bc->n_more; j++) {

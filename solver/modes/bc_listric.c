@@ -25,7 +25,17 @@
  * bc_planar_fault.c.
  * CD kinematics ("mylar sheet", kinematics = cd): the path stays fixed and the fault elements
  * (also CDEM_FLAG_MYLAR) slide along it by du per step (down-dip for normal); the base and
- * right wall move du along the basal segment. */
+ * right wall move du along the basal segment.
+ * One of several boundary actors (bc.h, docs/solver.md "Boundaries on a timeline"): the
+ * footwall is another fault's block or part of one, so it stays live material and the frame is
+ * the footwall's. Nothing is made display-only (the left wall stays a wall, the free elements
+ * left of the curve stay free); the fault elements are fixed to the footwall (CH) or slide
+ * along their path relative to it (CD, by the path's increments, so that a fault whose
+ * footwall rides on another's hanging wall carries its curve along), and the base right of
+ * x0 and the right wall move du along the basal segment per step (its model's moving flag),
+ * adding their velocity to the other actors'. Its adopt hook takes the other actors' fault
+ * elements right of its curve (below the base along the basal segment, above the curve's top
+ * vertically). The relative motion of the two walls of the fault is the single run's. */
 #include "bc.h"
 #include "checkpoint.h"
 #include "fault_file.h"
@@ -62,6 +72,9 @@ typedef struct {
     /* this step's moves (step_begin): CD: base and right wall (bx, by); CH: fault and
      * footwall display (ux), base and right wall (uy); dt for the velocities */
     double step_bx, step_by, step_ux, step_uy, step_dt;
+    int composed;           /* 1: one of several actors (the footwall's frame, see above) */
+    uint32_t moving;        /* the flag of its block (cdem_bc_moving_flag) */
+    double step_sheet_prev; /* m, CD: the sheet offset before this step (composed moves) */
 } listric_ctx;
 
 static const char *mode_name(const listric_ctx *c) {
@@ -119,8 +132,10 @@ static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s
     c->spacing = r;
     c->first_id = s->next_id;
     const double mass = p->density * M_PI * r * r;
+    /* composed CH: the curve is fixed to its footwall (moved only by the actors that adopt it) */
     const uint32_t fl =
-        CDEM_FLAG_FAULT | CDEM_FLAG_MOVING | (c->cd ? (uint32_t)CDEM_FLAG_MYLAR : 0u);
+        c->composed ? CDEM_FLAG_FAULT | (c->cd ? (uint32_t)CDEM_FLAG_MYLAR | c->moving : 0u)
+                    : CDEM_FLAG_FAULT | CDEM_FLAG_MOVING | (c->cd ? (uint32_t)CDEM_FLAG_MYLAR : 0u);
     const long n = (long)floor(c->path_s[nv - 1] / r) + 1;
     for (long j = 0; j < n; j++) {
         double x, y;
@@ -130,6 +145,50 @@ static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s
         c->n_fault++;
     }
     return CDEM_OK;
+}
+
+static cdem_status lay_fault(listric_ctx *c, const cdem_params *p, cdem_state *s, double r,
+                             double ramp, double y_top, cdem_error *err);
+
+/* init of one of several actors (the footwall's frame): the base right of x0 and the right
+ * wall carry its moving flag, the free elements cut by the curve are removed, nothing else
+ * changes; then the fault elements. */
+static cdem_status composed_init(listric_ctx *c, const cdem_params *p, const cdem_model *m,
+                                 cdem_state *s, const cdem_bc_walls *w, double wall_top,
+                                 cdem_error *err) {
+    c->sense = p->fault_sense;
+    c->inversion = p->inversion ? 1 : 0;
+    c->k_inversion = cdem_model_inversion_step(p, m);
+    const double db = c->dip_base_deg * M_PI / 180.0;
+    c->heave = cos(db);
+    c->throw_ = sin(db);
+    const double rf = w->r_base;
+    unsigned char *keep = malloc(s->n ? s->n : 1);
+    if (!keep)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "%s: out of memory for %zu keep flags", mode_name(c),
+                         s->n);
+    memset(keep, 1, s->n);
+    for (size_t i = 0; i < s->n; i++) {
+        s->flags[i] &= ~c->moving;
+        if (s->flags[i] & CDEM_FLAG_WALL) {
+            const int is_base = cdem_bc_is_base(w, s, i);
+            if ((is_base && s->x[i] >= c->x_fault) || (!is_base && s->x[i] > w->x_mid)) {
+                s->flags[i] |= c->moving;
+                c->n_base_moving++;
+            } else if (is_base) {
+                c->n_base_footwall++;
+            }
+        } else if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY) &&
+                   cdem_fault_file_distance(&c->line, s->x[i], s->y[i]) < s->radius[i] + rf) {
+            keep[i] = 0;
+            c->n_cut++;
+        }
+    }
+    if (c->n_cut > 0)
+        cdem_state_compact(s, keep, NULL);
+    free(keep);
+    const double ramp = m->total_displacement + 4.0 * rf;
+    return lay_fault(c, p, s, rf, ramp, fmax(wall_top, c->height) + m->total_displacement, err);
 }
 
 static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, const cdem_model *m,
@@ -179,6 +238,10 @@ static cdem_status listric_init_common(listric_ctx *c, const cdem_params *p, con
         c->dip_base_deg = p->fault_dip;
     }
     const cdem_fault_polyline *pl = &c->line;
+    c->composed = m->composed;
+    c->moving = cdem_bc_moving_flag(m);
+    if (c->composed)
+        return composed_init(c, p, m, s, &w, wall_top, err);
     /* the fault moves up to the whole heave toward the left wall */
     const double x_left = pl->x[pl->n - 1];
     const double max_heave = m->total_displacement * cos(c->dip_base_deg * M_PI / 180.0);
@@ -260,7 +323,13 @@ static cdem_status listric_step_begin(void *vctx, long k, double du, double dt, 
     const double sgn =
         ((k <= c->k_inversion) ? 1.0 : -1.0) * (c->sense == CDEM_SENSE_NORMAL ? 1.0 : -1.0);
     c->step_dt = dt;
-    if (c->cd) {
+    if (c->composed) { /* the footwall's frame: the base along the basal segment */
+        c->step_sheet_prev = c->sheet;
+        if (c->cd)
+            c->sheet -= sgn * du;
+        c->step_bx = sgn * du * c->heave;
+        c->step_by = -sgn * du * c->throw_;
+    } else if (c->cd) {
         c->sheet -= sgn * du;
         c->step_bx = sgn * du * c->heave;
         c->step_by = -sgn * du * c->throw_;
@@ -295,8 +364,37 @@ static void cd_move(const listric_ctx *c, cdem_state *s, long lo, long hi) {
     }
 }
 
+/* The moves of one of several actors: the block by (bx, by); CD: its own sheet elements by
+ * their path's increment (whatever the other actors moved them by). Velocities add. */
+static void composed_move(const listric_ctx *c, cdem_state *s, long lo, long hi) {
+    const double bx = c->step_bx, by = c->step_by, dt = c->step_dt;
+    for (long i = lo; i < hi; i++) {
+        const uint32_t f = s->flags[i];
+        if (!(f & c->moving))
+            continue;
+        double ux = bx, uy = by;
+        if ((f & CDEM_FLAG_MYLAR) && s->id[i] >= c->first_id &&
+            s->id[i] < c->first_id + (int32_t)c->n_fault) {
+            const double a = (double)(s->id[i] - c->first_id) * c->spacing;
+            double x0, y0, x1, y1;
+            path_at(c, a + c->step_sheet_prev, &x0, &y0);
+            path_at(c, a + c->sheet, &x1, &y1);
+            ux = x1 - x0;
+            uy = y1 - y0;
+        }
+        s->x[i] += ux;
+        s->y[i] += uy;
+        s->vx[i] += ux / dt;
+        s->vy[i] += uy / dt;
+    }
+}
+
 static void listric_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
     const listric_ctx *c = vctx;
+    if (c->composed) {
+        composed_move(c, s, lo, hi);
+        return;
+    }
     if (c->cd) {
         cd_move(c, s, lo, hi);
         return;
@@ -325,6 +423,35 @@ static void listric_step_move(const void *vctx, cdem_state *s, long lo, long hi)
     }
 }
 
+/* The other actors' fault elements right of the curve join the block (x_at: below the base
+ * along the basal segment, above the curve's top vertically). */
+static void listric_adopt(void *vctx, cdem_state *s) {
+    listric_ctx *c = vctx;
+    for (size_t i = 0; i < s->n; i++) {
+        if (!(s->flags[i] & CDEM_FLAG_FAULT) || (s->flags[i] & c->moving) ||
+            (s->id[i] >= c->first_id && s->id[i] < c->first_id + (int32_t)c->n_fault))
+            continue;
+        if (s->x[i] > cdem_fault_file_x_at(&c->line, s->y[i])) {
+            s->flags[i] |= c->moving;
+            c->n_base_moving++;
+        }
+    }
+}
+
+/* The traces: the built-in curve, or the vertex file's. */
+static cdem_status listric_trace(const cdem_params *p, const cdem_model *m, double height,
+                                 cdem_fault_polyline *out, cdem_error *err) {
+    return cdem_fault_file_listric(p->fault_location * m->width_m, height, p->fault_dip,
+                                   CDEM_LISTRIC_SEGMENTS, out, err);
+}
+
+static cdem_status irregular_trace(const cdem_params *p, const cdem_model *m, double height,
+                                   cdem_fault_polyline *out, cdem_error *err) {
+    (void)height;
+    return cdem_fault_file_read(p->fault_file, p->fault_location * m->width_m, 0.5 * m->radius[0],
+                                out, err);
+}
+
 static double listric_net(const void *vctx) {
     return ((const listric_ctx *)vctx)->net;
 }
@@ -339,7 +466,15 @@ static void listric_view(const void *vctx, FILE *out) {
             c->cd ? "constant displacement (CD, mylar sheet)" : "constant heave (CH)", c->x_fault,
             c->line.x[c->line.n - 1], c->line.y[c->line.n - 1], c->line.n,
             c->irregular ? ", from the fault file" : ", dip = d0 + (90 - d0) y/H", c->dip_base_deg);
-    if (c->cd)
+    if (c->composed)
+        fprintf(out,
+                "one of several boundary actors, in its footwall's frame: per metre of "
+                "displacement the base right of the fault and the right wall move (%.4f, %.4f) m "
+                "along the basal segment%s; the footwall stays live material; ",
+                c->heave, -c->throw_,
+                c->cd ? " and the fault elements slide 1 m along the fault"
+                      : ", the fault elements stay with the footwall");
+    else if (c->cd)
         fprintf(out,
                 "per metre of displacement the fault elements slide 1 m along the fault and "
                 "the base and right wall move (%.4f, %.4f) m along the basal segment; ",
@@ -410,7 +545,12 @@ static void describe_rest(const cdem_params *p, const cdem_model *m, FILE *out) 
     cdem_summary_line(out, "kinematics", "%s",
                       p->kinematics == CDEM_KIN_CD ? "constant displacement (CD, mylar sheet)"
                                                    : "constant heave (CH)");
-    cdem_summary_line(out, "footwall", "removed (hanging-wall deformation only)");
+    if (m->composed)
+        cdem_summary_line(out, "footwall",
+                          "live material, fixed (the frame of the footwall: one of several "
+                          "boundary actors)");
+    else
+        cdem_summary_line(out, "footwall", "removed (hanging-wall deformation only)");
     cdem_bc_describe_inversion(p, m, out);
 }
 
@@ -455,6 +595,9 @@ static const cdem_bc_ops listric_ops = {
     .inverts = 1,
     .derive = NULL,
     .describe = listric_describe,
+    .composes = 1,          /* one of several actors: the footwall's frame (above) */
+    .adopt = listric_adopt, /* the other actors' fault elements right of its curve */
+    .trace = listric_trace, /* its curve, for the checks of several faults */
 };
 
 static const cdem_bc_ops irregular_ops = {
@@ -473,6 +616,9 @@ static const cdem_bc_ops irregular_ops = {
     .inverts = 1,
     .derive = irregular_derive, /* the vertex file is an input of the run */
     .describe = irregular_describe,
+    .composes = 1,
+    .adopt = listric_adopt,
+    .trace = irregular_trace,
 };
 
 const cdem_bc_ops *const cdem_bc_listric_fault = &listric_ops;

@@ -13,14 +13,18 @@
  * becomes the exposed fault face as the block rises. Ramps and walls never interact with
  * each other (boundary-boundary pairs are skipped).
  * One of several boundary actors (bc.h): its block's elements carry its model's moving flag,
- * and its adopt hook adds the other actors' fault ramps that lie in its hanging wall (on the
- * hanging-wall side of its plane), so that a later fault's ramp rides down with this block,
- * and this block's ramps with a later fault's hanging wall. */
+ * and its adopt hook adds the other actors' fault elements that lie in its hanging wall (on
+ * the hanging-wall side of its plane up to the top of the assembly, right of the plane's top
+ * above it), so that a later fault's ramp (or a listric fault's curve) rides with this block,
+ * and this block's ramps with a later fault's hanging wall. With several actors it adds its
+ * velocity to the others' (bc.h): a block in the hanging walls of two faults acting at once
+ * moves by both. */
 #include "bc.h"
 #include "checkpoint.h"
 #include "summary_line.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct {
@@ -40,6 +44,8 @@ typedef struct {
     double step_ux, step_uy, step_vx, step_vy; /* this step's move and velocity (step_begin) */
     uint32_t moving;                           /* the flag of its block (cdem_bc_moving_flag) */
     int32_t ramp_id_lo, ramp_id_hi;            /* ids of its own ramps: [lo, hi) */
+    int composed;                              /* 1: one of several actors: adds velocities */
+    double x_top, y_top; /* m, the plane at the top of the assembly (adopt: vertical above) */
 } planar_ctx;
 
 static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_model *m, cdem_state *s,
@@ -87,6 +93,13 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     c->dir_x = sgn * cos(d);
     c->dir_y = -sgn * sin(d);
     c->moving = cdem_bc_moving_flag(m);
+    c->composed = m->composed;
+    double top = ymin;
+    for (size_t i = 0; i < s->n; i++)
+        if (!(s->flags[i] & CDEM_FLAGS_BOUNDARY))
+            top = fmax(top, s->y[i] + s->radius[i]);
+    c->y_top = top;
+    c->x_top = c->x_fault - (top - ymin) * cos(d) / sin(d);
     /* the hanging-wall block: base right of x_f plus the right lateral wall */
     const double xmid = 0.5 * (xmin_wall + xmax_wall);
     for (size_t i = 0; i < s->n; i++) {
@@ -126,9 +139,10 @@ static cdem_status planar_init(void *vctx, const cdem_params *p, const cdem_mode
     return CDEM_OK;
 }
 
-/* The other actors' fault ramps on the hanging-wall side of the plane join the block: the
+/* The other actors' fault elements on the hanging-wall side of the plane join the block: the
  * plane through (x_f, y_b) dipping toward +x leaves the hanging wall where
- * (x - x_f) sin d - (y_b - y) cos d > 0. */
+ * (x - x_f) sin d - (y_b - y) cos d > 0; above the top of the assembly the side is x > x_top
+ * (vertical), so that a listric fault's elements above it stay with their own block. */
 static void planar_adopt(void *vctx, cdem_state *s) {
     planar_ctx *c = vctx;
     const double d = c->dip_deg * M_PI / 180.0, sd = sin(d), cd = cos(d);
@@ -136,7 +150,10 @@ static void planar_adopt(void *vctx, cdem_state *s) {
         if (!(s->flags[i] & CDEM_FLAG_FAULT) || (s->flags[i] & c->moving) ||
             (s->id[i] >= c->ramp_id_lo && s->id[i] < c->ramp_id_hi))
             continue;
-        if ((s->x[i] - c->x_fault) * sd - (c->y_base - s->y[i]) * cd > 0.0) {
+        const int hanging = s->y[i] > c->y_top
+                                ? s->x[i] > c->x_top
+                                : (s->x[i] - c->x_fault) * sd - (c->y_base - s->y[i]) * cd > 0.0;
+        if (hanging) {
             s->flags[i] |= c->moving;
             c->n_moving++;
         }
@@ -157,8 +174,23 @@ static cdem_status planar_step_begin(void *vctx, long k, double du, double dt, c
     return CDEM_OK;
 }
 
+/* step_move of one of several actors: the velocity is added to the others' (bc.h). */
+static void planar_step_move_composed(const planar_ctx *c, cdem_state *s, long lo, long hi) {
+    for (long i = lo; i < hi; i++)
+        if (s->flags[i] & c->moving) {
+            s->x[i] += c->step_ux;
+            s->y[i] += c->step_uy;
+            s->vx[i] += c->step_vx;
+            s->vy[i] += c->step_vy;
+        }
+}
+
 static void planar_step_move(const void *vctx, cdem_state *s, long lo, long hi) {
     const planar_ctx *c = vctx;
+    if (c->composed) {
+        planar_step_move_composed(c, s, lo, hi);
+        return;
+    }
     const double ux = c->step_ux, uy = c->step_uy, vx = c->step_vx, vy = c->step_vy;
     double *restrict x = s->x, *restrict y = s->y, *restrict vxa = s->vx, *restrict vya = s->vy;
     const uint32_t *restrict fl = s->flags;
@@ -218,6 +250,25 @@ static void planar_describe(const cdem_params *p, const cdem_model *m, FILE *out
     cdem_bc_describe_inversion(p, m, out);
 }
 
+/* The trace: the plane from (x_f, 0) up-dip to the top of the assembly. */
+static cdem_status planar_trace(const cdem_params *p, const cdem_model *m, double height,
+                                cdem_fault_polyline *out, cdem_error *err) {
+    memset(out, 0, sizeof *out);
+    out->x = malloc(2 * sizeof *out->x);
+    out->y = malloc(2 * sizeof *out->y);
+    if (!out->x || !out->y) {
+        cdem_fault_file_free(out);
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "planar fault: out of memory for its trace");
+    }
+    const double d = p->fault_dip * M_PI / 180.0;
+    out->n = 2;
+    out->x[0] = p->fault_location * m->width_m;
+    out->y[0] = 0.0;
+    out->x[1] = out->x[0] - height * cos(d) / sin(d);
+    out->y[1] = height;
+    return CDEM_OK;
+}
+
 static const cdem_bc_ops planar_ops = {
     .state_size = sizeof(planar_ctx), /* state_size */
     .init = planar_init,              /* init */
@@ -236,6 +287,7 @@ static const cdem_bc_ops planar_ops = {
     .describe = planar_describe,      /* sense, location, dip, inversion */
     .composes = 1,                    /* one of several actors: its own moving flag */
     .adopt = planar_adopt,            /* the other actors' ramps in its hanging wall */
+    .trace = planar_trace,            /* its plane, for the checks of several faults */
 };
 
 const cdem_bc_ops *const cdem_bc_planar_fault = &planar_ops;

@@ -137,6 +137,113 @@ static void window_rules(const cdem_params *pj, int j, const cdem_model *m, cdem
                       sec, pj->window_stop, run, m->boundary_speed);
 }
 
+/* One fault of a run of several, for the geometry checks: its section, keys, trace (from the
+ * base up to the assembly's top) and window in m of the run's boundary displacement. */
+typedef struct {
+    char section[20];
+    const char *mode;
+    int planar; /* 1: only its base moves (no fault elements along the trace) */
+    char keys[1200];
+    cdem_fault_polyline trace;
+    double start, stop; /* m; stop: the run's end when the window has none */
+} fault_of_run;
+
+static double base_dip(const cdem_fault_polyline *t) {
+    return atan2(t->y[1] - t->y[0], t->x[0] - t->x[1]);
+}
+
+/* Two faults of one run: they may not meet the base within the reach of the left one's ramp
+ * below it (they would share the gap and its ramp), and their traces may not cross inside the
+ * assembly when either lays fault elements along it (listric, irregular: the curves would cut
+ * each other) or both act at once (the block between them would move two ways). */
+static void fault_pair_rules(const fault_of_run *a, const fault_of_run *b, const cdem_model *m,
+                             cdem_rule_log *log) {
+    const fault_of_run *l = a->trace.x[0] <= b->trace.x[0] ? a : b, *r = l == a ? b : a;
+    const double r_base = m->max_radius;
+    const double reach = (l->stop - l->start + 4.0 * r_base) * cos(base_dip(&l->trace));
+    const double gap = r->trace.x[0] - l->trace.x[0];
+    if (gap <= reach + 2.0 * r_base) {
+        cdem_rule_add(log,
+                      "%s (%s; %s) and %s (%s; %s) overlap: they meet the base at x = %.6g m and "
+                      "%.6g m, closer than the left one's ramp below the base reaches (%.6g m: "
+                      "its displacement in its window plus 4 radii, along its basal dip): move "
+                      "them apart (fault_location) or shorten the left one's window",
+                      l->section, l->mode, l->keys, r->section, r->mode, r->keys, l->trace.x[0],
+                      r->trace.x[0], reach + 2.0 * r_base);
+        return;
+    }
+    const int together = a->start < b->stop && b->start < a->stop;
+    if (l->planar && r->planar && !together)
+        return; /* one after the other: the later fault cuts the earlier's zone */
+    const double top = fmin(l->trace.y[l->trace.n - 1], r->trace.y[r->trace.n - 1]);
+    const int steps = 400;
+    for (int k = 1; k <= steps; k++) {
+        const double y = top * (double)k / steps;
+        const double xl = cdem_fault_file_x_at(&l->trace, y),
+                     xr = cdem_fault_file_x_at(&r->trace, y);
+        if (xr > xl)
+            continue;
+        cdem_rule_add(log,
+                      "%s (%s; %s) and %s (%s; %s) cross inside the assembly: their traces meet "
+                      "near x = %.6g m, y = %.6g m (its top is at %.6g m); %s: move them apart "
+                      "(fault_location), change their dips%s",
+                      l->section, l->mode, l->keys, r->section, r->mode, r->keys, xl, y, top,
+                      l->planar && r->planar
+                          ? "the wedge above the crossing would move two ways at once while "
+                            "both act"
+                          : "the fault elements along them would cut each other",
+                      l->planar && r->planar ? " or give them windows one after the other "
+                                               "(start, stop)"
+                                             : "");
+        return;
+    }
+}
+
+/* The geometry checks of the faults of a run of several actors (fault_pair_rules). */
+static void faults_rules(const cdem_params *p, int n, const cdem_model *m, cdem_rule_log *log) {
+    fault_of_run f[CDEM_BOUNDARY_ACTORS];
+    int nf = 0;
+    const double run = (double)(m->total_steps - m->equil_steps) * m->displacement_per_step;
+    for (int j = 0; j < n && j < CDEM_BOUNDARY_ACTORS; j++) {
+        cdem_params pj;
+        const cdem_bc_ops *ops = NULL;
+        if (cdem_params_actor(p, j, &pj, NULL) != CDEM_OK ||
+            cdem_bc_find(pj.mode, &ops, NULL) != CDEM_OK || !ops->trace)
+            continue;
+        fault_of_run *o = &f[nf];
+        memset(o, 0, sizeof *o);
+        if (ops->trace(&pj, m, m->height_m, &o->trace, NULL) != CDEM_OK || o->trace.n < 2)
+            continue; /* the mode's own rules or its init name what is wrong */
+        snprintf(o->section, sizeof o->section, j == 0 ? "[boundary]" : "[boundary.%d]", j + 1);
+        o->mode = cdem_mode_name(pj.mode);
+        o->planar = ops == cdem_bc_planar_fault;
+        if (pj.mode == CDEM_MODE_IRREGULAR_FAULT)
+            snprintf(o->keys, sizeof o->keys, "fault_location = %g, fault_file = %s",
+                     pj.fault_location, pj.fault_file);
+        else
+            snprintf(o->keys, sizeof o->keys, "fault_location = %g, fault_dip = %g",
+                     pj.fault_location, pj.fault_dip);
+        o->start = pj.window_start;
+        o->stop = pj.window_stop > 0.0 ? pj.window_stop : run;
+        nf++;
+    }
+    for (int a = 0; a < nf; a++)
+        for (int b = a + 1; b < nf; b++)
+            fault_pair_rules(&f[a], &f[b], m, log);
+    for (int a = 0; a < nf; a++)
+        cdem_fault_file_free(&f[a].trace);
+}
+
+/* The modes that can be one of several actors, "a, b or c". */
+static void composing_modes(char *words, size_t cap) {
+    const char *w[CDEM_MODE_WORDS];
+    size_t n = 0;
+    for (int k = 0; k < CDEM_MODE_WORDS; k++)
+        if ((*registry[k])->composes)
+            w[n++] = cdem_mode_name((cdem_mode)k);
+    cdem_words_or(w, n, words, cap);
+}
+
 void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log) {
     const int n = cdem_params_actor_count(p);
     mode_rules(p, log);
@@ -147,11 +254,13 @@ void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log) {
     if (n == 1)
         return;
     const cdem_bc_ops *first = NULL;
+    char can[160];
+    composing_modes(can, sizeof can);
     if (cdem_bc_find(p->mode, &first, NULL) == CDEM_OK && !first->composes)
         cdem_rule_add(log,
                       "[boundary] mode = %s cannot be one of several boundary actors (%d are set: "
-                      "[boundary.2] ...); modes that can: planar-fault",
-                      cdem_mode_name(p->mode), n);
+                      "[boundary.2] ...); modes that can: %s",
+                      cdem_mode_name(p->mode), n, can);
     cdem_model_mode mode_first = cdem_model_mode_default();
     if (first && first->derive)
         first->derive(p, &mode_first);
@@ -175,8 +284,8 @@ void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log) {
         if (!ops->composes)
             cdem_rule_add(log,
                           "[boundary.%d] mode = %s cannot be one of several boundary actors; "
-                          "modes that can: planar-fault",
-                          j + 1, cdem_mode_name(pj.mode));
+                          "modes that can: %s",
+                          j + 1, cdem_mode_name(pj.mode), can);
         cdem_model_mode mj = cdem_model_mode_default();
         if (ops->derive)
             ops->derive(&pj, &mj);
@@ -191,6 +300,8 @@ void cdem_bc_rules(const cdem_params *p, cdem_rule_log *log) {
                           "%s (gravity, moving boundaries or base): the actors share one model",
                           j + 1, cdem_mode_name(pj.mode), cdem_mode_name(p->mode));
     }
+    if (have_model)
+        faults_rules(p, n, &m, log);
 }
 
 cdem_status cdem_bc_derive_model(const cdem_params *p, cdem_model *m, cdem_error *err) {
@@ -224,8 +335,10 @@ static void describe_window(const cdem_params *pj, const cdem_model *m, FILE *ou
 
 void cdem_bc_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
     const cdem_bc_ops *ops = NULL;
+    cdem_model m0 = *m; /* as the actor's init sees it (bc_actors.c) */
+    m0.composed = cdem_params_actor_count(p) > 1;
     if (cdem_bc_find(p->mode, &ops, NULL) == CDEM_OK && ops->describe)
-        ops->describe(p, m, out);
+        ops->describe(p, &m0, out);
     describe_window(p, m, out);
     for (int j = 1; j < cdem_params_actor_count(p); j++) {
         cdem_params pj;
@@ -238,6 +351,7 @@ void cdem_bc_describe(const cdem_params *p, const cdem_model *m, FILE *out) {
         cdem_model mj;
         long ks, ke;
         cdem_bc_actor_model(&pj, j, m, &mj, &ks, &ke);
+        mj.composed = 1;
         if (cdem_bc_find(pj.mode, &ops, NULL) == CDEM_OK && ops->describe)
             ops->describe(&pj, &mj, out);
     }

@@ -114,22 +114,9 @@ static void contact_line(FILE *f, const char *label, const cdem_params *p,
              c->breaking_strain);
 }
 
-cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
-                              long n_wall_elements, int elements_estimated, char **text,
-                              cdem_error *err) {
-    /* n_elements: free elements; n_wall_elements: wall, fault and other boundary elements */
-    if (text)
-        *text = NULL;
-    if (!p || !m || !text)
-        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_summary_text: NULL argument");
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&buf, &len);
-    if (!f)
-        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "model summary: cannot open a memory stream");
-
-    fprintf(f, "cdem-c model summary\n");
-
+/* The summary's section "Elements". */
+static void elements_section(FILE *f, long n_elements, long n_wall_elements,
+                             int elements_estimated) {
     /* One count everywhere (docs/format.md, "Counting"): the elements stored in increment 0,
      * after the boundary mode has added its fault elements; the progress line and
      * cdem-strain info count the same. */
@@ -141,7 +128,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "free elements", "%ld%s", n_elements, elements_estimated ? " (estimated)" : "");
     line(f, "wall and fault elements", "%ld%s", n_wall_elements,
          elements_estimated ? " (estimated)" : "");
+}
 
+/* The summary's section "Model dimensions". */
+static void dimensions_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Model dimensions");
     line(f, "assembly", "%g x %g units = %.6g x %.6g m", p->width, p->height, m->width_m,
          m->height_m);
@@ -149,7 +139,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     line(f, "lateral wall height", "%.6g m (%d x the assembly height)",
          p->wall_height_multiplier * m->height_m, p->wall_height_multiplier);
     line(f, "random seed", "%ld", p->seed);
+}
 
+/* The summary's section "Element radii and masses". */
+static void radii_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Element radii and masses");
     const double scale = cdem_params_radius_scale(p);
     if (scale == 1.0)
@@ -171,7 +164,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     else if (m->min_mass < m->mass[0])
         snprintf(lightest, sizeof lightest, " (light interval)");
     line(f, "smallest mass", "%.6g kg/m%s", m->min_mass, lightest);
+}
 
+/* The summary's section "Constants". */
+static void constants_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Constants");
     const char *kn_origin = p->unit_scaling >= 1000.0 ? "default constant"
                             : p->keep_constants       ? "default constant (keep_constants = on)"
@@ -190,7 +186,8 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
              m->damping, p->deformation_damping);
     line(f, "time step dt", "%.6g s (0.25 sqrt(smallest mass / Kn))", m->dt);
     if (m->mode.gravity_tilt != 0.0 && m->gravity > 0.0) {
-        const double gx = m->gravity_x, gy = m->gravity_y;
+        double gx, gy;
+        cdem_model_gravity_vector(m->gravity, m->mode.gravity_tilt, &gx, &gy);
         line(f, "gravity", "%g m/s^2, tilted %g degrees from -y toward %s: (%.6g, %.6g) m/s^2",
              m->gravity, fabs(m->mode.gravity_tilt), m->mode.gravity_tilt > 0.0 ? "+x" : "-x", gx,
              gy);
@@ -199,13 +196,19 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
              m->mode.gravity_off ? m->mode.gravity_off : "", m->mode.gravity_off ? ")" : "");
     line(f, "density", "%g kg/m^3", p->density);
     line(f, "stress calculation", "%s", on_off(p->calculate_stress));
+}
 
+/* The summary's section "Time". */
+static void time_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Time");
     line(f, "equilibration", "%g s = %ld time steps", p->equilibration, m->equil_steps);
     line(f, "runtime", "%g s = %ld time steps (%ld after equilibration)", p->runtime,
          m->total_steps, m->total_steps - m->equil_steps);
     line(f, "time-series sample", "every %d time steps", p->series_interval);
+}
 
+/* The summary's section "Boundary displacement". */
+static void boundary_displacement_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Boundary displacement");
     if (m->mode.moving_boundaries == 0) {
         line(f, "boundary speed", "none (%s)", m->mode.still ? m->mode.still : "no boundary moves");
@@ -216,7 +219,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
         line(f, "total displacement", "%.6g m (first-order estimate%s)", m->total_displacement,
              p->sedimentation ? "; settling pauses make it smaller" : "");
     }
+}
 
+/* The summary's section "Display increments". */
+static void increments_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Display increments");
     if (m->mode.moving_boundaries == 0) /* no boundary moves: the interval is in seconds */
         line(f, "display interval", "%g s = %.6g time steps", p->display_interval,
@@ -227,11 +233,17 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     /* increments are numbered 0..N and the file holds N + 1 of them (0 = before equilibration) */
     line(f, "increments", "%d, numbered 0..%d", m->n_increments_total + 1, m->n_increments_total);
     line(f, "end of equilibration", "increment %d", m->n_increments_equil);
+}
 
+/* The summary's section "Faulting / boundary conditions". */
+static void boundary_conditions_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Faulting / boundary conditions");
     line(f, "mode", "%s", cdem_mode_name(p->mode));
     cdem_bc_describe(p, m, f);
+}
 
+/* The summary's section "Material". */
+static void material_section(FILE *f, const cdem_params *p) {
     heading(f, "Material");
     line(f, "model", "%s",
          p->material == CDEM_MATERIAL_GRANULAR ? "granular frictional-cohesive"
@@ -261,7 +273,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     else
         line(f, "element-base", "as element-wall");
     contact_line(f, "element-fault", p, &p->fault);
+}
 
+/* The summary's section "Heterogeneity". */
+static void heterogeneity_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Heterogeneity");
     line(f, "flexural slip", "%s",
          !p->flexural_slip ? "off"
@@ -290,9 +305,10 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     else
         line(f, "layered friction", "off");
     line(f, "pre-growth layers", "%d of equal thickness", CDEM_PREGROWTH_LAYERS);
+}
 
-    cdem_processes_describe(p, m, f); /* each process's section (process.h) */
-
+/* The summary's section "Surface processes". */
+static void surface_section(FILE *f, const cdem_params *p, const cdem_model *m) {
     heading(f, "Surface processes");
     if (p->overburden_pressure > 0)
         line(f, "overburden pressure",
@@ -324,6 +340,35 @@ cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_
     } else {
         line(f, "sedimentation", "off");
     }
+}
+
+cdem_status cdem_summary_text(const cdem_params *p, const cdem_model *m, long n_elements,
+                              long n_wall_elements, int elements_estimated, char **text,
+                              cdem_error *err) {
+    /* n_elements: free elements; n_wall_elements: wall, fault and other boundary elements */
+    if (text)
+        *text = NULL;
+    if (!p || !m || !text)
+        return CDEM_FAIL(err, CDEM_ERR_INVALID, "cdem_summary_text: NULL argument");
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return CDEM_FAIL(err, CDEM_ERR_NOMEM, "model summary: cannot open a memory stream");
+
+    fprintf(f, "cdem-c model summary\n");
+    elements_section(f, n_elements, n_wall_elements, elements_estimated);
+    dimensions_section(f, p, m);
+    radii_section(f, p, m);
+    constants_section(f, p, m);
+    time_section(f, p, m);
+    boundary_displacement_section(f, p, m);
+    increments_section(f, p, m);
+    boundary_conditions_section(f, p, m);
+    material_section(f, p);
+    heterogeneity_section(f, p, m);
+    cdem_processes_describe(p, m, f); /* each process's section (process.h) */
+    surface_section(f, p, m);
 
     estimates_section(f, p, m, n_elements + n_wall_elements);
 

@@ -45,7 +45,7 @@ cdem_status cdem_integrator_init(cdem_integrator *it, const cdem_params *p, cons
     it->dt = m->dt;
     it->damping = m->damping;
     const double max_radius = m->max_radius > 0.0 ? m->max_radius : m->radius[CDEM_NUM_RADII - 1];
-    cdem_loads_init(&it->loads, m->gravity, m->gravity_x, m->gravity_y, max_radius);
+    cdem_loads_init(&it->loads, m->gravity, m->mode.gravity_tilt, max_radius);
     cdem_removal_init(&it->removal, max_radius);
     CDEM_TRY(cdem_contact_law_init(&it->law, p, m->kn, m->ks, err));
     it->force.law_scalar_only = !cdem_force_law_vectorised(it->law.granular);

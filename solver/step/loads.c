@@ -9,11 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-void cdem_loads_init(cdem_loads *l, double gravity, double gx, double gy, double max_radius) {
+void cdem_loads_init(cdem_loads *l, double gravity, double tilt_deg, double max_radius) {
     memset(l, 0, sizeof *l);
     l->gravity = gravity;
-    l->gravity_x = gx;
-    l->gravity_y = gy;
+    cdem_model_gravity_vector(gravity, tilt_deg, &l->gravity_x, &l->gravity_y);
     l->model_gx = l->gravity_x;
     l->model_gy = l->gravity_y;
     l->column_width = 2.0 * max_radius;

@@ -39,9 +39,11 @@ typedef struct {
     size_t bandcap;             /* capacity of band_lo, band_hi */
 } cdem_loads;
 
-/* Gravity of magnitude `gravity` along (gx, gy) (m/s^2: the model's start vector,
- * cdem_model.gravity_x/_y), overburden and confinement off; columns 2 x max_radius wide. */
-void cdem_loads_init(cdem_loads *l, double gravity, double gx, double gy, double max_radius);
+/* Gravity of magnitude `gravity` tilted by tilt_deg degrees from -y toward +x
+ * (cdem_model_gravity_vector), overburden and confinement off; columns 2 x max_radius wide.
+ * From the magnitude and the angle, not from a vector kept in the model, so that a model made
+ * by hand (the tests') that sets its gravity has it. */
+void cdem_loads_init(cdem_loads *l, double gravity, double tilt_deg, double max_radius);
 
 /* Gravity's acceleration from now on (m/s^2, the model's frame): a mode that turns the frame
  * (bc.h, the gravity hook) sets it each step. */
